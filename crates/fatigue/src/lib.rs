@@ -1,0 +1,1 @@
+//! Rainflow counting and damage kernels (see issue 5).
