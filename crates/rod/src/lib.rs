@@ -1,1 +1,16 @@
-pub mod placeholder {}
+//! Discrete geometrically exact Cosserat rod (DESIGN.md §3): the model, its strain elements
+//! with exact derivatives, the block-tridiagonal Newton solver, and static/quasistatic solves.
+//! Pure Rust: no files, no Python.
+pub mod assembly;
+pub mod bending;
+pub mod block_tridiag;
+pub mod model;
+pub mod rotation;
+pub mod routing;
+pub mod shear;
+pub mod state;
+pub mod statics;
+
+pub use model::{CableSpec, ClipKind, ClipSpec, PointLoad, Pose, Rod, Section, SpecError};
+pub use state::State;
+pub use statics::{NewtonOptions, SolveError, SolveStats, Statics};

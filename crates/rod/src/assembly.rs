@@ -1,0 +1,322 @@
+//! Residual and Jacobian of the static equilibrium (gradient of the potential energy in the
+//! coordinates x_n and θ with p ← p ⊗ exp(θ/2)), section outputs and clip reactions.
+//!
+//! The Jacobian is the exact derivative of the residual along the Newton update: the symmetric
+//! energy Hessian plus ½[g]× on each rotation's own block (g its energy gradient), which comes
+//! from exp(δ)exp(θ) = exp(δ + θ + ½ δ×θ + …), plus the derivative of dead moments −[Rᵀ M]×.
+use crate::bending::{bend_element, BendEval, Kink};
+use crate::block_tridiag::BlockTridiag;
+use crate::model::{EdgeKind, NodeKind, Rod, RotRef};
+use crate::rotation::{rotation_matrix, skew, Quat};
+use crate::shear::{shear_element, ShearEval};
+use crate::state::State;
+use nalgebra::{Matrix3, Vector3, Vector6};
+
+/// Scratch and outputs of one assembly; allocated once per cable.
+#[derive(Clone, Debug)]
+pub struct Workspace {
+    pub jac: BlockTridiag,
+    /// Residual by block, inactive slots zeroed (the Newton right-hand side is −rhs).
+    pub rhs: Vec<Vector6<f64>>,
+    /// ∂V/∂x_n − f_ext (global): at prescribed nodes, the force of the clip on the cable.
+    pub node_grad: Vec<Vector3<f64>>,
+    /// ∂V/∂θ − Rᵀ m_ext per edge (body frame).
+    pub edge_grad: Vec<Vector3<f64>>,
+    /// ∂V/∂θ per ghost rotation (body frame of the ghost).
+    pub ghost_grad: Vec<Vector3<f64>>,
+    /// Section forces on edges, material frame.
+    pub edge_force: Vec<Vector3<f64>>,
+    /// Section moments on nodes, material frame (average of the two half cells at a clip).
+    pub node_moment: Vec<Vector3<f64>>,
+    node_moment_count: Vec<u8>,
+    pub elastic_energy: f64,
+    /// Potential of the external loads (−work), at the current load factor.
+    pub load_potential: f64,
+    shear: ShearEval,
+    bend: BendEval,
+}
+
+/// The curvature became singular (180° between neighbouring rotations) at a node.
+#[derive(Clone, Copy, Debug)]
+pub struct KinkAt {
+    pub node: usize,
+    pub kink: Kink,
+}
+
+/// A variable of an element: where its 3 coordinates go in the block structure.
+#[derive(Clone, Copy)]
+enum Var {
+    /// Full 3-vector at (block, half).
+    Full(usize, usize),
+    /// Only the d3 component, stored in slot 0 of the block (swivel ghost twist).
+    Axis3(usize),
+    /// Not an unknown.
+    None,
+}
+
+impl Workspace {
+    pub fn new(rod: &Rod) -> Self {
+        let n = rod.n_edges();
+        Workspace {
+            jac: BlockTridiag::new(n + 1),
+            rhs: vec![Vector6::zeros(); n + 1],
+            node_grad: vec![Vector3::zeros(); n + 1],
+            edge_grad: vec![Vector3::zeros(); n],
+            ghost_grad: vec![Vector3::zeros(); rod.ghosts.len()],
+            edge_force: vec![Vector3::zeros(); n],
+            node_moment: vec![Vector3::zeros(); n + 1],
+            node_moment_count: vec![0; n + 1],
+            elastic_energy: 0.0,
+            load_potential: 0.0,
+            shear: ShearEval::default(),
+            bend: BendEval::default(),
+        }
+    }
+
+    pub fn clear(&mut self, want_jac: bool) {
+        if want_jac {
+            self.jac.clear();
+        }
+        self.node_grad.iter_mut().for_each(|v| v.fill(0.0));
+        self.edge_grad.iter_mut().for_each(|v| v.fill(0.0));
+        self.ghost_grad.iter_mut().for_each(|v| v.fill(0.0));
+        self.node_moment.iter_mut().for_each(|v| v.fill(0.0));
+        self.node_moment_count.iter_mut().for_each(|c| *c = 0);
+        self.elastic_energy = 0.0;
+        self.load_potential = 0.0;
+    }
+
+    fn add(&mut self, vi: Var, vj: Var, m: &Matrix3<f64>) {
+        let (bi, hi, mi) = match vi {
+            Var::Full(b, h) => (b, h, *m),
+            Var::Axis3(b) => {
+                let mut r = Matrix3::zeros();
+                r.set_row(0, &m.row(2));
+                (b, 0, r)
+            }
+            Var::None => return,
+        };
+        match vj {
+            Var::Full(b, h) => self.jac.add3(bi, hi, b, h, &mi),
+            Var::Axis3(b) => {
+                let mut c = Matrix3::zeros();
+                c.set_column(0, &mi.column(2));
+                self.jac.add3(bi, hi, b, 0, &c);
+            }
+            Var::None => {}
+        }
+    }
+
+    /// Elastic terms (shear/extension and bending/torsion) with the rotation-group correction.
+    pub fn add_elastic(&mut self, rod: &Rod, st: &State, want_jac: bool) -> Result<(), KinkAt> {
+        let sec = &rod.spec.section;
+        let strain0 = Vector3::zeros();
+        for e in 0..rod.n_edges() {
+            shear_element(
+                &st.x[e],
+                &st.x[e + 1],
+                &st.p[e],
+                rod.ds_edge[e],
+                &sec.shear_stiffness,
+                &strain0,
+                want_jac,
+                &mut self.shear,
+            );
+            self.elastic_energy += self.shear.energy;
+            self.edge_force[e] = self.shear.force;
+            self.node_grad[e] += self.shear.grad[0];
+            self.node_grad[e + 1] += self.shear.grad[1];
+            self.edge_grad[e] += self.shear.grad[2];
+            if want_jac {
+                let vars = [node_var(rod, e), node_var(rod, e + 1), edge_var(rod, e)];
+                let h = self.shear.hess;
+                for i in 0..3 {
+                    for j in 0..3 {
+                        self.add(vars[i], vars[j], &h[i][j]);
+                    }
+                }
+            }
+        }
+        let k0 = rod.spec.natural_curvature;
+        for t in &rod.bend_terms {
+            let pa = rot(st, t.a);
+            let pb = rot(st, t.b);
+            bend_element(
+                &pa,
+                &pb,
+                t.weight,
+                &sec.bend_stiffness,
+                &k0,
+                want_jac,
+                &mut self.bend,
+            )
+            .map_err(|kink| KinkAt { node: t.node, kink })?;
+            self.elastic_energy += self.bend.energy;
+            self.node_moment[t.node] += self.bend.moment;
+            self.node_moment_count[t.node] += 1;
+            for (r, g) in [(t.a, self.bend.grad[0]), (t.b, self.bend.grad[1])] {
+                match r {
+                    RotRef::Edge(e) => self.edge_grad[e] += g,
+                    RotRef::Ghost(k) => self.ghost_grad[k] += g,
+                }
+            }
+            if want_jac {
+                let vars = [rot_var(rod, t.a), rot_var(rod, t.b)];
+                let h = self.bend.hess;
+                for i in 0..2 {
+                    for j in 0..2 {
+                        self.add(vars[i], vars[j], &h[i][j]);
+                    }
+                }
+            }
+        }
+        for n in 0..self.node_moment.len() {
+            if self.node_moment_count[n] > 1 {
+                self.node_moment[n] /= self.node_moment_count[n] as f64;
+            }
+        }
+        if want_jac {
+            for e in 0..rod.n_edges() {
+                if rod.edge_kind[e] != EdgeKind::Free {
+                    continue; // prescribed, or a single twist axis (whose correction is zero)
+                }
+                let corr = 0.5 * skew(&self.edge_grad[e]);
+                self.jac.add3(e, 1, e, 1, &corr);
+            }
+        }
+        Ok(())
+    }
+
+    /// Gravity and point loads, scaled by `load_factor`.
+    pub fn add_external(&mut self, rod: &Rod, st: &State, load_factor: f64, want_jac: bool) {
+        let g = rod.spec.gravity;
+        for n in 0..st.x.len() {
+            let f = load_factor * (rod.node_mass[n] * g + rod.node_force[n]);
+            self.node_grad[n] -= f;
+            self.load_potential -= f.dot(&st.x[n]);
+        }
+        for e in 0..rod.n_edges() {
+            let m = rod.edge_moment[e];
+            if m == Vector3::zeros() {
+                continue;
+            }
+            let mb = rotation_matrix(&st.p[e]).transpose() * (load_factor * m);
+            self.edge_grad[e] -= mb;
+            if want_jac {
+                self.jac.add3(e, 1, e, 1, &(-skew(&mb)));
+            }
+        }
+    }
+
+    /// Gathers the gradients into the block residual and eliminates inactive slots.
+    pub fn finalize(&mut self, rod: &Rod, want_jac: bool) {
+        let n_edges = rod.n_edges();
+        for n in 0..=n_edges {
+            let mut r = Vector6::zeros();
+            r.fixed_rows_mut::<3>(0).copy_from(&self.node_grad[n]);
+            if n < n_edges {
+                r.fixed_rows_mut::<3>(3).copy_from(&self.edge_grad[n]);
+            }
+            self.rhs[n] = r;
+        }
+        for (k, g) in rod.ghosts.iter().enumerate() {
+            if g.twist_free {
+                self.rhs[g.node][0] = self.ghost_grad[k].z;
+            }
+        }
+        for n in 0..=n_edges {
+            for k in 0..6 {
+                if !rod.mask[n][k] {
+                    self.rhs[n][k] = 0.0;
+                    if want_jac {
+                        self.jac.eliminate_slot(n, k);
+                    }
+                }
+            }
+        }
+    }
+
+    /// Full static assembly at a load factor.
+    pub fn assemble_static(
+        &mut self,
+        rod: &Rod,
+        st: &State,
+        load_factor: f64,
+        want_jac: bool,
+    ) -> Result<(), KinkAt> {
+        self.clear(want_jac);
+        self.add_elastic(rod, st, want_jac)?;
+        self.add_external(rod, st, load_factor, want_jac);
+        self.finalize(rod, want_jac);
+        Ok(())
+    }
+
+    /// Reaction force and moment (about the clip point) of clip `c` on the cable, global frame.
+    /// Valid after an assembly at the state `st`.
+    pub fn clip_reaction(&self, rod: &Rod, st: &State, c: usize) -> (Vector3<f64>, Vector3<f64>) {
+        let centre = st.clip_pose[c].position;
+        let mut f = Vector3::zeros();
+        let mut m = Vector3::zeros();
+        for &n in &rod.clip_nodes[c] {
+            f += self.node_grad[n];
+            m += (st.x[n] - centre).cross(&self.node_grad[n]);
+        }
+        for &e in &rod.clip_edges[c] {
+            m += rotation_matrix(&st.p[e]) * self.edge_grad[e];
+        }
+        if let Some(g) = rod.clip_ghost[c] {
+            m += rotation_matrix(&st.ghost[g]) * self.ghost_grad[g];
+        }
+        (f, m)
+    }
+
+    /// Scaled residual norms (max over blocks): forces in N, moments divided by `length`.
+    pub fn residual_norms(&self, length: f64) -> (f64, f64) {
+        let mut two = 0.0;
+        let mut inf = 0.0f64;
+        for r in &self.rhs {
+            for k in 0..6 {
+                let v = if k < 3 { r[k] } else { r[k] / length };
+                two += v * v;
+                inf = inf.max(v.abs());
+            }
+        }
+        (two.sqrt(), inf)
+    }
+}
+
+#[inline]
+fn rot(st: &State, r: RotRef) -> Quat {
+    match r {
+        RotRef::Edge(e) => st.p[e],
+        RotRef::Ghost(g) => st.ghost[g],
+    }
+}
+
+fn node_var(rod: &Rod, n: usize) -> Var {
+    match rod.node_kind[n] {
+        NodeKind::Free => Var::Full(n, 0),
+        NodeKind::Prescribed { .. } => Var::None,
+    }
+}
+
+fn edge_var(rod: &Rod, e: usize) -> Var {
+    match rod.edge_kind[e] {
+        EdgeKind::Prescribed { .. } => Var::None,
+        _ => Var::Full(e, 1),
+    }
+}
+
+fn rot_var(rod: &Rod, r: RotRef) -> Var {
+    match r {
+        RotRef::Edge(e) => edge_var(rod, e),
+        RotRef::Ghost(g) => {
+            let gh = rod.ghosts[g];
+            if gh.twist_free {
+                Var::Axis3(gh.node)
+            } else {
+                Var::None
+            }
+        }
+    }
+}

@@ -1,0 +1,188 @@
+//! Quaternions (scalar first, Hamilton product) and the rotation-group helpers of the solver.
+//!
+//! nalgebra's `Quaternion::new(w, i, j, k)` is used throughout; `R(p)` maps the material frame
+//! (d1, d2, d3) to the global frame. Increments act in the body frame: p ← p ⊗ exp(θ/2).
+use nalgebra::{Matrix3, Quaternion, Vector3};
+
+pub type Quat = Quaternion<f64>;
+
+/// The cross-product matrix [v]×, with [v]× w = v × w.
+#[inline]
+pub fn skew(v: &Vector3<f64>) -> Matrix3<f64> {
+    Matrix3::new(0.0, -v.z, v.y, v.z, 0.0, -v.x, -v.y, v.x, 0.0)
+}
+
+/// exp(θ/2) as a unit quaternion: the rotation by |θ| about θ/|θ|.
+#[inline]
+pub fn exp_half(theta: &Vector3<f64>) -> Quat {
+    let angle = theta.norm();
+    if angle < 1e-8 {
+        // Taylor expansion; exact to round-off for such small angles.
+        let w = 1.0 - angle * angle / 8.0;
+        let s = 0.5 - angle * angle / 48.0;
+        Quaternion::new(w, s * theta.x, s * theta.y, s * theta.z)
+    } else {
+        let (s, c) = (0.5 * angle).sin_cos();
+        let k = s / angle;
+        Quaternion::new(c, k * theta.x, k * theta.y, k * theta.z)
+    }
+}
+
+/// p ⊗ exp(θ/2), renormalised so that |p| = 1 holds to round-off.
+#[inline]
+pub fn rotate_body(p: &Quat, theta: &Vector3<f64>) -> Quat {
+    let q = p * exp_half(theta);
+    q / q.norm()
+}
+
+/// Rotation vector (axis · angle, angle in [0, π]) of a unit quaternion.
+pub fn log_vec(q: &Quat) -> Vector3<f64> {
+    let q = if q.w < 0.0 { -q } else { *q };
+    let v = q.imag();
+    let s = v.norm();
+    if s < 1e-12 {
+        return 2.0 * v;
+    }
+    let angle = 2.0 * s.atan2(q.w);
+    v * (angle / s)
+}
+
+/// The rotation matrix R(p) of a unit quaternion p.
+#[inline]
+pub fn rotation_matrix(p: &Quat) -> Matrix3<f64> {
+    let (w, x, y, z) = (p.w, p.i, p.j, p.k);
+    let (xx, yy, zz) = (x * x, y * y, z * z);
+    let (xy, xz, yz) = (x * y, x * z, y * z);
+    let (wx, wy, wz) = (w * x, w * y, w * z);
+    Matrix3::new(
+        1.0 - 2.0 * (yy + zz),
+        2.0 * (xy - wz),
+        2.0 * (xz + wy),
+        2.0 * (xy + wz),
+        1.0 - 2.0 * (xx + zz),
+        2.0 * (yz - wx),
+        2.0 * (xz - wy),
+        2.0 * (yz + wx),
+        1.0 - 2.0 * (xx + yy),
+    )
+}
+
+/// The unit quaternion of a rotation matrix (Shepperd's method, stable for all angles).
+pub fn from_matrix(r: &Matrix3<f64>) -> Quat {
+    let tr = r.trace();
+    let q = if tr > r[(0, 0)] && tr > r[(1, 1)] && tr > r[(2, 2)] {
+        let s = (1.0 + tr).sqrt() * 2.0;
+        Quaternion::new(
+            0.25 * s,
+            (r[(2, 1)] - r[(1, 2)]) / s,
+            (r[(0, 2)] - r[(2, 0)]) / s,
+            (r[(1, 0)] - r[(0, 1)]) / s,
+        )
+    } else if r[(0, 0)] > r[(1, 1)] && r[(0, 0)] > r[(2, 2)] {
+        let s = (1.0 + r[(0, 0)] - r[(1, 1)] - r[(2, 2)]).sqrt() * 2.0;
+        Quaternion::new(
+            (r[(2, 1)] - r[(1, 2)]) / s,
+            0.25 * s,
+            (r[(0, 1)] + r[(1, 0)]) / s,
+            (r[(0, 2)] + r[(2, 0)]) / s,
+        )
+    } else if r[(1, 1)] > r[(2, 2)] {
+        let s = (1.0 + r[(1, 1)] - r[(0, 0)] - r[(2, 2)]).sqrt() * 2.0;
+        Quaternion::new(
+            (r[(0, 2)] - r[(2, 0)]) / s,
+            (r[(0, 1)] + r[(1, 0)]) / s,
+            0.25 * s,
+            (r[(1, 2)] + r[(2, 1)]) / s,
+        )
+    } else {
+        let s = (1.0 + r[(2, 2)] - r[(0, 0)] - r[(1, 1)]).sqrt() * 2.0;
+        Quaternion::new(
+            (r[(1, 0)] - r[(0, 1)]) / s,
+            (r[(0, 2)] + r[(2, 0)]) / s,
+            (r[(1, 2)] + r[(2, 1)]) / s,
+            0.25 * s,
+        )
+    };
+    let q = q / q.norm();
+    if q.w < 0.0 {
+        -q
+    } else {
+        q
+    }
+}
+
+/// The material frame with tangent d3 and (the part of `normal` orthogonal to d3 as) d1.
+/// Returns `None` when `normal` is parallel to `tangent` or either is zero.
+pub fn frame_quaternion(tangent: &Vector3<f64>, normal: &Vector3<f64>) -> Option<Quat> {
+    let d3 = tangent.try_normalize(1e-300)?;
+    let d1 = (normal - d3 * normal.dot(&d3)).try_normalize(1e-9 * normal.norm().max(1e-300))?;
+    let d2 = d3.cross(&d1);
+    Some(from_matrix(&Matrix3::from_columns(&[d1, d2, d3])))
+}
+
+/// A normal to `t` (unit), the global axis least aligned with it projected away from it.
+pub fn any_normal(t: &Vector3<f64>) -> Vector3<f64> {
+    let a = if t.x.abs() <= t.y.abs() && t.x.abs() <= t.z.abs() {
+        Vector3::x()
+    } else if t.y.abs() <= t.z.abs() {
+        Vector3::y()
+    } else {
+        Vector3::z()
+    };
+    (a - t * a.dot(t)).normalize()
+}
+
+/// The smallest rotation taking unit vector `a` to unit vector `b`, as a quaternion
+/// (global frame: q ⊗ a ⊗ q̄ = b). For antiparallel vectors any half turn is returned.
+pub fn min_rotation(a: &Vector3<f64>, b: &Vector3<f64>) -> Quat {
+    let c = a.dot(b);
+    if c < -1.0 + 1e-12 {
+        let n = any_normal(a);
+        return Quaternion::new(0.0, n.x, n.y, n.z);
+    }
+    let v = a.cross(b);
+    let q = Quaternion::new(1.0 + c, v.x, v.y, v.z);
+    q / q.norm()
+}
+
+/// Spherical linear interpolation between unit quaternions (shortest arc).
+pub fn slerp(a: &Quat, b: &Quat, t: f64) -> Quat {
+    let b = if a.coords.dot(&b.coords) < 0.0 {
+        -b
+    } else {
+        *b
+    };
+    let d = a.conjugate() * b;
+    let out = a * exp_half(&(log_vec(&d) * t));
+    out / out.norm()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn matrix_round_trip_and_exp() {
+        let p = exp_half(&Vector3::new(0.3, -1.2, 2.5));
+        let r = rotation_matrix(&p);
+        assert!((r.transpose() * r - Matrix3::identity()).norm() < 1e-14);
+        let q = from_matrix(&r);
+        assert!((q.coords - p.coords).norm() < 1e-13 || (q.coords + p.coords).norm() < 1e-13);
+        let theta = Vector3::new(0.2, 0.1, -0.4);
+        let e = rotation_matrix(&exp_half(&theta));
+        // exp([θ]×) rotates θ onto itself and is a rotation by |θ|.
+        assert!((e * theta - theta).norm() < 1e-15);
+        assert!(((e.trace() - 1.0) / 2.0 - theta.norm().cos()).abs() < 1e-14);
+        assert!((log_vec(&exp_half(&theta)) - theta).norm() < 1e-14);
+    }
+
+    #[test]
+    fn min_rotation_maps_vectors() {
+        let a = Vector3::new(1.0, 2.0, 3.0).normalize();
+        let b = Vector3::new(-2.0, 0.5, 1.0).normalize();
+        let r = rotation_matrix(&min_rotation(&a, &b));
+        assert!((r * a - b).norm() < 1e-14);
+        let r = rotation_matrix(&min_rotation(&a, &(-a)));
+        assert!((r * a + a).norm() < 1e-14);
+    }
+}

@@ -1,0 +1,349 @@
+//! Static and quasistatic equilibria: Newton on the rotation group with a backtracking line
+//! search on the scaled residual, load continuation when plain Newton fails, and sub-stepped
+//! clip motions for sequences of equilibria.
+use crate::assembly::{KinkAt, Workspace};
+use crate::block_tridiag::Singular;
+use crate::model::{Pose, Rod};
+use crate::rotation::slerp;
+use crate::state::State;
+use nalgebra::Vector6;
+use std::fmt;
+
+#[derive(Clone, Debug)]
+pub struct NewtonOptions {
+    pub max_iterations: usize,
+    /// Converged when the full Newton step is below this (|Δx|/L and |θ| in rad).
+    pub step_tolerance: f64,
+    /// … or when the scaled residual is below this times the reference force.
+    pub residual_tolerance: f64,
+    /// Largest rotation increment per iteration, rad.
+    pub max_rotation_step: f64,
+    /// Smallest load-factor increment of the continuation before giving up.
+    pub min_load_step: f64,
+    /// Deepest bisection of a quasistatic step before giving up.
+    pub max_substep_depth: usize,
+}
+
+impl Default for NewtonOptions {
+    fn default() -> Self {
+        NewtonOptions {
+            max_iterations: 40,
+            step_tolerance: 1e-9,
+            residual_tolerance: 1e-10,
+            max_rotation_step: 1.0,
+            min_load_step: 1e-4,
+            max_substep_depth: 12,
+        }
+    }
+}
+
+/// What a solve did.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct SolveStats {
+    pub iterations: usize,
+    /// Scaled residual (∞-norm, N) at the end.
+    pub residual: f64,
+    /// Number of continuation or sub-steps used (0: plain Newton worked).
+    pub substeps: usize,
+}
+
+#[derive(Clone, Debug)]
+pub enum SolveError {
+    Kink {
+        node: usize,
+        s: f64,
+    },
+    Singular {
+        node: usize,
+        s: f64,
+    },
+    NotConverged {
+        iterations: usize,
+        residual: f64,
+        load_factor: f64,
+    },
+}
+
+impl fmt::Display for SolveError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            SolveError::Kink { node, s } => write!(
+                f,
+                "the cable folds back on itself at node {node} (s = {s:.4} m): neighbouring \
+                 segments turned by almost 180°; refine the mesh or check the clip poses"
+            ),
+            SolveError::Singular { node, s } => write!(
+                f,
+                "the stiffness matrix is singular near node {node} (s = {s:.4} m): the clips \
+                 leave a rigid-body motion of the cable free (add a fixed clip or a constraint)"
+            ),
+            SolveError::NotConverged {
+                iterations,
+                residual,
+                load_factor,
+            } => write!(
+                f,
+                "Newton did not converge: {iterations} iterations, last residual {residual:.3e} N \
+                 at load factor {load_factor:.4}"
+            ),
+        }
+    }
+}
+impl std::error::Error for SolveError {}
+
+/// A static/quasistatic solver for one cable: the workspace and options.
+pub struct Statics {
+    pub ws: Workspace,
+    pub opts: NewtonOptions,
+    delta: Vec<Vector6<f64>>,
+    trial: Vec<Vector6<f64>>,
+    base: State,
+    force_scale: f64,
+}
+
+impl Statics {
+    pub fn new(rod: &Rod, opts: NewtonOptions) -> Self {
+        let sec = &rod.spec.section;
+        let l = rod.spec.length;
+        let weight = sec.mass_per_length * l * rod.spec.gravity.norm();
+        let loads = rod
+            .spec
+            .loads
+            .iter()
+            .map(|ld| ld.force.norm() + ld.moment.norm() / l)
+            .fold(0.0, f64::max);
+        let bend = sec.bend_stiffness.max() / (l * l);
+        Statics {
+            ws: Workspace::new(rod),
+            opts,
+            delta: vec![Vector6::zeros(); rod.n_edges() + 1],
+            trial: vec![Vector6::zeros(); rod.n_edges() + 1],
+            base: State::empty(),
+            force_scale: weight.max(loads).max(bend).max(1e-12),
+        }
+    }
+
+    fn kink_err(rod: &Rod, k: KinkAt) -> SolveError {
+        SolveError::Kink {
+            node: k.node,
+            s: rod.arc[k.node],
+        }
+    }
+
+    /// Newton iterations at a fixed load factor. Plain steps (rotation increments capped, halved
+    /// only when a trial kinks or is not finite) or, with `damped`, steps that must pass the
+    /// natural monotonicity test. On failure the state is left where it got.
+    pub fn newton(
+        &mut self,
+        rod: &Rod,
+        st: &mut State,
+        load_factor: f64,
+        damped: bool,
+    ) -> Result<SolveStats, SolveError> {
+        let h = rod.mean_ds();
+        let l = rod.spec.length;
+        self.ws
+            .assemble_static(rod, st, load_factor, true)
+            .map_err(|k| Self::kink_err(rod, k))?;
+        let (_, mut rinf) = self.ws.residual_norms(h);
+        let mut stats = SolveStats::default();
+        for it in 0..self.opts.max_iterations {
+            stats.iterations = it + 1;
+            if rinf <= self.opts.residual_tolerance * self.force_scale {
+                stats.iterations = it;
+                stats.residual = rinf;
+                return Ok(stats);
+            }
+            self.ws
+                .jac
+                .factor()
+                .map_err(|Singular { block }| SolveError::Singular {
+                    node: block,
+                    s: rod.arc[block.min(rod.arc.len() - 1)],
+                })?;
+            for (d, r) in self.delta.iter_mut().zip(&self.ws.rhs) {
+                *d = -r;
+            }
+            self.ws.jac.solve_factored(&mut self.delta);
+            let (mut dx, mut dth) = (0.0f64, 0.0f64);
+            for d in &self.delta {
+                dx = dx.max(d.fixed_rows::<3>(0).amax());
+                dth = dth.max(d.fixed_rows::<3>(3).amax());
+            }
+            if !(dx.is_finite() && dth.is_finite()) {
+                return Err(SolveError::Singular { node: 0, s: 0.0 });
+            }
+            let step = (dx / l).max(dth);
+            let norm0 = scaled_norm(&self.delta, l);
+            let mut alpha = 1.0f64.min(self.opts.max_rotation_step / dth.max(1e-300));
+            // Damped: Deuflhard's natural monotonicity test, the simplified Newton correction
+            // J⁻¹ r(x ⊕ αΔ) with the factorisation at hand must shrink. It is invariant to the
+            // scaling of the equations, so a stiff EA does not distort it. (Residual-norm line
+            // searches stall here: a rotation step stretches the stiff axis quadratically.)
+            self.base.clone_from(st);
+            let mut accepted = false;
+            for _ in 0..16 {
+                st.apply_increment(rod, &self.delta, alpha);
+                if self.ws.assemble_static(rod, st, load_factor, false).is_ok() {
+                    for (d, r) in self.trial.iter_mut().zip(&self.ws.rhs) {
+                        *d = -r;
+                    }
+                    self.ws.jac.solve_factored(&mut self.trial);
+                    let theta = scaled_norm(&self.trial, l) / norm0.max(1e-300);
+                    let monotone =
+                        theta <= 1.0 - 0.25 * alpha || step * alpha < self.opts.step_tolerance;
+                    if theta.is_finite() && (!damped || monotone) {
+                        accepted = true;
+                        break;
+                    }
+                }
+                st.clone_from(&self.base);
+                alpha *= 0.5;
+            }
+            if !accepted {
+                return Err(SolveError::NotConverged {
+                    iterations: stats.iterations,
+                    residual: rinf,
+                    load_factor,
+                });
+            }
+            self.ws
+                .assemble_static(rod, st, load_factor, true)
+                .map_err(|k| Self::kink_err(rod, k))?;
+            (_, rinf) = self.ws.residual_norms(h);
+            if std::env::var_os("ROD_DEBUG").is_some() {
+                eprintln!(
+                    "it {it} lf {load_factor} alpha {alpha:.3e} step {step:.3e} rinf {rinf:.3e}"
+                );
+            }
+            if alpha == 1.0 && step < self.opts.step_tolerance {
+                stats.residual = rinf;
+                return Ok(stats);
+            }
+        }
+        Err(SolveError::NotConverged {
+            iterations: stats.iterations,
+            residual: rinf,
+            load_factor,
+        })
+    }
+
+    /// Static equilibrium: plain Newton, then load continuation from the unloaded routed shape
+    /// (gravity and loads ramped), first with plain then with damped Newton steps.
+    pub fn solve(&mut self, rod: &Rod, st: &mut State) -> Result<SolveStats, SolveError> {
+        let start = st.clone();
+        let mut last = match self.newton(rod, st, 1.0, false) {
+            Ok(s) => return Ok(s),
+            Err(e @ SolveError::Singular { .. }) => return Err(e),
+            Err(e) => e,
+        };
+        for damped in [false, true] {
+            st.clone_from(&start);
+            match self.continuation(rod, st, damped) {
+                Ok(s) => return Ok(s),
+                Err(e @ SolveError::Singular { .. }) => return Err(e),
+                Err(e) => last = e,
+            }
+        }
+        Err(last)
+    }
+
+    fn continuation(
+        &mut self,
+        rod: &Rod,
+        st: &mut State,
+        damped: bool,
+    ) -> Result<SolveStats, SolveError> {
+        let mut total = self.newton(rod, st, 0.0, damped)?;
+        total.substeps = 1;
+        let mut lambda = 0.0;
+        let mut dl = 0.25f64;
+        while lambda < 1.0 {
+            let trial = (lambda + dl).min(1.0);
+            let saved = st.clone();
+            match self.newton(rod, st, trial, damped) {
+                Ok(s) => {
+                    total.iterations += s.iterations;
+                    total.residual = s.residual;
+                    total.substeps += 1;
+                    lambda = trial;
+                    dl *= 1.5;
+                }
+                Err(e) => {
+                    st.clone_from(&saved);
+                    dl *= 0.5;
+                    if dl < self.opts.min_load_step {
+                        return Err(e);
+                    }
+                }
+            }
+        }
+        Ok(total)
+    }
+
+    /// One step of a sequence of equilibria: from the current (converged) state to the clip
+    /// poses `target`, bisecting the clip motion when Newton fails.
+    pub fn step_to(
+        &mut self,
+        rod: &Rod,
+        st: &mut State,
+        target: &[Pose],
+    ) -> Result<SolveStats, SolveError> {
+        let start_poses = st.clip_pose.clone();
+        let saved = st.clone();
+        st.set_clip_poses(rod, target);
+        match self.newton(rod, st, 1.0, false) {
+            Ok(s) => return Ok(s),
+            Err(e @ SolveError::Singular { .. }) => return Err(e),
+            Err(_) => st.clone_from(&saved),
+        }
+        // Bisect the motion: fractions of the way from start to target.
+        let mut total = SolveStats::default();
+        let mut done = 0.0f64;
+        let mut df = 0.5f64;
+        let mut depth = 1;
+        let mut poses = target.to_vec();
+        while done < 1.0 {
+            let f = (done + df).min(1.0);
+            for (c, pose) in poses.iter_mut().enumerate() {
+                pose.position = start_poses[c].position.lerp(&target[c].position, f);
+                pose.orientation = slerp(&start_poses[c].orientation, &target[c].orientation, f);
+            }
+            let saved = st.clone();
+            st.set_clip_poses(rod, &poses);
+            match self.newton(rod, st, 1.0, false) {
+                Ok(s) => {
+                    total.iterations += s.iterations;
+                    total.residual = s.residual;
+                    total.substeps += 1;
+                    done = f;
+                    if depth > 1 {
+                        depth -= 1;
+                        df *= 2.0;
+                    }
+                }
+                Err(e) => {
+                    st.clone_from(&saved);
+                    df *= 0.5;
+                    depth += 1;
+                    if depth > self.opts.max_substep_depth {
+                        return Err(e);
+                    }
+                }
+            }
+        }
+        Ok(total)
+    }
+}
+
+/// ‖Δ‖ with positions relative to the cable length and rotations in rad.
+fn scaled_norm(d: &[Vector6<f64>], length: f64) -> f64 {
+    let mut sum = 0.0;
+    for v in d {
+        for k in 0..6 {
+            let x = if k < 3 { v[k] / length } else { v[k] };
+            sum += x * x;
+        }
+    }
+    sum.sqrt()
+}
