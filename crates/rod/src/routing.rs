@@ -1,9 +1,9 @@
 //! The initial configuration: a smooth curve through the clips with the clip tangents and the
-//! prescribed cable length between clips (cubic Hermite, tangent scale solved for the length);
+//! prescribed cable length between clips (cubic Hermite plus a sag bulge, solved for the length);
 //! free ends follow the natural curvature from the last clip. Frames are parallel-transported
 //! and the twist mismatch at the next clip is spread linearly over the span.
 use crate::model::{Pose, Rod, SpecError};
-use crate::rotation::{exp_half, min_rotation, rotation_matrix, Quat};
+use crate::rotation::{any_normal, exp_half, min_rotation, rotation_matrix, Quat};
 use crate::state::{twist, State};
 use nalgebra::Vector3;
 
@@ -72,17 +72,10 @@ pub fn route(rod: &Rod, poses: Option<&[Pose]>) -> Result<State, SpecError> {
                 span
             )));
         }
-        let lambda = solve_tangent_scale(&a, &b, &ta, &tb, span);
+        let sag = sag_direction(&a, &b, &ta, &tb, &spec.gravity);
+        let curve = SpanCurve::fit(a, b, ta, tb, sag, span);
         let pts: Vec<Vector3<f64>> = (0..=SAMPLES)
-            .map(|i| {
-                hermite(
-                    &a,
-                    &b,
-                    &(lambda * ta),
-                    &(lambda * tb),
-                    i as f64 / SAMPLES as f64,
-                )
-            })
+            .map(|i| curve.at(i as f64 / SAMPLES as f64))
             .collect();
         let mut cum = vec![0.0; pts.len()];
         for i in 1..pts.len() {
@@ -152,63 +145,102 @@ fn twist_angle(a: &Quat, b: &Quat) -> f64 {
     2.0 * q.k.atan2(q.w)
 }
 
-fn hermite(
+/// The curve of one span: a cubic Hermite with tangent scale λ ≤ chord (larger λ makes loops),
+/// plus a sag bulge β·n·16t²(1−t)² (zero offset and slope at both ends) for the slack a
+/// Hermite curve without loops cannot take up.
+struct SpanCurve {
+    a: Vector3<f64>,
+    b: Vector3<f64>,
+    ta: Vector3<f64>,
+    tb: Vector3<f64>,
+    sag: Vector3<f64>,
+}
+
+impl SpanCurve {
+    fn at(&self, t: f64) -> Vector3<f64> {
+        let (t2, t3) = (t * t, t * t * t);
+        let bump = 16.0 * t2 * (1.0 - t) * (1.0 - t);
+        self.a * (2.0 * t3 - 3.0 * t2 + 1.0)
+            + self.ta * (t3 - 2.0 * t2 + t)
+            + self.b * (-2.0 * t3 + 3.0 * t2)
+            + self.tb * (t3 - t2)
+            + self.sag * bump
+    }
+
+    fn length(&self) -> f64 {
+        let mut len = 0.0;
+        let mut prev = self.a;
+        for i in 1..=SAMPLES {
+            let p = self.at(i as f64 / SAMPLES as f64);
+            len += (p - prev).norm();
+            prev = p;
+        }
+        len
+    }
+
+    fn fit(
+        a: Vector3<f64>,
+        b: Vector3<f64>,
+        ta: Vector3<f64>,
+        tb: Vector3<f64>,
+        n: Vector3<f64>,
+        span: f64,
+    ) -> Self {
+        let chord = (b - a).norm();
+        let make = |lambda: f64, beta: f64| SpanCurve {
+            a,
+            b,
+            ta: ta * lambda,
+            tb: tb * lambda,
+            sag: n * beta,
+        };
+        let lmax = chord.max(1e-3 * span);
+        if make(lmax, 0.0).length() >= span {
+            let (mut lo, mut hi) = (0.0, lmax);
+            for _ in 0..60 {
+                let mid = 0.5 * (lo + hi);
+                if make(mid, 0.0).length() < span {
+                    lo = mid
+                } else {
+                    hi = mid
+                }
+            }
+            return make(0.5 * (lo + hi), 0.0);
+        }
+        let mut hi = span;
+        while make(lmax, hi).length() < span {
+            hi *= 2.0;
+        }
+        let mut lo = 0.0;
+        for _ in 0..60 {
+            let mid = 0.5 * (lo + hi);
+            if make(lmax, mid).length() < span {
+                lo = mid
+            } else {
+                hi = mid
+            }
+        }
+        make(lmax, 0.5 * (lo + hi))
+    }
+}
+
+/// The direction a slack span sags: along gravity, orthogonal to the chord; without gravity
+/// (or gravity along the chord) along the mean end tangent's orthogonal part, else any normal.
+fn sag_direction(
     a: &Vector3<f64>,
     b: &Vector3<f64>,
     ta: &Vector3<f64>,
     tb: &Vector3<f64>,
-    t: f64,
+    gravity: &Vector3<f64>,
 ) -> Vector3<f64> {
-    let (t2, t3) = (t * t, t * t * t);
-    a * (2.0 * t3 - 3.0 * t2 + 1.0)
-        + ta * (t3 - 2.0 * t2 + t)
-        + b * (-2.0 * t3 + 3.0 * t2)
-        + tb * (t3 - t2)
-}
-
-fn curve_length(
-    a: &Vector3<f64>,
-    b: &Vector3<f64>,
-    ta: &Vector3<f64>,
-    tb: &Vector3<f64>,
-    lambda: f64,
-) -> f64 {
-    let (ta, tb) = (ta * lambda, tb * lambda);
-    let mut len = 0.0;
-    let mut prev = *a;
-    for i in 1..=SAMPLES {
-        let p = hermite(a, b, &ta, &tb, i as f64 / SAMPLES as f64);
-        len += (p - prev).norm();
-        prev = p;
-    }
-    len
-}
-
-/// The tangent scale λ at which the Hermite curve has length `span` (bisection; λ = 0 gives the
-/// chord, the shortest curve).
-fn solve_tangent_scale(
-    a: &Vector3<f64>,
-    b: &Vector3<f64>,
-    ta: &Vector3<f64>,
-    tb: &Vector3<f64>,
-    span: f64,
-) -> f64 {
-    let mut hi = span.max(1e-12);
-    let mut k = 0;
-    while curve_length(a, b, ta, tb, hi) < span && k < 60 {
-        hi *= 2.0;
-        k += 1;
-    }
-    let mut lo = 0.0;
-    for _ in 0..60 {
-        let mid = 0.5 * (lo + hi);
-        if curve_length(a, b, ta, tb, mid) < span {
-            lo = mid;
-        } else {
-            hi = mid;
+    let c = (b - a).try_normalize(1e-300).unwrap_or(*ta);
+    for cand in [*gravity, ta + tb, ta - tb] {
+        let v = cand - c * cand.dot(&c);
+        if v.norm() > 1e-6 * cand.norm().max(1e-300) && v.norm() > 0.0 {
+            return v.normalize();
         }
     }
-    0.5 * (lo + hi)
+    any_normal(&c)
 }
 
 /// Integrates the natural shape forward from node `from` (pose at that node) to node `to`.

@@ -1,0 +1,301 @@
+//! Bindings of the rod solver: a `Cable` built from plain numbers and arrays; runs release the
+//! GIL, poll Ctrl-C and report progress through an optional Python callable.
+use nalgebra::{Quaternion, Vector3};
+use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray3};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use rod::assembly::Workspace;
+use rod::routing::route;
+use rod::{CableSpec, ClipKind, ClipSpec, NewtonOptions, PointLoad, Pose, Rod, Section, State, Statics};
+
+fn vec3(v: &[f64], what: &str) -> PyResult<Vector3<f64>> {
+    if v.len() != 3 || v.iter().any(|x| !x.is_finite()) {
+        return Err(PyValueError::new_err(format!("{what} = {v:?}: must be 3 finite numbers")));
+    }
+    Ok(Vector3::new(v[0], v[1], v[2]))
+}
+
+fn quat(v: &[f64], what: &str) -> PyResult<Quaternion<f64>> {
+    if v.len() != 4 || v.iter().any(|x| !x.is_finite()) {
+        return Err(PyValueError::new_err(format!("{what} = {v:?}: must be 4 finite numbers")));
+    }
+    let q = Quaternion::new(v[0], v[1], v[2], v[3]);
+    if q.norm() == 0.0 {
+        return Err(PyValueError::new_err(format!("{what} = {v:?}: must be a non-zero quaternion")));
+    }
+    Ok(q / q.norm())
+}
+
+/// Per-step outputs collected during a run (flat, row-major).
+#[derive(Default)]
+struct Record {
+    steps: usize,
+    positions: Vec<f64>,
+    quaternions: Vec<f64>,
+    forces: Vec<f64>,
+    moments: Vec<f64>,
+    reaction_force: Vec<f64>,
+    reaction_moment: Vec<f64>,
+    iterations: Vec<i64>,
+    substeps: Vec<i64>,
+    residual: Vec<f64>,
+    elastic_energy: Vec<f64>,
+}
+
+impl Record {
+    fn push(&mut self, rod: &Rod, st: &State, ws: &Workspace, stats: &rod::SolveStats) {
+        self.steps += 1;
+        for x in &st.x {
+            self.positions.extend_from_slice(x.as_slice());
+        }
+        for p in &st.p {
+            self.quaternions.extend_from_slice(&[p.w, p.i, p.j, p.k]);
+        }
+        for f in &ws.edge_force {
+            self.forces.extend_from_slice(f.as_slice());
+        }
+        for m in &ws.node_moment {
+            self.moments.extend_from_slice(m.as_slice());
+        }
+        for c in 0..rod.spec.clips.len() {
+            let (f, m) = ws.clip_reaction(rod, st, c);
+            self.reaction_force.extend_from_slice(f.as_slice());
+            self.reaction_moment.extend_from_slice(m.as_slice());
+        }
+        self.iterations.push(stats.iterations as i64);
+        self.substeps.push(stats.substeps as i64);
+        self.residual.push(stats.residual);
+        self.elastic_energy.push(ws.elastic_energy);
+    }
+
+    fn into_dict<'py>(self, py: Python<'py>, n_nodes: usize, n_clips: usize) -> PyResult<Bound<'py, PyDict>> {
+        let t = self.steps;
+        let d = PyDict::new(py);
+        let shaped = |v: Vec<f64>, shape: &[usize]| PyArray1::from_vec(py, v).reshape(shape.to_vec());
+        d.set_item("positions", shaped(self.positions, &[t, n_nodes, 3])?)?;
+        d.set_item("quaternions", shaped(self.quaternions, &[t, n_nodes - 1, 4])?)?;
+        d.set_item("forces", shaped(self.forces, &[t, n_nodes - 1, 3])?)?;
+        d.set_item("moments", shaped(self.moments, &[t, n_nodes, 3])?)?;
+        d.set_item("reaction_force", shaped(self.reaction_force, &[t, n_clips, 3])?)?;
+        d.set_item("reaction_moment", shaped(self.reaction_moment, &[t, n_clips, 3])?)?;
+        d.set_item("iterations", PyArray1::from_vec(py, self.iterations))?;
+        d.set_item("substeps", PyArray1::from_vec(py, self.substeps))?;
+        d.set_item("residual", PyArray1::from_vec(py, self.residual))?;
+        d.set_item("elastic_energy", PyArray1::from_vec(py, self.elastic_energy))?;
+        d.set_item("steps", t)?;
+        Ok(d)
+    }
+}
+
+/// One cable: mesh, state and solver.
+#[pyclass(module = "cablelife._core")]
+pub struct Cable {
+    rod: Rod,
+    state: Option<State>,
+    solver: Statics,
+}
+
+#[pymethods]
+impl Cable {
+    /// clips: list of (name, s, length, kind, position[3], quaternion[4] scalar first);
+    /// loads: list of (s, force[3], moment[3]).
+    #[new]
+    #[pyo3(signature = (length, segments, shear_stiffness, bend_stiffness, mass_per_length,
+        rotary_inertia, natural_curvature, gravity, clips, loads, max_iterations=40,
+        step_tolerance=1e-9))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        length: f64,
+        segments: usize,
+        shear_stiffness: Vec<f64>,
+        bend_stiffness: Vec<f64>,
+        mass_per_length: f64,
+        rotary_inertia: Vec<f64>,
+        natural_curvature: Vec<f64>,
+        gravity: Vec<f64>,
+        clips: Vec<(String, f64, f64, String, Vec<f64>, Vec<f64>)>,
+        loads: Vec<(f64, Vec<f64>, Vec<f64>)>,
+        max_iterations: usize,
+        step_tolerance: f64,
+    ) -> PyResult<Self> {
+        let section = Section {
+            shear_stiffness: vec3(&shear_stiffness, "shear_stiffness")?,
+            bend_stiffness: vec3(&bend_stiffness, "bend_stiffness")?,
+            mass_per_length,
+            rotary_inertia: vec3(&rotary_inertia, "rotary_inertia")?,
+        };
+        let mut clip_specs = Vec::with_capacity(clips.len());
+        for (name, s, len, kind, pos, q) in clips {
+            let kind = match kind.as_str() {
+                "fixed" => ClipKind::Fixed,
+                "swivel" => ClipKind::Swivel,
+                "ball" => ClipKind::Ball,
+                other => {
+                    return Err(PyValueError::new_err(format!(
+                        "clip '{name}': type = {other:?}; allowed: fixed, swivel, ball"
+                    )))
+                }
+            };
+            let pose = Pose {
+                position: vec3(&pos, &format!("clip '{name}' position"))?,
+                orientation: quat(&q, &format!("clip '{name}' orientation"))?,
+            };
+            clip_specs.push(ClipSpec { name, s, length: len, kind, pose });
+        }
+        let mut load_specs = Vec::with_capacity(loads.len());
+        for (i, (s, f, m)) in loads.into_iter().enumerate() {
+            load_specs.push(PointLoad {
+                s,
+                force: vec3(&f, &format!("load {i} force"))?,
+                moment: vec3(&m, &format!("load {i} moment"))?,
+            });
+        }
+        let spec = CableSpec {
+            length,
+            segments,
+            section,
+            natural_curvature: vec3(&natural_curvature, "natural_curvature")?,
+            clips: clip_specs,
+            loads: load_specs,
+            gravity: vec3(&gravity, "gravity")?,
+        };
+        let rod = Rod::new(spec).map_err(|e| PyValueError::new_err(e.0))?;
+        let opts = NewtonOptions { max_iterations, step_tolerance, ..Default::default() };
+        let solver = Statics::new(&rod, opts);
+        Ok(Cable { rod, state: None, solver })
+    }
+
+    /// Arc lengths of the nodes (N+1,).
+    #[getter]
+    fn arc_length<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_vec(py, self.rod.arc.clone())
+    }
+
+    /// Lumped nodal masses (N+1,).
+    #[getter]
+    fn node_mass<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_vec(py, self.rod.node_mass.clone())
+    }
+
+    /// Runs a sequence of equilibria through the clip poses `positions` (T, C, 3) and
+    /// `quaternions` (T, C, 4). Step 0 is a static solve from the routed shape (with load
+    /// continuation if needed); later steps are warm-started and sub-stepped on failure.
+    /// Returns a dict of arrays for the completed steps and `error` (None, or why it stopped:
+    /// the results up to there are kept).
+    #[pyo3(signature = (positions, quaternions, progress=None, progress_every=50))]
+    fn run_sequence<'py>(
+        &mut self,
+        py: Python<'py>,
+        positions: PyReadonlyArray3<'py, f64>,
+        quaternions: PyReadonlyArray3<'py, f64>,
+        progress: Option<Py<PyAny>>,
+        progress_every: usize,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let pos = positions.as_array();
+        let qs = quaternions.as_array();
+        let n_clips = self.rod.spec.clips.len();
+        let (t, c, three) = pos.dim();
+        if c != n_clips || three != 3 || qs.dim() != (t, n_clips, 4) {
+            return Err(PyValueError::new_err(format!(
+                "clip poses must be (T, {n_clips}, 3) and (T, {n_clips}, 4); got {:?} and {:?}",
+                pos.dim(),
+                qs.dim()
+            )));
+        }
+        let mut poses: Vec<Vec<Pose>> = Vec::with_capacity(t);
+        for k in 0..t {
+            let mut step = Vec::with_capacity(c);
+            for j in 0..c {
+                let p = pos.slice(numpy::ndarray::s![k, j, ..]);
+                let q = qs.slice(numpy::ndarray::s![k, j, ..]);
+                step.push(Pose {
+                    position: Vector3::new(p[0], p[1], p[2]),
+                    orientation: quat(&[q[0], q[1], q[2], q[3]], "clip orientation")?,
+                });
+            }
+            poses.push(step);
+        }
+        let rod = &self.rod;
+        let solver = &mut self.solver;
+        let state_slot = &mut self.state;
+        let every = progress_every.max(1);
+        let (record, error) = py.detach(|| {
+            let mut rec = Record::default();
+            let mut st = match route(rod, poses.first().map(|p| p.as_slice())) {
+                Ok(s) => s,
+                Err(e) => return (rec, Some(e.0)),
+            };
+            let mut prev: Option<State> = None;
+            for (k, target) in poses.iter().enumerate() {
+                let result = if k == 0 {
+                    solver.solve(rod, &mut st)
+                } else {
+                    // Predictor: extrapolate the free unknowns from the last two equilibria.
+                    let before = st.clone();
+                    if let Some(p0) = &prev {
+                        let p1 = st.clone();
+                        st.extrapolate_free(rod, p0, &p1);
+                    }
+                    let r = solver.step_to(rod, &mut st, target);
+                    if r.is_err() {
+                        st = before.clone();
+                        // Retry from the last equilibrium without the predictor.
+                        let r2 = solver.step_to(rod, &mut st, target);
+                        prev = Some(before);
+                        r2
+                    } else {
+                        prev = Some(before);
+                        r
+                    }
+                };
+                match result {
+                    Ok(stats) => {
+                        if let Err(kink) = solver.ws.assemble_static(rod, &st, 1.0, false) {
+                            return (rec, Some(format!("kink at node {}", kink.node)));
+                        }
+                        rec.push(rod, &st, &solver.ws, &stats);
+                    }
+                    Err(e) => {
+                        *state_slot = Some(st);
+                        return (rec, Some(format!("step {k}: {e}")));
+                    }
+                }
+                if (k + 1) % every == 0 || k + 1 == poses.len() {
+                    let stop = Python::attach(|py| -> Option<String> {
+                        if let Err(e) = py.check_signals() {
+                            return Some(format!("interrupted: {e}"));
+                        }
+                        if let Some(cb) = &progress {
+                            if let Err(e) = cb.call1(py, (k + 1, poses.len())) {
+                                return Some(format!("progress callback failed: {e}"));
+                            }
+                        }
+                        None
+                    });
+                    if stop.is_some() {
+                        *state_slot = Some(st);
+                        return (rec, stop);
+                    }
+                }
+            }
+            *state_slot = Some(st);
+            (rec, None)
+        });
+        let d = record.into_dict(py, self.rod.arc.len(), n_clips)?;
+        d.set_item("error", error)?;
+        Ok(d)
+    }
+
+    /// Node positions of the routed initial shape at the reference clip poses (N+1, 3).
+    fn routed_positions<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let st = route(&self.rod, None).map_err(|e| PyValueError::new_err(e.0))?;
+        let flat: Vec<f64> = st.x.iter().flat_map(|x| [x.x, x.y, x.z]).collect();
+        Ok(PyArray1::from_vec(py, flat).reshape([st.x.len(), 3])?.into_any())
+    }
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<Cable>()?;
+    Ok(())
+}

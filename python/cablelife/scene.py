@@ -1,0 +1,363 @@
+"""The scene: cables, their clips on bodies, loads, body motions and simulation settings.
+
+A scene is a TOML file (see docs/scene.md and the JSON schema docs/scene.schema.json) or is
+built in Python. Validation errors name the key path, the bad value and what is allowed.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from pathlib import Path
+from typing import Annotated, Literal
+
+import numpy as np
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    NonNegativeFloat,
+    PositiveFloat,
+    PositiveInt,
+    ValidationError,
+    field_validator,
+    model_validator,
+)
+
+from cablelife.sections import SectionProperties, from_material, from_measured
+from cablelife.signals.spec import ChannelMotion, MeasuredSignal
+
+Vec3 = tuple[float, float, float]
+
+
+class SceneError(ValueError):
+    """A scene that cannot be used; the message says where and why."""
+
+
+class _Model(BaseModel):
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
+
+
+class CircleSection(_Model):
+    """Solid circular section."""
+
+    shape: Literal["circle"]
+    radius: PositiveFloat
+
+
+class TubeSection(_Model):
+    """Circular tube (hose)."""
+
+    shape: Literal["tube"]
+    outer_radius: PositiveFloat
+    inner_radius: PositiveFloat
+
+    @model_validator(mode="after")
+    def _radii(self):
+        if self.inner_radius >= self.outer_radius:
+            raise ValueError(
+                f"inner_radius = {self.inner_radius} must be smaller than "
+                f"outer_radius = {self.outer_radius}"
+            )
+        return self
+
+
+class Material(_Model):
+    """Isotropic material: Young's modulus and Poisson's ratio (or shear modulus), density."""
+
+    youngs_modulus: PositiveFloat  # Pa
+    poisson_ratio: Annotated[float, Field(ge=0.0, le=0.5)] | None = None
+    shear_modulus: PositiveFloat | None = None  # Pa
+    density: PositiveFloat  # kg/m³
+
+    @model_validator(mode="after")
+    def _elastic(self):
+        if (self.poisson_ratio is None) == (self.shear_modulus is None):
+            raise ValueError("give exactly one of poisson_ratio and shear_modulus")
+        if self.shear_modulus is not None:
+            nu = self.youngs_modulus / (2 * self.shear_modulus) - 1
+            if not 0.0 <= nu <= 0.5:
+                raise ValueError(
+                    f"shear_modulus = {self.shear_modulus} gives Poisson's ratio {nu:.3f}; "
+                    "allowed is G between E/3 and E/2"
+                )
+        return self
+
+    @property
+    def nu(self) -> float:
+        if self.poisson_ratio is not None:
+            return self.poisson_ratio
+        return self.youngs_modulus / (2 * self.shear_modulus) - 1
+
+
+class MeasuredStiffness(_Model):
+    """Effective stiffnesses as measured by cable suppliers, instead of section + material."""
+
+    model_config = ConfigDict(extra="forbid", populate_by_name=True)
+    EA: PositiveFloat  # N
+    GA: PositiveFloat | None = None  # N (shear stiffness incl. shear coefficient)
+    EI: PositiveFloat | None = None  # N m² (round cables)
+    EI1: PositiveFloat | None = None  # N m² (non-round cables: both)
+    EI2: PositiveFloat | None = None
+    GJ: PositiveFloat  # N m²
+    mass_per_length: PositiveFloat  # kg/m
+    radius: PositiveFloat  # m, outer radius (contact, pictures, stresses)
+    rotary_inertia: PositiveFloat | None = None  # kg m (ρI per length)
+
+    @model_validator(mode="after")
+    def _bending(self):
+        if self.EI is None and (self.EI1 is None or self.EI2 is None):
+            raise ValueError("give EI, or both EI1 and EI2")
+        if self.EI is not None and (self.EI1 is not None or self.EI2 is not None):
+            raise ValueError("give EI or EI1/EI2, not both")
+        return self
+
+
+class Clip(_Model):
+    """A clip holding the cable at arc length ``s`` (the clip centre)."""
+
+    name: Annotated[str, Field(min_length=1)]
+    s: NonNegativeFloat  # m
+    body: str = "world"
+    position: Vec3  # m
+    direction: Vec3  # cable tangent d3 at the clip
+    normal: Vec3 | None = None  # d1 at the clip (fixes the twist); default: any normal
+    type: Literal["fixed", "swivel", "ball"] = "fixed"
+    length: NonNegativeFloat = 0.0  # held length; 0 = point clip
+    frame: Literal["global", "body"] = "global"  # frame of position/direction/normal
+
+    @field_validator("direction")
+    @classmethod
+    def _nonzero(cls, v):
+        if math.hypot(*v) == 0:
+            raise ValueError("direction must not be the zero vector")
+        return v
+
+    @model_validator(mode="after")
+    def _normal(self):
+        if self.normal is not None:
+            d = np.array(self.direction) / np.linalg.norm(self.direction)
+            n = np.array(self.normal)
+            if np.linalg.norm(n - d * n.dot(d)) < 1e-9 * max(np.linalg.norm(n), 1e-300):
+                raise ValueError(
+                    f"normal = {list(self.normal)} is parallel to direction = "
+                    f"{list(self.direction)}; it must have a part orthogonal to it"
+                )
+        if self.type == "ball" and self.length > 0:
+            raise ValueError("a ball clip holds a point: its length must be 0")
+        return self
+
+
+class Load(_Model):
+    """A dead load (global frame) at arc length ``s``."""
+
+    s: NonNegativeFloat
+    force: Vec3 = (0.0, 0.0, 0.0)  # N
+    moment: Vec3 = (0.0, 0.0, 0.0)  # N m
+
+
+class Cable(_Model):
+    """One cable or hose."""
+
+    name: Annotated[str, Field(min_length=1)]
+    length: PositiveFloat  # m
+    segments: PositiveInt | None = None
+    max_segment_length: PositiveFloat | None = None  # m
+    natural_curvature: Vec3 = (0.0, 0.0, 0.0)  # κ₁, κ₂, twist in 1/m
+    section: Annotated[CircleSection | TubeSection, Field(discriminator="shape")] | None = None
+    material: Material | None = None
+    stiffness: MeasuredStiffness | None = None
+    clips: Annotated[list[Clip], Field(min_length=1)]
+    loads: list[Load] = []
+
+    @model_validator(mode="after")
+    def _consistent(self):
+        if self.stiffness is None and (self.section is None or self.material is None):
+            raise ValueError("give section and material, or stiffness (measured values)")
+        if self.stiffness is not None and (self.section is not None or self.material is not None):
+            raise ValueError("give either section + material or stiffness, not both")
+        if self.segments is not None and self.max_segment_length is not None:
+            raise ValueError("give segments or max_segment_length, not both")
+        names = [c.name for c in self.clips]
+        dup = {n for n in names if names.count(n) > 1}
+        if dup:
+            raise ValueError(f"clip names must be unique; repeated: {sorted(dup)}")
+        for i, c in enumerate(self.clips):
+            lo, hi = c.s - c.length / 2, c.s + c.length / 2
+            if lo < -1e-12 or hi > self.length * (1 + 1e-12):
+                raise ValueError(
+                    f"clips[{i}] ('{c.name}') covers s = [{lo}, {hi}] m, outside the cable "
+                    f"[0, {self.length}] m"
+                )
+        for i, ld in enumerate(self.loads):
+            if ld.s > self.length * (1 + 1e-12):
+                raise ValueError(f"loads[{i}].s = {ld.s} m is beyond the cable end {self.length} m")
+        return self
+
+    @property
+    def n_segments(self) -> int:
+        if self.segments is not None:
+            return self.segments
+        if self.max_segment_length is not None:
+            return max(1, math.ceil(self.length / self.max_segment_length))
+        return 50
+
+    def properties(self) -> SectionProperties:
+        """Effective section properties."""
+        if self.stiffness is not None:
+            k = self.stiffness
+            ei1 = k.EI if k.EI is not None else k.EI1
+            ei2 = k.EI if k.EI is not None else k.EI2
+            return from_measured(
+                k.EA, k.GA, ei1, ei2, k.GJ, k.mass_per_length, k.radius, k.rotary_inertia
+            )
+        sec, mat = self.section, self.material
+        if sec.shape == "circle":
+            outer, inner = sec.radius, 0.0
+        else:
+            outer, inner = sec.outer_radius, sec.inner_radius
+        return from_material(sec.shape, outer, inner, mat.youngs_modulus, mat.nu, mat.density)
+
+
+class Body(_Model):
+    """A rigid body carrying clips; its motion is a list of channel signals, or a CSV table
+    ``motion_file`` with columns t, x, y, z, rx, ry, rz (m, rad; global frame)."""
+
+    name: Annotated[str, Field(min_length=1)]
+    origin: Vec3 = (0.0, 0.0, 0.0)  # reference point (rotation centre) of the body, global
+    orientation: Vec3 = (0.0, 0.0, 0.0)  # rx, ry, rz (rad) of the body frame, R = Rz Ry Rx
+    motion: list[ChannelMotion] = []
+    motion_file: Path | None = None
+
+    @model_validator(mode="after")
+    def _one_motion(self):
+        if self.motion and self.motion_file is not None:
+            raise ValueError("give motion (channels) or motion_file, not both")
+        return self
+
+    def channel_motions(self) -> list[ChannelMotion]:
+        if self.motion_file is None:
+            return list(self.motion)
+        return [
+            ChannelMotion(
+                channel=ch,
+                frame="global",
+                signal=MeasuredSignal(
+                    type="measured",
+                    file=self.motion_file,
+                    channel=ch,
+                    format="csv",
+                    time_channel="t",
+                ),
+            )
+            for ch in ("x", "y", "z", "rx", "ry", "rz")
+        ]
+
+
+class Damping(_Model):
+    """Kelvin–Voigt damping: a fraction of critical damping of the first mode, or τ directly."""
+
+    ratio: PositiveFloat | None = None
+    retardation_time: PositiveFloat | None = None  # s
+
+
+class Simulation(_Model):
+    """Run settings."""
+
+    mode: Literal["static", "quasistatic", "dynamic"] = "static"
+    gravity: Vec3 = (0.0, 0.0, -9.81)  # m/s²
+    duration: PositiveFloat | None = None  # s
+    time_step: PositiveFloat = 1e-3  # s
+    output_step: PositiveFloat | None = None  # s (default: every step)
+    max_iterations: PositiveInt = 40
+
+
+class Scene(_Model):
+    """A complete scene."""
+
+    simulation: Simulation = Simulation()
+    bodies: list[Body] = []
+    cables: Annotated[list[Cable], Field(min_length=1)]
+    base_dir: Annotated[Path | None, Field(exclude=True)] = None
+
+    @model_validator(mode="after")
+    def _references(self):
+        body_names = [b.name for b in self.bodies]
+        if "world" in body_names:
+            raise ValueError("'world' is reserved for the fixed frame; name the body otherwise")
+        dup = {n for n in body_names if body_names.count(n) > 1}
+        if dup:
+            raise ValueError(f"body names must be unique; repeated: {sorted(dup)}")
+        cable_names = [c.name for c in self.cables]
+        dup = {n for n in cable_names if cable_names.count(n) > 1}
+        if dup:
+            raise ValueError(f"cable names must be unique; repeated: {sorted(dup)}")
+        allowed = ["world", *body_names]
+        for i, cable in enumerate(self.cables):
+            for j, clip in enumerate(cable.clips):
+                if clip.body not in allowed:
+                    raise ValueError(
+                        f"cables[{i}].clips[{j}].body = '{clip.body}' is not a body of the scene; "
+                        f"allowed: {allowed}"
+                    )
+        if self.simulation.mode != "static" and self.simulation.duration is None:
+            raise ValueError(f"simulation.duration is required in {self.simulation.mode} mode")
+        return self
+
+    def body(self, name: str) -> Body | None:
+        return next((b for b in self.bodies if b.name == name), None)
+
+    def to_toml(self) -> str:
+        """The scene as TOML text (as embedded in result files)."""
+        import tomli_w
+
+        data = self.model_dump(mode="json", exclude_none=True)
+        return tomli_w.dumps(data)
+
+
+def _format_errors(err: ValidationError, source: str) -> str:
+    lines = [f"invalid scene {source}:"]
+    for e in err.errors():
+        loc = ".".join(str(p) if not isinstance(p, int) else f"[{p}]" for p in e["loc"])
+        loc = loc.replace(".[", "[")
+        msg = e["msg"].removeprefix("Value error, ")
+        value = e.get("input")
+        shown = repr(value)
+        if len(shown) > 80:
+            shown = shown[:77] + "..."
+        if e["type"] in ("missing",):
+            lines.append(f"  {loc}: required, but missing")
+        elif e["type"] == "extra_forbidden":
+            lines.append(f"  {loc}: unknown key (value {shown}); check the spelling")
+        elif isinstance(value, dict):
+            lines.append(f"  {loc or '(top level)'}: {msg}")
+        else:
+            lines.append(f"  {loc or '(top level)'}: {msg} (got {shown})")
+    return "\n".join(lines)
+
+
+def scene_from_dict(data: dict, base_dir: Path | None = None, source: str = "") -> Scene:
+    """Validates a scene given as a dict (as parsed from TOML)."""
+    try:
+        scene = Scene.model_validate(data)
+    except ValidationError as err:
+        raise SceneError(_format_errors(err, source)) from None
+    scene.base_dir = base_dir
+    return scene
+
+
+def load_scene(path: str | Path) -> Scene:
+    """Reads and validates a scene TOML file."""
+    path = Path(path)
+    if not path.is_file():
+        raise SceneError(f"scene file {str(path)!r} does not exist")
+    try:
+        data = tomllib.loads(path.read_text())
+    except tomllib.TOMLDecodeError as err:
+        raise SceneError(f"scene file {str(path)!r} is not valid TOML: {err}") from None
+    return scene_from_dict(data, base_dir=path.parent.resolve(), source=f"{str(path)!r}")
+
+
+def json_schema() -> dict:
+    """JSON schema of the scene format."""
+    return Scene.model_json_schema()
