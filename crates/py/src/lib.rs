@@ -1,8 +1,11 @@
 //! Thin PyO3 bindings: numpy arrays in, numpy arrays out; no physics here.
 use pyo3::prelude::*;
 
+mod cable;
+
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    cable::register(m)?;
     Ok(())
 }
