@@ -8,10 +8,10 @@ HDF5 layout (every dataset carries a ``unit`` attribute)::
     /cables/<name>/arc_length    (N+1,)      m
     /cables/<name>/positions     (T, N+1, 3) m      node positions, global frame
     /cables/<name>/quaternions   (T, N, 4)   1      edge orientations, scalar first
-    /cables/<name>/forces        (T, N, 3)   N      material frame on edges: F1, F2 shear, F3 tension
-    /cables/<name>/moments       (T, N+1, 3) N m    material frame on nodes: M1, M2 bending, M3 torsion
-    /cables/<name>/clips/<clip>/reaction_force   (T, 3) N    force of the clip on the cable, global
-    /cables/<name>/clips/<clip>/reaction_moment  (T, 3) N m  moment about the clip point, global
+    /cables/<name>/forces        (T, N, 3)   N      material frame, edges: F1, F2 shear, F3 tension
+    /cables/<name>/moments       (T, N+1, 3) N m    material frame, nodes: M1, M2 bend, M3 torsion
+    /cables/<name>/clips/<clip>/reaction_force   (T, 3) N    force of the clip on the cable
+    /cables/<name>/clips/<clip>/reaction_moment  (T, 3) N m  moment about the clip point
     /cables/<name>/section       attrs: shape, outer_radius, inner_radius, poisson_ratio,
                                         EA, GA1, GA2, EI1, EI2, GJ, mass_per_length, from_measured
     /cables/<name>/solver        attrs and datasets: iterations (T,), residual (T,), ...

@@ -124,7 +124,10 @@ def _run_cable(scene: Scene, cable: Cable, times: np.ndarray, progress: Progress
     pos, quat = clip_poses(scene, cable, times)
     callback = (lambda k, n: progress(cable.name, k, n)) if progress else None
     start = _time.perf_counter()
-    out = core.run_sequence(pos, quat, callback, max(1, times.size // 100))
+    try:
+        out = core.run_sequence(pos, quat, callback, max(1, times.size // 100))
+    except ValueError as err:
+        raise SceneError(f"cable '{cable.name}': {err}") from None
     wall = _time.perf_counter() - start
     n = int(out["steps"])
     props = cable.properties()

@@ -7,25 +7,36 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rod::assembly::Workspace;
 use rod::routing::route;
-use rod::{CableSpec, ClipKind, ClipSpec, NewtonOptions, PointLoad, Pose, Rod, Section, State, Statics};
+use rod::{
+    CableSpec, ClipKind, ClipSpec, NewtonOptions, PointLoad, Pose, Rod, Section, State, Statics,
+};
 
 fn vec3(v: &[f64], what: &str) -> PyResult<Vector3<f64>> {
     if v.len() != 3 || v.iter().any(|x| !x.is_finite()) {
-        return Err(PyValueError::new_err(format!("{what} = {v:?}: must be 3 finite numbers")));
+        return Err(PyValueError::new_err(format!(
+            "{what} = {v:?}: must be 3 finite numbers"
+        )));
     }
     Ok(Vector3::new(v[0], v[1], v[2]))
 }
 
 fn quat(v: &[f64], what: &str) -> PyResult<Quaternion<f64>> {
     if v.len() != 4 || v.iter().any(|x| !x.is_finite()) {
-        return Err(PyValueError::new_err(format!("{what} = {v:?}: must be 4 finite numbers")));
+        return Err(PyValueError::new_err(format!(
+            "{what} = {v:?}: must be 4 finite numbers"
+        )));
     }
     let q = Quaternion::new(v[0], v[1], v[2], v[3]);
     if q.norm() == 0.0 {
-        return Err(PyValueError::new_err(format!("{what} = {v:?}: must be a non-zero quaternion")));
+        return Err(PyValueError::new_err(format!(
+            "{what} = {v:?}: must be a non-zero quaternion"
+        )));
     }
     Ok(q / q.norm())
 }
+
+/// (name, s, length, kind, position[3], quaternion[4] scalar first).
+type ClipTuple = (String, f64, f64, String, Vec<f64>, Vec<f64>);
 
 /// Per-step outputs collected during a run (flat, row-major).
 #[derive(Default)]
@@ -69,20 +80,38 @@ impl Record {
         self.elastic_energy.push(ws.elastic_energy);
     }
 
-    fn into_dict<'py>(self, py: Python<'py>, n_nodes: usize, n_clips: usize) -> PyResult<Bound<'py, PyDict>> {
+    fn into_dict<'py>(
+        self,
+        py: Python<'py>,
+        n_nodes: usize,
+        n_clips: usize,
+    ) -> PyResult<Bound<'py, PyDict>> {
         let t = self.steps;
         let d = PyDict::new(py);
-        let shaped = |v: Vec<f64>, shape: &[usize]| PyArray1::from_vec(py, v).reshape(shape.to_vec());
+        let shaped =
+            |v: Vec<f64>, shape: &[usize]| PyArray1::from_vec(py, v).reshape(shape.to_vec());
         d.set_item("positions", shaped(self.positions, &[t, n_nodes, 3])?)?;
-        d.set_item("quaternions", shaped(self.quaternions, &[t, n_nodes - 1, 4])?)?;
+        d.set_item(
+            "quaternions",
+            shaped(self.quaternions, &[t, n_nodes - 1, 4])?,
+        )?;
         d.set_item("forces", shaped(self.forces, &[t, n_nodes - 1, 3])?)?;
         d.set_item("moments", shaped(self.moments, &[t, n_nodes, 3])?)?;
-        d.set_item("reaction_force", shaped(self.reaction_force, &[t, n_clips, 3])?)?;
-        d.set_item("reaction_moment", shaped(self.reaction_moment, &[t, n_clips, 3])?)?;
+        d.set_item(
+            "reaction_force",
+            shaped(self.reaction_force, &[t, n_clips, 3])?,
+        )?;
+        d.set_item(
+            "reaction_moment",
+            shaped(self.reaction_moment, &[t, n_clips, 3])?,
+        )?;
         d.set_item("iterations", PyArray1::from_vec(py, self.iterations))?;
         d.set_item("substeps", PyArray1::from_vec(py, self.substeps))?;
         d.set_item("residual", PyArray1::from_vec(py, self.residual))?;
-        d.set_item("elastic_energy", PyArray1::from_vec(py, self.elastic_energy))?;
+        d.set_item(
+            "elastic_energy",
+            PyArray1::from_vec(py, self.elastic_energy),
+        )?;
         d.set_item("steps", t)?;
         Ok(d)
     }
@@ -114,7 +143,7 @@ impl Cable {
         rotary_inertia: Vec<f64>,
         natural_curvature: Vec<f64>,
         gravity: Vec<f64>,
-        clips: Vec<(String, f64, f64, String, Vec<f64>, Vec<f64>)>,
+        clips: Vec<ClipTuple>,
         loads: Vec<(f64, Vec<f64>, Vec<f64>)>,
         max_iterations: usize,
         step_tolerance: f64,
@@ -141,7 +170,13 @@ impl Cable {
                 position: vec3(&pos, &format!("clip '{name}' position"))?,
                 orientation: quat(&q, &format!("clip '{name}' orientation"))?,
             };
-            clip_specs.push(ClipSpec { name, s, length: len, kind, pose });
+            clip_specs.push(ClipSpec {
+                name,
+                s,
+                length: len,
+                kind,
+                pose,
+            });
         }
         let mut load_specs = Vec::with_capacity(loads.len());
         for (i, (s, f, m)) in loads.into_iter().enumerate() {
@@ -161,9 +196,17 @@ impl Cable {
             gravity: vec3(&gravity, "gravity")?,
         };
         let rod = Rod::new(spec).map_err(|e| PyValueError::new_err(e.0))?;
-        let opts = NewtonOptions { max_iterations, step_tolerance, ..Default::default() };
+        let opts = NewtonOptions {
+            max_iterations,
+            step_tolerance,
+            ..Default::default()
+        };
         let solver = Statics::new(&rod, opts);
-        Ok(Cable { rod, state: None, solver })
+        Ok(Cable {
+            rod,
+            state: None,
+            solver,
+        })
     }
 
     /// Arc lengths of the nodes (N+1,).
@@ -220,12 +263,12 @@ impl Cable {
         let solver = &mut self.solver;
         let state_slot = &mut self.state;
         let every = progress_every.max(1);
-        let (record, error) = py.detach(|| {
+        // Routing problems (a cable too short between two clips) are input errors.
+        let initial = route(rod, poses.first().map(|p| p.as_slice()))
+            .map_err(|e| PyValueError::new_err(e.0))?;
+        let (record, error) = py.detach(move || {
             let mut rec = Record::default();
-            let mut st = match route(rod, poses.first().map(|p| p.as_slice())) {
-                Ok(s) => s,
-                Err(e) => return (rec, Some(e.0)),
-            };
+            let mut st = initial;
             let mut prev: Option<State> = None;
             for (k, target) in poses.iter().enumerate() {
                 let result = if k == 0 {
@@ -291,7 +334,9 @@ impl Cable {
     fn routed_positions<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         let st = route(&self.rod, None).map_err(|e| PyValueError::new_err(e.0))?;
         let flat: Vec<f64> = st.x.iter().flat_map(|x| [x.x, x.y, x.z]).collect();
-        Ok(PyArray1::from_vec(py, flat).reshape([st.x.len(), 3])?.into_any())
+        Ok(PyArray1::from_vec(py, flat)
+            .reshape([st.x.len(), 3])?
+            .into_any())
     }
 }
 

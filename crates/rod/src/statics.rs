@@ -91,6 +91,9 @@ impl fmt::Display for SolveError {
 }
 impl std::error::Error for SolveError {}
 
+/// Initial damping of the pseudo-transient path relative to the stiffest diagonal entry.
+const PTC_START: f64 = 1e-3;
+
 /// A static/quasistatic solver for one cable: the workspace and options.
 pub struct Statics {
     pub ws: Workspace,
@@ -228,15 +231,143 @@ impl Statics {
         })
     }
 
-    /// Static equilibrium: plain Newton, then load continuation from the unloaded routed shape
-    /// (gravity and loads ramped), first with plain then with damped Newton steps.
+    /// Pseudo-transient continuation: (J + σD) Δ = −r with D a damping diagonal (δs for
+    /// positions, Δs³/12 for rotations: a viscous medium) and σ driven to zero by switched
+    /// evolution relaxation (σ ← σ·min(‖r_k‖/‖r_{k−1}‖, ½), ×10 after a rejected step). It follows a damped motion into a stable
+    /// equilibrium, where plain Newton from a poor guess (slack spans, buckled loops) may not
+    /// find one, and turns into Newton near convergence.
+    pub fn pseudo_transient(
+        &mut self,
+        rod: &Rod,
+        st: &mut State,
+        load_factor: f64,
+        max_iterations: usize,
+    ) -> Result<SolveStats, SolveError> {
+        let h = rod.mean_ds();
+        let l = rod.spec.length;
+        let nb = rod.n_edges() + 1;
+        let damping = |b: usize, k: usize| -> f64 {
+            if k < 3 {
+                rod.ds_node[b]
+            } else {
+                rod.ds_edge[b.min(nb - 2)].powi(3) / 12.0
+            }
+        };
+        self.ws
+            .assemble_static(rod, st, load_factor, true)
+            .map_err(|k| Self::kink_err(rod, k))?;
+        let (mut r_old, mut rinf) = self.ws.residual_norms(h);
+        // Start where the damping term matches the largest stiffness on the diagonal.
+        let mut sigma = 0.0f64;
+        for b in 0..nb {
+            for k in 0..6 {
+                if rod.mask[b][k] {
+                    sigma = sigma.max(self.ws.jac.diag[b][(k, k)].abs() / damping(b, k));
+                }
+            }
+        }
+        sigma *= PTC_START;
+        let sigma0 = sigma;
+        let mut stats = SolveStats::default();
+        for it in 0..max_iterations {
+            stats.iterations = it + 1;
+            if rinf <= self.opts.residual_tolerance * self.force_scale {
+                stats.iterations = it;
+                stats.residual = rinf;
+                return Ok(stats);
+            }
+            for b in 0..nb {
+                for k in 0..6 {
+                    if rod.mask[b][k] {
+                        self.ws.jac.diag[b][(k, k)] += sigma * damping(b, k);
+                    }
+                }
+            }
+            self.ws
+                .jac
+                .factor()
+                .map_err(|Singular { block }| SolveError::Singular {
+                    node: block,
+                    s: rod.arc[block.min(rod.arc.len() - 1)],
+                })?;
+            for (d, r) in self.delta.iter_mut().zip(&self.ws.rhs) {
+                *d = -r;
+            }
+            self.ws.jac.solve_factored(&mut self.delta);
+            let (mut dx, mut dth) = (0.0f64, 0.0f64);
+            for d in &self.delta {
+                dx = dx.max(d.fixed_rows::<3>(0).amax());
+                dth = dth.max(d.fixed_rows::<3>(3).amax());
+            }
+            let step = (dx / l).max(dth);
+            let alpha = 1.0f64.min(self.opts.max_rotation_step / dth.max(1e-300));
+            self.base.clone_from(st);
+            st.apply_increment(rod, &self.delta, alpha);
+            let ok = self.ws.assemble_static(rod, st, load_factor, true).is_ok();
+            let (r_new, r_inf_new) = if ok {
+                self.ws.residual_norms(h)
+            } else {
+                (f64::INFINITY, f64::INFINITY)
+            };
+            if !(step.is_finite() && r_new.is_finite()) || r_new > 10.0 * r_old.max(1e-300) {
+                // Too bold: back off and damp more.
+                st.clone_from(&self.base);
+                self.ws
+                    .assemble_static(rod, st, load_factor, true)
+                    .map_err(|k| Self::kink_err(rod, k))?;
+                sigma = (sigma * 10.0).max(1e-6 * sigma0);
+                continue;
+            }
+            if std::env::var_os("ROD_DEBUG").is_some() {
+                eprintln!("ptc {it} sigma {sigma:.3e} step {step:.3e} rinf {r_inf_new:.3e}");
+            }
+            if sigma == 0.0 && alpha == 1.0 && step < self.opts.step_tolerance {
+                stats.residual = r_inf_new;
+                return Ok(stats);
+            }
+            // At least halve σ per accepted step: soft (slack, near-mechanism) cables creep
+            // with small residuals, so residual ratios alone would relax σ far too slowly.
+            sigma *= (r_new / r_old.max(1e-300)).min(0.5);
+            if sigma < 1e-10 * sigma0 {
+                sigma = 0.0;
+            }
+            r_old = r_new;
+            rinf = r_inf_new;
+        }
+        Err(SolveError::NotConverged {
+            iterations: stats.iterations,
+            residual: rinf,
+            load_factor,
+        })
+    }
+
+    /// Static equilibrium: plain Newton; then pseudo-transient continuation; then load
+    /// continuation from the unloaded routed shape (gravity and loads ramped), with plain and
+    /// then damped Newton steps.
     pub fn solve(&mut self, rod: &Rod, st: &mut State) -> Result<SolveStats, SolveError> {
         let start = st.clone();
-        let mut last = match self.newton(rod, st, 1.0, false) {
-            Ok(s) => return Ok(s),
+        // Plain Newton converges in a handful of iterations from a good guess; a slow start
+        // means a poor guess, for which the pseudo-transient path is the better use of time.
+        let full = self.opts.max_iterations;
+        self.opts.max_iterations = full.min(15);
+        let plain = self.newton(rod, st, 1.0, false);
+        self.opts.max_iterations = full;
+        if let Err(e @ SolveError::Singular { .. }) = plain {
+            return Err(e);
+        }
+        if let Ok(s) = plain {
+            return Ok(s);
+        }
+        let mut last;
+        st.clone_from(&start);
+        match self.pseudo_transient(rod, st, 1.0, 20 * self.opts.max_iterations) {
+            Ok(mut s) => {
+                s.substeps = 1;
+                return Ok(s);
+            }
             Err(e @ SolveError::Singular { .. }) => return Err(e),
-            Err(e) => e,
-        };
+            Err(e) => last = e,
+        }
         for damped in [false, true] {
             st.clone_from(&start);
             match self.continuation(rod, st, damped) {

@@ -1,0 +1,40 @@
+"""Key figures of a result, for the run summary and reports."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from cablelife.results import CableResult
+
+
+def cable_summary(c: CableResult) -> dict:
+    """Maxima over time and arc length, the smallest bend radius, clip reaction maxima and the
+    solver statistics of one cable."""
+    f, m = c.forces, c.moments
+    radius = c.bend_radius()
+    i_min = np.unravel_index(np.argmin(radius), radius.shape)
+    clips = {
+        name: {
+            "s": r.s,
+            "max_force": float(np.linalg.norm(r.force, axis=-1).max()),
+            "max_moment": float(np.linalg.norm(r.moment, axis=-1).max()),
+        }
+        for name, r in c.clips.items()
+    }
+    iters = np.asarray(c.solver.get("iterations", [0]))
+    return {
+        "steps": c.n_steps,
+        "segments": int(c.arc_length.size - 1),
+        "max_tension": float(f[..., 2].max()),
+        "min_tension": float(f[..., 2].min()),
+        "max_shear": float(np.hypot(f[..., 0], f[..., 1]).max()),
+        "max_bending": float(np.hypot(m[..., 0], m[..., 1]).max()),
+        "max_torsion": float(np.abs(m[..., 2]).max()),
+        "min_bend_radius": float(radius[i_min]),
+        "min_bend_radius_s": float(c.arc_length[i_min[1]]),
+        "min_bend_radius_t": float(c.time[i_min[0]]),
+        "clips": clips,
+        "newton_iterations_mean": float(iters.mean()) if iters.size else 0.0,
+        "newton_iterations_max": int(iters.max()) if iters.size else 0,
+        "wall_time": float(c.solver.get("wall_time", float("nan"))),
+    }
