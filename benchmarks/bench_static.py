@@ -11,7 +11,6 @@ import statistics
 import time
 
 import numpy as np
-
 from cablelife.scene import scene_from_dict
 from cablelife.simulate import build_cable, clip_poses, output_times
 

@@ -10,7 +10,6 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
-
 from cablelife import load_result
 from cablelife.scene import json_schema, load_scene, scene_from_dict
 from cablelife.simulate import simulate
