@@ -1,0 +1,1 @@
+//! Motion volumes of cables (see issue 6).
