@@ -95,3 +95,41 @@ def test_interrupted_run_keeps_the_steps_computed(scene_dict, tmp_path):
 
     back = load_result(path)
     assert not back.complete and back.cable.n_steps == n
+
+
+def test_motion_table_csv(scene_dict, tmp_path):
+    # A body pose table t, x, y, z, rx, ry, rz drives the clip; the clip follows it exactly.
+    t = np.linspace(0.0, 1.0, 11)
+    table = np.column_stack([t, 0 * t, 0.05 * t, -0.02 * t, 0.1 * t, 0 * t, 0 * t])
+    csv = tmp_path / "engine.csv"
+    np.savetxt(csv, table, delimiter=",", header="t,x,y,z,rx,ry,rz", comments="")
+    scene_dict["simulation"].update(mode="quasistatic", duration=1.0, time_step=0.25)
+    scene_dict["bodies"] = [{"name": "engine", "origin": [0.8, 0.2, 0.0], "motion_file": str(csv)}]
+    scene_dict["cables"][0]["clips"][1]["body"] = "engine"
+    res = simulate(scene_from_dict(scene_dict)).cable
+    np.testing.assert_allclose(
+        res.positions[:, -1], [[0.8, 0.2 + 0.05 * ti, -0.02 * ti] for ti in res.time], atol=1e-12
+    )
+
+
+def test_newton_failure_names_the_residual_and_keeps_steps(scene_dict):
+    # Far too few iterations for a slack four-clip cable: a clear failure, not a hang or NaN.
+    cable = scene_dict["cables"][0]
+    cable["length"] = 1.2
+    cable["clips"].insert(
+        1,
+        {
+            "name": "m",
+            "s": 0.6,
+            "position": [0.3, 0.3, -0.1],
+            "direction": [0.0, 1.0, 0.0],
+            "type": "swivel",
+        },
+    )
+    cable["clips"][-1]["s"] = 1.2
+    scene_dict["simulation"]["max_iterations"] = 1
+    with pytest.raises(SimulationError) as info:
+        simulate(scene_from_dict(scene_dict))
+    msg = str(info.value)
+    assert "did not converge" in msg and "last residual" in msg and " N" in msg
+    assert info.value.result.cable.n_steps == 0

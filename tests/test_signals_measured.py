@@ -91,6 +91,17 @@ def test_downsampling_keeps_a_sine_below_nyquist_and_removes_aliases(tmp_path):
     assert np.max(np.abs(value - expected)[20:-20]) < 1e-6 * 1e-3
 
 
+def test_downsampling_keeps_ramps_at_the_record_ends(tmp_path):
+    # A drifting record (e.g. a slow pose change) must keep its end values: the anti-alias
+    # filter takes the end-to-end line out before filtering.
+    t_file = np.linspace(0.0, 1.0, 11)
+    path = tmp_path / "ramp.csv"
+    write_csv(path, t_file, {"z": 0.05 * t_file})
+    t = time_grid(1.0, 0.25)
+    value = generate(measured(file=path, channel="z"), t)
+    assert np.max(np.abs(value - 0.05 * t)) < 1e-12
+
+
 def test_upsampling_keeps_a_sine(tmp_path):
     t_file = np.arange(401) / 200.0  # 2 s at 200 Hz
     path = tmp_path / "slow.csv"

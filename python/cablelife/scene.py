@@ -25,7 +25,7 @@ from pydantic import (
 )
 
 from cablelife.sections import SectionProperties, from_material, from_measured
-from cablelife.signals.spec import ChannelMotion, MeasuredSignal
+from cablelife.signals.spec import ChannelMotion, TableSignal
 
 Vec3 = tuple[float, float, float]
 
@@ -235,23 +235,53 @@ class Body(_Model):
             raise ValueError("give motion (channels) or motion_file, not both")
         return self
 
-    def channel_motions(self) -> list[ChannelMotion]:
+    def channel_motions(self, base_dir: Path | None = None) -> list[ChannelMotion]:
+        """The body's channel signals; a ``motion_file`` table becomes six table signals
+        (linear interpolation between its rows: poses, not a sampled signal to filter)."""
         if self.motion_file is None:
             return list(self.motion)
+        path = self.motion_file
+        if not path.is_absolute() and base_dir is not None:
+            path = base_dir / path
+        table = read_pose_table(path, f"bodies '{self.name}' motion_file")
         return [
             ChannelMotion(
                 channel=ch,
                 frame="global",
-                signal=MeasuredSignal(
-                    type="measured",
-                    file=self.motion_file,
-                    channel=ch,
-                    format="csv",
-                    time_channel="t",
-                ),
+                signal=TableSignal(type="table", t=table["t"].tolist(), value=table[ch].tolist()),
             )
-            for ch in ("x", "y", "z", "rx", "ry", "rz")
+            for ch in POSE_COLUMNS[1:]
         ]
+
+
+POSE_COLUMNS = ("t", "x", "y", "z", "rx", "ry", "rz")
+
+
+def read_pose_table(path: Path, what: str) -> dict[str, np.ndarray]:
+    """Reads a CSV pose table with the columns t, x, y, z, rx, ry, rz (m, rad)."""
+    if not path.is_file():
+        raise SceneError(f"{what} = {str(path)!r} does not exist")
+    try:
+        data = np.genfromtxt(path, delimiter=",", names=True, dtype=float, encoding="utf-8")
+    except ValueError as err:
+        raise SceneError(f"{what} = {str(path)!r} is not a numeric CSV table: {err}") from None
+    names = data.dtype.names or ()
+    missing = [c for c in POSE_COLUMNS if c not in names]
+    if missing:
+        raise SceneError(
+            f"{what} = {str(path)!r} lacks the columns {missing}; it has {list(names)}, "
+            f"needed: {list(POSE_COLUMNS)}"
+        )
+    table = {c: np.atleast_1d(data[c]) for c in POSE_COLUMNS}
+    for c, v in table.items():
+        if not np.all(np.isfinite(v)):
+            row = int(np.flatnonzero(~np.isfinite(v))[0]) + 2
+            raise SceneError(
+                f"{what}: column {c!r} has a missing or non-numeric value in line {row}"
+            )
+    if table["t"].size < 2 or np.any(np.diff(table["t"]) <= 0):
+        raise SceneError(f"{what}: the times in column 't' must increase strictly (≥ 2 rows)")
+    return table
 
 
 class Damping(_Model):

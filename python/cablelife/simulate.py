@@ -65,7 +65,7 @@ def clip_poses(scene: Scene, cable: Cable, times: np.ndarray) -> tuple[np.ndarra
     motions = {}
     for body in scene.bodies:
         r0 = euler_matrix(body.orientation)
-        channels = body.channel_motions()
+        channels = body.channel_motions(scene.base_dir)
         motion = body_motion(channels, grid, scene.base_dir, r0) if channels else None
         motions[body.name] = (body, r0, motion)
     positions = np.empty((n_t, n_c, 3))

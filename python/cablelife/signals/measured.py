@@ -254,9 +254,12 @@ def anti_alias(value: np.ndarray, dt_source: float, dt_target: float) -> np.ndar
         return value
     cutoff = ANTI_ALIAS_FRACTION * 0.5 / dt_target  # Hz
     sos = butter(ANTI_ALIAS_ORDER, cutoff, btype="low", fs=1.0 / dt_source, output="sos")
-    # pad (odd extension) over ~10 periods of the cut-off so the ends settle
+    # pad (odd extension) over ~10 periods of the cut-off so the ends settle; the straight line
+    # through the end values is taken out first (a low-pass passes it unchanged, but the filter's
+    # start-up would not), so records that start or end on a ramp keep their ends
+    trend = np.linspace(value[0], value[-1], value.size)
     padlen = int(np.ceil(10.0 / (cutoff * dt_source)))
-    return sosfiltfilt(sos, value, padlen=min(padlen, value.size - 1))
+    return trend + sosfiltfilt(sos, value - trend, padlen=min(padlen, value.size - 1))
 
 
 def resample(
