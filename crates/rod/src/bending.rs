@@ -48,7 +48,116 @@ pub fn curvature(pa: &Quat, pb: &Quat, w: f64) -> Result<Vector3<f64>, Kink> {
     Ok(q.imag() * (2.0 / (w * q.w)))
 }
 
-/// Evaluates the element; the Hessian only when `want_hess`.
+/// Curvature K of a bending cell and its derivatives with respect to θ_a, θ_b.
+#[derive(Clone, Copy, Debug)]
+pub struct BendKinematics {
+    pub w: f64,
+    /// q = p̄_a p_b.
+    q: Quat,
+    /// K (not reduced by K⁰).
+    pub curvature: Vector3<f64>,
+    dkdq: Matrix3x4<f64>,
+    qa: Matrix4x3<f64>,
+    qb: Matrix4x3<f64>,
+    /// ∂K/∂θ_a, ∂K/∂θ_b.
+    pub ja: Matrix3<f64>,
+    pub jb: Matrix3<f64>,
+}
+
+impl BendKinematics {
+    pub fn new(pa: &Quat, pb: &Quat, w: f64) -> Result<Self, Kink> {
+        let q = pa.conjugate() * pb;
+        let s = q.w;
+        if s.abs() < MIN_COS_HALF * q.norm() {
+            return Err(Kink {
+                cos_half_angle: s / q.norm(),
+            });
+        }
+        let v = q.imag();
+        let c2 = 2.0 / w;
+        // ∂K/∂q, columns (s, v1, v2, v3).
+        let mut dkdq = Matrix3x4::zeros();
+        dkdq.set_column(0, &(-v * (c2 / (s * s))));
+        for i in 0..3 {
+            dkdq[(i, i + 1)] = c2 / s;
+        }
+        // ∂q/∂θ_a = −½ ε_j ⊗ q, ∂q/∂θ_b = ½ q ⊗ ε_j (columns j).
+        let mut qa = Matrix4x3::zeros();
+        let mut qb = Matrix4x3::zeros();
+        for j in 0..3 {
+            let a = pure(j) * q * -0.5;
+            let b = q * pure(j) * 0.5;
+            qa.set_column(j, &Vector4::new(a.w, a.i, a.j, a.k));
+            qb.set_column(j, &Vector4::new(b.w, b.i, b.j, b.k));
+        }
+        Ok(BendKinematics {
+            w,
+            q,
+            curvature: v * (c2 / s),
+            dkdq,
+            qa,
+            qb,
+            ja: dkdq * qa,
+            jb: dkdq * qb,
+        })
+    }
+
+    /// K̇ for the body angular velocities ω_a, ω_b.
+    pub fn rate(&self, omega_a: &Vector3<f64>, omega_b: &Vector3<f64>) -> Vector3<f64> {
+        self.ja * omega_a + self.jb * omega_b
+    }
+
+    /// Generalised moments w Jᵀ m of the section moment m on (θ_a, θ_b).
+    pub fn forces(&self, m: &Vector3<f64>) -> [Vector3<f64>; 2] {
+        [
+            self.w * self.ja.transpose() * m,
+            self.w * self.jb.transpose() * m,
+        ]
+    }
+
+    /// w Jᵀ C J for a diagonal C (stiffness or viscous damping).
+    pub fn gauss_newton(&self, c: &Vector3<f64>) -> [[Matrix3<f64>; 2]; 2] {
+        let c = Matrix3::from_diagonal(c);
+        let (ja, jb) = (self.ja, self.jb);
+        let ab = self.w * ja.transpose() * c * jb;
+        [
+            [self.w * ja.transpose() * c * ja, ab],
+            [ab.transpose(), self.w * jb.transpose() * c * jb],
+        ]
+    }
+
+    /// Σ_k m_k w ∇²K_k: the geometric stiffness of the section moment m.
+    pub fn geometric(&self, m: &Vector3<f64>) -> [[Matrix3<f64>; 2]; 2] {
+        let (s, v) = (self.q.w, self.q.imag());
+        let c2 = 2.0 / self.w;
+        // Σ_k m_k ∂²K_k/∂q² (K = (2/w) v/s: only the s-s and s-v entries are non-zero).
+        let mut sqq = Matrix4::zeros();
+        sqq[(0, 0)] = c2 * 2.0 * m.dot(&v) / (s * s * s);
+        for j in 0..3 {
+            sqq[(0, j + 1)] = -c2 * m[j] / (s * s);
+            sqq[(j + 1, 0)] = sqq[(0, j + 1)];
+        }
+        // λ = (∂K/∂q)ᵀ m with the second derivatives of q: aa and bb are −q/4 δij, which
+        // contract with λ to zero (K is homogeneous of degree 0 in q); ab is −¼ ε_i ⊗ q ⊗ ε_j.
+        let lambda = self.dkdq.transpose() * m;
+        let mut tab = Matrix3::zeros();
+        for i in 0..3 {
+            let left = pure(i) * self.q;
+            for j in 0..3 {
+                let d = left * pure(j);
+                tab[(i, j)] = -0.25 * lambda.dot(&Vector4::new(d.w, d.i, d.j, d.k));
+            }
+        }
+        let (qa, qb, w) = (self.qa, self.qb, self.w);
+        let ab = w * (qa.transpose() * sqq * qb + tab);
+        [
+            [w * qa.transpose() * sqq * qa, ab],
+            [ab.transpose(), w * qb.transpose() * sqq * qb],
+        ]
+    }
+}
+
+/// Evaluates the element (static: m = C^K(K − K⁰)); the Hessian only when `want_hess`.
 #[allow(clippy::too_many_arguments)]
 pub fn bend_element(
     pa: &Quat,
@@ -59,66 +168,22 @@ pub fn bend_element(
     want_hess: bool,
     out: &mut BendEval,
 ) -> Result<(), Kink> {
-    let q = pa.conjugate() * pb;
-    let s = q.w;
-    if s.abs() < MIN_COS_HALF * q.norm() {
-        return Err(Kink {
-            cos_half_angle: s / q.norm(),
-        });
-    }
-    let v = q.imag();
-    let c2 = 2.0 / w;
-    let k = v * (c2 / s);
-    let dk = k - curvature0;
+    let kin = BendKinematics::new(pa, pb, w)?;
+    let dk = kin.curvature - curvature0;
     let m = stiffness.component_mul(&dk);
     out.energy = 0.5 * w * dk.dot(&m);
-    out.curvature = k;
+    out.curvature = kin.curvature;
     out.moment = m;
-    // ∂K/∂q, columns (s, v1, v2, v3).
-    let mut dkdq = Matrix3x4::zeros();
-    dkdq.set_column(0, &(-v * (c2 / (s * s))));
-    for i in 0..3 {
-        dkdq[(i, i + 1)] = c2 / s;
-    }
-    // ∂q/∂θ_a = −½ ε_j ⊗ q, ∂q/∂θ_b = ½ q ⊗ ε_j (columns j).
-    let mut qa = Matrix4x3::zeros();
-    let mut qb = Matrix4x3::zeros();
-    for j in 0..3 {
-        let a = pure(j) * q * -0.5;
-        let b = q * pure(j) * 0.5;
-        qa.set_column(j, &Vector4::new(a.w, a.i, a.j, a.k));
-        qb.set_column(j, &Vector4::new(b.w, b.i, b.j, b.k));
-    }
-    let ja = dkdq * qa;
-    let jb = dkdq * qb;
-    out.grad[0] = w * ja.transpose() * m;
-    out.grad[1] = w * jb.transpose() * m;
-    if !want_hess {
-        return Ok(());
-    }
-    let c = Matrix3::from_diagonal(stiffness);
-    // Σ_k m_k ∂²K_k/∂q² (K is v/s: only the s-s and s-v entries are non-zero).
-    let mut sqq = Matrix4::zeros();
-    sqq[(0, 0)] = c2 * 2.0 * m.dot(&v) / (s * s * s);
-    for j in 0..3 {
-        sqq[(0, j + 1)] = -c2 * m[j] / (s * s);
-        sqq[(j + 1, 0)] = sqq[(0, j + 1)];
-    }
-    // λ = (∂K/∂q)ᵀ m; the second derivatives of q: aa and bb are −q/4 δij, which contract
-    // with λ to zero (K is homogeneous of degree 0 in q); ab is −¼ ε_i ⊗ q ⊗ ε_j.
-    let lambda = dkdq.transpose() * m;
-    let mut tab = Matrix3::zeros();
-    for i in 0..3 {
-        let left = pure(i) * q;
-        for j in 0..3 {
-            let d = left * pure(j);
-            tab[(i, j)] = -0.25 * lambda.dot(&Vector4::new(d.w, d.i, d.j, d.k));
+    out.grad = kin.forces(&m);
+    if want_hess {
+        let gn = kin.gauss_newton(stiffness);
+        let geo = kin.geometric(&m);
+        for i in 0..2 {
+            for j in 0..2 {
+                out.hess[i][j] = gn[i][j] + geo[i][j];
+            }
         }
     }
-    out.hess[0][0] = w * (ja.transpose() * c * ja + qa.transpose() * sqq * qa);
-    out.hess[1][1] = w * (jb.transpose() * c * jb + qb.transpose() * sqq * qb);
-    out.hess[0][1] = w * (ja.transpose() * c * jb + qa.transpose() * sqq * qb + tab);
-    out.hess[1][0] = out.hess[0][1].transpose();
     Ok(())
 }
 

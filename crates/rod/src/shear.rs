@@ -33,7 +33,78 @@ pub fn shear_strain(
     r.transpose() * ((xb - xa) / ds) - Vector3::z() - strain0
 }
 
-/// Evaluates the element; the Hessian only when `want_hess`.
+/// Strain Γ − Γ⁰ of an edge and its derivatives: the pieces from which forces, stiffness
+/// and viscous damping are assembled (static and dynamic alike).
+#[derive(Clone, Copy, Debug)]
+pub struct ShearKinematics {
+    pub ds: f64,
+    /// R(p).
+    pub r: Matrix3<f64>,
+    /// u = Rᵀ (x_b − x_a)/Δs.
+    pub u: Vector3<f64>,
+    /// Γ − Γ⁰.
+    pub strain: Vector3<f64>,
+}
+
+impl ShearKinematics {
+    pub fn new(
+        xa: &Vector3<f64>,
+        xb: &Vector3<f64>,
+        p: &Quat,
+        ds: f64,
+        strain0: &Vector3<f64>,
+    ) -> Self {
+        let r = rotation_matrix(p);
+        let u = r.transpose() * ((xb - xa) / ds);
+        ShearKinematics {
+            ds,
+            r,
+            u,
+            strain: u - Vector3::z() - strain0,
+        }
+    }
+
+    /// Γ̇ for the velocities ẋ_a, ẋ_b (global) and ω (body frame): dΓ = Rᵀ(dx_b − dx_a)/Δs + [u]× θ.
+    pub fn rate(&self, va: &Vector3<f64>, vb: &Vector3<f64>, omega: &Vector3<f64>) -> Vector3<f64> {
+        self.r.transpose() * ((vb - va) / self.ds) + self.u.cross(omega)
+    }
+
+    /// Generalised forces Δs Jᵀ f of the section force f (material frame) on (x_a, x_b, θ).
+    pub fn forces(&self, f: &Vector3<f64>) -> [Vector3<f64>; 3] {
+        let rf = self.r * f;
+        [-rf, rf, self.ds * f.cross(&self.u)]
+    }
+
+    /// Δs Jᵀ C J for a diagonal C: the stiffness (C = C^Γ) or viscous damping (C = τC^Γ) blocks.
+    pub fn gauss_newton(&self, c: &Vector3<f64>) -> [[Matrix3<f64>; 3]; 3] {
+        let c = Matrix3::from_diagonal(c);
+        let su = skew(&self.u);
+        let kxx = self.r * c * self.r.transpose() / self.ds;
+        let kxt = self.r * c * su;
+        let ktt = -self.ds * su * c * su;
+        [
+            [kxx, -kxx, -kxt],
+            [-kxx, kxx, kxt],
+            [-kxt.transpose(), kxt.transpose(), ktt],
+        ]
+    }
+
+    /// Σ_k f_k Δs ∇²Γ_k: the geometric stiffness of the section force f.
+    pub fn geometric(&self, f: &Vector3<f64>) -> [[Matrix3<f64>; 3]; 3] {
+        let z = Matrix3::zeros();
+        let kxt = -self.r * skew(f);
+        let ktt = self.ds
+            * (0.5 * (f * self.u.transpose() + self.u * f.transpose())
+                - Matrix3::identity() * f.dot(&self.u));
+        [
+            [z, z, -kxt],
+            [z, z, kxt],
+            [-kxt.transpose(), kxt.transpose(), ktt],
+        ]
+    }
+}
+
+/// Evaluates the element (static: f = C^Γ(Γ − Γ⁰)); the Hessian only when `want_hess`.
 #[allow(clippy::too_many_arguments)]
 pub fn shear_element(
     xa: &Vector3<f64>,
@@ -45,36 +116,21 @@ pub fn shear_element(
     want_hess: bool,
     out: &mut ShearEval,
 ) {
-    let r = rotation_matrix(p);
-    let u = r.transpose() * ((xb - xa) / ds); // u = Rᵀ v
-    let gamma = u - Vector3::z() - strain0;
-    let f = stiffness.component_mul(&gamma);
-    out.energy = 0.5 * ds * gamma.dot(&f);
-    out.strain = gamma;
+    let kin = ShearKinematics::new(xa, xb, p, ds, strain0);
+    let f = stiffness.component_mul(&kin.strain);
+    out.energy = 0.5 * ds * kin.strain.dot(&f);
+    out.strain = kin.strain;
     out.force = f;
-    let rf = r * f;
-    out.grad[0] = -rf;
-    out.grad[1] = rf;
-    out.grad[2] = ds * f.cross(&u);
-    if !want_hess {
-        return;
+    out.grad = kin.forces(&f);
+    if want_hess {
+        let gn = kin.gauss_newton(stiffness);
+        let geo = kin.geometric(&f);
+        for i in 0..3 {
+            for j in 0..3 {
+                out.hess[i][j] = gn[i][j] + geo[i][j];
+            }
+        }
     }
-    let c = Matrix3::from_diagonal(stiffness);
-    let su = skew(&u);
-    let kxx = r * c * r.transpose() / ds;
-    let kxt = r * (c * su - skew(&f));
-    let ktt = ds
-        * (-su * c * su + 0.5 * (f * u.transpose() + u * f.transpose())
-            - Matrix3::identity() * f.dot(&u));
-    out.hess[0][0] = kxx;
-    out.hess[1][1] = kxx;
-    out.hess[0][1] = -kxx;
-    out.hess[1][0] = -kxx;
-    out.hess[1][2] = kxt;
-    out.hess[0][2] = -kxt;
-    out.hess[2][1] = kxt.transpose();
-    out.hess[2][0] = -kxt.transpose();
-    out.hess[2][2] = ktt;
 }
 
 #[cfg(test)]
