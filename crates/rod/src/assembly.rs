@@ -4,11 +4,11 @@
 //! The Jacobian is the exact derivative of the residual along the Newton update: the symmetric
 //! energy Hessian plus ½[g]× on each rotation's own block (g its energy gradient), which comes
 //! from exp(δ)exp(θ) = exp(δ + θ + ½ δ×θ + …), plus the derivative of dead moments −[Rᵀ M]×.
-use crate::bending::{bend_element, BendEval, Kink};
+use crate::bending::{BendKinematics, Kink};
 use crate::block_tridiag::BlockTridiag;
 use crate::model::{EdgeKind, NodeKind, Rod, RotRef};
 use crate::rotation::{rotation_matrix, skew, Quat};
-use crate::shear::{shear_element, ShearEval};
+use crate::shear::ShearKinematics;
 use crate::state::State;
 use nalgebra::{Matrix3, Vector3, Vector6};
 
@@ -30,10 +30,33 @@ pub struct Workspace {
     pub node_moment: Vec<Vector3<f64>>,
     node_moment_count: Vec<u8>,
     pub elastic_energy: f64,
+    /// Dissipated power of the viscous damping, W (with rates).
+    pub dissipation: f64,
     /// Potential of the external loads (−work), at the current load factor.
     pub load_potential: f64,
-    shear: ShearEval,
-    bend: BendEval,
+}
+
+/// Velocities and damping for a viscoelastic assembly.
+#[derive(Clone, Debug)]
+pub struct Rates {
+    /// Per block: ẋ_n (global), ω_{n+½} (body frame).
+    pub v: Vec<Vector6<f64>>,
+    /// Body angular velocity of each ghost rotation (its clip's).
+    pub ghost_omega: Vec<Vector3<f64>>,
+    /// τ ∘ C^Γ and τ ∘ C^K: the viscous section coefficients.
+    pub shear_damping: Vector3<f64>,
+    pub bend_damping: Vector3<f64>,
+    /// Factor of the damping matrix in the Jacobian (γ/(βh) in generalized-α).
+    pub damping_factor: f64,
+}
+
+impl Rates {
+    fn omega(&self, r: RotRef) -> Vector3<f64> {
+        match r {
+            RotRef::Edge(e) => self.v[e].fixed_rows::<3>(3).into(),
+            RotRef::Ghost(g) => self.ghost_omega[g],
+        }
+    }
 }
 
 /// The curvature became singular (180° between neighbouring rotations) at a node.
@@ -67,9 +90,8 @@ impl Workspace {
             node_moment: vec![Vector3::zeros(); n + 1],
             node_moment_count: vec![0; n + 1],
             elastic_energy: 0.0,
+            dissipation: 0.0,
             load_potential: 0.0,
-            shear: ShearEval::default(),
-            bend: BendEval::default(),
         }
     }
 
@@ -107,31 +129,49 @@ impl Workspace {
         }
     }
 
-    /// Elastic terms (shear/extension and bending/torsion) with the rotation-group correction.
-    pub fn add_elastic(&mut self, rod: &Rod, st: &State, want_jac: bool) -> Result<(), KinkAt> {
+    /// Elastic terms (shear/extension and bending/torsion) with the rotation-group correction;
+    /// with `rates`, Kelvin–Voigt damping too: the section stress is C(Γ−Γ⁰) + τ∘C Γ̇ (and the
+    /// same for K), the stored section forces and moments include it, and the Jacobian gets
+    /// `rates.damping_factor` × the damping matrix Jᵀ τ∘C J.
+    pub fn add_elastic(
+        &mut self,
+        rod: &Rod,
+        st: &State,
+        rates: Option<&Rates>,
+        want_jac: bool,
+    ) -> Result<(), KinkAt> {
         let sec = &rod.spec.section;
         let strain0 = Vector3::zeros();
+        self.dissipation = 0.0;
         for e in 0..rod.n_edges() {
-            shear_element(
-                &st.x[e],
-                &st.x[e + 1],
-                &st.p[e],
-                rod.ds_edge[e],
-                &sec.shear_stiffness,
-                &strain0,
-                want_jac,
-                &mut self.shear,
-            );
-            self.elastic_energy += self.shear.energy;
-            self.edge_force[e] = self.shear.force;
-            self.node_grad[e] += self.shear.grad[0];
-            self.node_grad[e + 1] += self.shear.grad[1];
-            self.edge_grad[e] += self.shear.grad[2];
+            let kin =
+                ShearKinematics::new(&st.x[e], &st.x[e + 1], &st.p[e], rod.ds_edge[e], &strain0);
+            let f_el = sec.shear_stiffness.component_mul(&kin.strain);
+            self.elastic_energy += 0.5 * rod.ds_edge[e] * kin.strain.dot(&f_el);
+            let mut f = f_el;
+            if let Some(r) = rates {
+                let (va, vb) = (r.v[e].fixed_rows::<3>(0), r.v[e + 1].fixed_rows::<3>(0));
+                let gd = kin.rate(&va.into(), &vb.into(), &r.v[e].fixed_rows::<3>(3).into());
+                let fd = r.shear_damping.component_mul(&gd);
+                self.dissipation += rod.ds_edge[e] * gd.dot(&fd);
+                f += fd;
+            }
+            self.edge_force[e] = f;
+            let g = kin.forces(&f);
+            self.node_grad[e] += g[0];
+            self.node_grad[e + 1] += g[1];
+            self.edge_grad[e] += g[2];
             if want_jac {
                 let vars = [node_var(rod, e), node_var(rod, e + 1), edge_var(rod, e)];
-                let h = self.shear.hess;
+                let mut h = kin.gauss_newton(&sec.shear_stiffness);
+                let geo = kin.geometric(&f);
+                let damp = rates.map(|r| (r.damping_factor, kin.gauss_newton(&r.shear_damping)));
                 for i in 0..3 {
                     for j in 0..3 {
+                        h[i][j] += geo[i][j];
+                        if let Some((c, d)) = &damp {
+                            h[i][j] += *c * d[i][j];
+                        }
                         self.add(vars[i], vars[j], &h[i][j]);
                     }
                 }
@@ -139,32 +179,38 @@ impl Workspace {
         }
         let k0 = rod.spec.natural_curvature;
         for t in &rod.bend_terms {
-            let pa = rot(st, t.a);
-            let pb = rot(st, t.b);
-            bend_element(
-                &pa,
-                &pb,
-                t.weight,
-                &sec.bend_stiffness,
-                &k0,
-                want_jac,
-                &mut self.bend,
-            )
-            .map_err(|kink| KinkAt { node: t.node, kink })?;
-            self.elastic_energy += self.bend.energy;
-            self.node_moment[t.node] += self.bend.moment;
+            let kin = BendKinematics::new(&rot(st, t.a), &rot(st, t.b), t.weight)
+                .map_err(|kink| KinkAt { node: t.node, kink })?;
+            let dk = kin.curvature - k0;
+            let m_el = sec.bend_stiffness.component_mul(&dk);
+            self.elastic_energy += 0.5 * t.weight * dk.dot(&m_el);
+            let mut m = m_el;
+            if let Some(r) = rates {
+                let kd = kin.rate(&r.omega(t.a), &r.omega(t.b));
+                let md = r.bend_damping.component_mul(&kd);
+                self.dissipation += t.weight * kd.dot(&md);
+                m += md;
+            }
+            self.node_moment[t.node] += m;
             self.node_moment_count[t.node] += 1;
-            for (r, g) in [(t.a, self.bend.grad[0]), (t.b, self.bend.grad[1])] {
+            let g = kin.forces(&m);
+            for (r, gi) in [(t.a, g[0]), (t.b, g[1])] {
                 match r {
-                    RotRef::Edge(e) => self.edge_grad[e] += g,
-                    RotRef::Ghost(k) => self.ghost_grad[k] += g,
+                    RotRef::Edge(e) => self.edge_grad[e] += gi,
+                    RotRef::Ghost(k) => self.ghost_grad[k] += gi,
                 }
             }
             if want_jac {
                 let vars = [rot_var(rod, t.a), rot_var(rod, t.b)];
-                let h = self.bend.hess;
+                let mut h = kin.gauss_newton(&sec.bend_stiffness);
+                let geo = kin.geometric(&m);
+                let damp = rates.map(|r| (r.damping_factor, kin.gauss_newton(&r.bend_damping)));
                 for i in 0..2 {
                     for j in 0..2 {
+                        h[i][j] += geo[i][j];
+                        if let Some((c, d)) = &damp {
+                            h[i][j] += *c * d[i][j];
+                        }
                         self.add(vars[i], vars[j], &h[i][j]);
                     }
                 }
@@ -245,7 +291,7 @@ impl Workspace {
         want_jac: bool,
     ) -> Result<(), KinkAt> {
         self.clear(want_jac);
-        self.add_elastic(rod, st, want_jac)?;
+        self.add_elastic(rod, st, None, want_jac)?;
         self.add_external(rod, st, load_factor, want_jac);
         self.finalize(rod, want_jac);
         Ok(())

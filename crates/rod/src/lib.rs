@@ -4,6 +4,7 @@
 pub mod assembly;
 pub mod bending;
 pub mod block_tridiag;
+pub mod dynamics;
 pub mod model;
 pub mod rotation;
 pub mod routing;
@@ -11,6 +12,7 @@ pub mod shear;
 pub mod state;
 pub mod statics;
 
+pub use dynamics::{ClipMotion, DynamicOptions, Dynamics, Energies, GenAlpha, StepStats};
 pub use model::{CableSpec, ClipKind, ClipSpec, PointLoad, Pose, Rod, Section, SpecError};
 pub use state::State;
 pub use statics::{NewtonOptions, SolveError, SolveStats, Statics};
