@@ -30,6 +30,8 @@ import numpy as np
 FORMAT = "cablelife-result"
 FORMAT_VERSION = 1
 
+ENERGIES = ("kinetic_energy", "elastic_energy", "dissipated_energy", "load_potential")
+
 _UNITS = {
     "time": "s",
     "arc_length": "m",
@@ -40,6 +42,7 @@ _UNITS = {
     "kinetic_energy": "J",
     "elastic_energy": "J",
     "dissipated_energy": "J",
+    "load_potential": "J",
 }
 
 
@@ -202,11 +205,7 @@ def load_result(path: str | os.PathLike) -> Result:
                 )
                 for cn, cg in g["clips"].items()
             }
-            energies = {
-                k: g[k][()]
-                for k in ("kinetic_energy", "elastic_energy", "dissipated_energy")
-                if k in g
-            }
+            energies = {k: g[k][()] for k in ENERGIES if k in g}
             solver = dict(g["solver"].attrs.items())
             solver.update({k: v[()] for k, v in g["solver"].items()})
             cables[name] = CableResult(

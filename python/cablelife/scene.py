@@ -156,6 +156,28 @@ class Load(_Model):
     moment: Vec3 = (0.0, 0.0, 0.0)  # N m
 
 
+class Damping(_Model):
+    """Kelvin–Voigt damping C^Γ̇ = τC^Γ, C^K̇ = τC^K. Give ``ratio`` ζ (fraction of critical
+    damping of the mounted cable's first mode: τ = 2ζ/ω₁; ζ = 1 is critical, the default) or
+    ``retardation_time`` τ directly; the per-mode times override τ for that deformation mode."""
+
+    ratio: PositiveFloat | None = None
+    retardation_time: NonNegativeFloat | None = None  # s
+    extension: NonNegativeFloat | None = None  # s, τ of EA
+    shear: NonNegativeFloat | None = None  # s, τ of GA₁, GA₂
+    bending: NonNegativeFloat | None = None  # s, τ of EI₁, EI₂
+    torsion: NonNegativeFloat | None = None  # s, τ of GJ
+
+    @model_validator(mode="after")
+    def _one(self):
+        if self.ratio is not None and self.retardation_time is not None:
+            raise ValueError("give ratio or retardation_time, not both")
+        return self
+
+
+DEFAULT_DAMPING_RATIO = 1.0
+
+
 class Cable(_Model):
     """One cable or hose."""
 
@@ -169,6 +191,7 @@ class Cable(_Model):
     stiffness: MeasuredStiffness | None = None
     clips: Annotated[list[Clip], Field(min_length=1)]
     loads: list[Load] = []
+    damping: Damping = Damping()
 
     @model_validator(mode="after")
     def _consistent(self):
@@ -284,13 +307,6 @@ def read_pose_table(path: Path, what: str) -> dict[str, np.ndarray]:
     return table
 
 
-class Damping(_Model):
-    """Kelvin–Voigt damping: a fraction of critical damping of the first mode, or τ directly."""
-
-    ratio: PositiveFloat | None = None
-    retardation_time: PositiveFloat | None = None  # s
-
-
 class Simulation(_Model):
     """Run settings."""
 
@@ -300,6 +316,7 @@ class Simulation(_Model):
     time_step: PositiveFloat = 1e-3  # s
     output_step: PositiveFloat | None = None  # s (default: every step)
     max_iterations: PositiveInt = 40
+    spectral_radius: Annotated[float, Field(ge=0.0, le=1.0)] = 0.9  # ρ∞ of generalized-α
 
 
 class Scene(_Model):

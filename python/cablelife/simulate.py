@@ -49,17 +49,21 @@ def euler_matrix(angles) -> np.ndarray:
 
 
 def output_times(scene: Scene, mode: str) -> np.ndarray:
-    """The saved time steps of a run."""
+    """The time grid of a run: the saved steps (static, quasistatic) or the integration
+    steps (dynamic; every ``output_every``-th is saved)."""
     sim = scene.simulation
     if mode == "static":
         return np.array([0.0])
     if sim.duration is None:
         raise SceneError(f"simulation.duration is required in {mode} mode")
+    if mode == "dynamic":
+        return time_grid(sim.duration, sim.time_step)  # the integration steps
     return time_grid(sim.duration, sim.output_step or sim.time_step)
 
 
-def clip_poses(scene: Scene, cable: Cable, times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Clip positions (T, C, 3) and orientations as quaternions, scalar first (T, C, 4)."""
+def clip_kinematics(scene: Scene, cable: Cable, times: np.ndarray) -> dict[str, np.ndarray]:
+    """Clip kinematics on ``times``: positions (T, C, 3), quaternions scalar first (T, C, 4),
+    velocities, angular velocities, accelerations, angular accelerations (T, C, 3), global."""
     n_t, n_c = times.size, len(cable.clips)
     grid = times if n_t > 1 else np.array([times[0], times[0] + scene.simulation.time_step])
     motions = {}
@@ -68,13 +72,22 @@ def clip_poses(scene: Scene, cable: Cable, times: np.ndarray) -> tuple[np.ndarra
         channels = body.channel_motions(scene.base_dir)
         motion = body_motion(channels, grid, scene.base_dir, r0) if channels else None
         motions[body.name] = (body, r0, motion)
-    positions = np.empty((n_t, n_c, 3))
+    out = {
+        k: np.zeros((n_t, n_c, 3))
+        for k in (
+            "positions",
+            "velocities",
+            "angular_velocities",
+            "accelerations",
+            "angular_accelerations",
+        )
+    }
     frames = np.empty((n_t, n_c, 3, 3))
     for j, clip in enumerate(cable.clips):
         local = frame_matrix(clip.direction, clip.normal)
         pos = np.asarray(clip.position, float)
         if clip.body == "world":
-            positions[:, j] = pos
+            out["positions"][:, j] = pos
             frames[:, j] = local
             continue
         body, r0, motion = motions[clip.body]
@@ -82,14 +95,29 @@ def clip_poses(scene: Scene, cable: Cable, times: np.ndarray) -> tuple[np.ndarra
         if clip.frame == "body":
             pos, local = origin + r0 @ pos, r0 @ local
         if motion is None:
-            positions[:, j] = pos
+            out["positions"][:, j] = pos
             frames[:, j] = local
             continue
         rot = motion.rotation[:n_t]
-        positions[:, j] = origin + motion.translation[:n_t] + rot @ (pos - origin)
+        arm = rot @ (pos - origin)  # r = R(X − o)
+        w, alpha = motion.angular_velocity[:n_t], motion.angular_acceleration[:n_t]
+        out["positions"][:, j] = origin + motion.translation[:n_t] + arm
+        out["velocities"][:, j] = motion.velocity[:n_t] + np.cross(w, arm)
+        out["accelerations"][:, j] = (
+            motion.acceleration[:n_t] + np.cross(alpha, arm) + np.cross(w, np.cross(w, arm))
+        )
+        out["angular_velocities"][:, j] = w
+        out["angular_accelerations"][:, j] = alpha
         frames[:, j] = rot @ local
     quats = Rotation.from_matrix(frames.reshape(-1, 3, 3)).as_quat(scalar_first=True)
-    return positions, quats.reshape(n_t, n_c, 4)
+    out["quaternions"] = quats.reshape(n_t, n_c, 4)
+    return out
+
+
+def clip_poses(scene: Scene, cable: Cable, times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Clip positions (T, C, 3) and orientations as quaternions, scalar first (T, C, 4)."""
+    k = clip_kinematics(scene, cable, times)
+    return k["positions"], k["quaternions"]
 
 
 def build_cable(scene: Scene, cable: Cable) -> _core.Cable:
@@ -119,13 +147,63 @@ def build_cable(scene: Scene, cable: Cable) -> _core.Cable:
         raise SceneError(f"cable '{cable.name}': {err}") from None
 
 
-def _run_cable(scene: Scene, cable: Cable, times: np.ndarray, progress: Progress | None):
+def output_every(scene: Scene) -> int:
+    """Integration steps per saved step of a dynamic run."""
+    sim = scene.simulation
+    if sim.output_step is None:
+        return 1
+    ratio = sim.output_step / sim.time_step
+    k = round(ratio)
+    if k < 1 or abs(ratio - k) > 1e-6 * ratio:
+        raise SceneError(
+            f"simulation.output_step = {sim.output_step} s must be a whole multiple of "
+            f"time_step = {sim.time_step} s"
+        )
+    return k
+
+
+def _run_cable(scene: Scene, cable: Cable, times: np.ndarray, mode: str, progress: Progress | None):
     core = build_cable(scene, cable)
-    pos, quat = clip_poses(scene, cable, times)
     callback = (lambda k, n: progress(cable.name, k, n)) if progress else None
+    solver: dict = {}
     start = _time.perf_counter()
     try:
-        out = core.run_sequence(pos, quat, callback, max(1, times.size // 100))
+        if mode == "dynamic":
+            from cablelife.modal import retardation_times
+
+            tau_shear, tau_bend, info = retardation_times(scene, cable)
+            every = output_every(scene)
+            kin = clip_kinematics(scene, cable, times)
+            start = _time.perf_counter()
+            out = core.run_dynamic(
+                scene.simulation.time_step,
+                kin["positions"],
+                kin["quaternions"],
+                kin["velocities"],
+                kin["angular_velocities"],
+                kin["accelerations"],
+                kin["angular_accelerations"],
+                every,
+                tau_shear,
+                tau_bend,
+                scene.simulation.spectral_radius,
+                callback,
+                max(1, times.size // 200),
+            )
+            saved = times[::every]
+            solver.update(
+                spectral_radius=scene.simulation.spectral_radius,
+                time_step=scene.simulation.time_step,
+                tau_shear=np.array(tau_shear),
+                tau_bend=np.array(tau_bend),
+                damping_source=info["source"],
+                damping_ratio=info.get("ratio", float("nan")),
+                omega1=info.get("omega1", float("nan")),
+            )
+        else:
+            pos, quat = clip_poses(scene, cable, times)
+            out = core.run_sequence(pos, quat, callback, max(1, times.size // 100))
+            saved = times
     except ValueError as err:
         raise SceneError(f"cable '{cable.name}': {err}") from None
     wall = _time.perf_counter() - start
@@ -137,17 +215,26 @@ def _run_cable(scene: Scene, cable: Cable, times: np.ndarray, progress: Progress
         )
         for j, c in enumerate(cable.clips)
     }
-    solver = {
-        "iterations": out["iterations"],
-        "substeps": out["substeps"],
-        "residual": out["residual"],
-        "segments": int(core.arc_length.size - 1),
-        "wall_time": wall,
-        "error": out["error"] or "",
-    }
+    simulated = float(saved[n - 1] - saved[0]) if n > 1 else 0.0
+    solver.update(
+        iterations=out["iterations"],
+        substeps=out["substeps"],
+        residual=out["residual"],
+        segments=int(core.arc_length.size - 1),
+        wall_time=wall,
+        real_time_factor=wall / simulated if simulated > 0 else float("nan"),
+        error=out["error"] or "",
+    )
+    energies = {"elastic_energy": out["elastic_energy"]}
+    if mode == "dynamic":
+        energies.update(
+            kinetic_energy=out["kinetic_energy"],
+            dissipated_energy=out["dissipated_energy"],
+            load_potential=out["load_potential"],
+        )
     res = CableResult(
         name=cable.name,
-        time=times[:n].copy(),
+        time=saved[:n].copy(),
         arc_length=core.arc_length,
         positions=out["positions"],
         quaternions=out["quaternions"],
@@ -156,7 +243,7 @@ def _run_cable(scene: Scene, cable: Cable, times: np.ndarray, progress: Progress
         clips=clips,
         section=props.as_attrs(),
         solver=solver,
-        energies={"elastic_energy": out["elastic_energy"]},
+        energies=energies,
     )
     return res, out["error"]
 
@@ -168,15 +255,14 @@ def simulate(scene: Scene, mode: str | None = None, progress: Progress | None = 
     is interrupted; :class:`SceneError` for an unusable scene.
     """
     mode = mode or scene.simulation.mode
-    if mode not in ("static", "quasistatic"):
+    if mode not in ("static", "quasistatic", "dynamic"):
         raise SceneError(
-            f"simulation.mode = {mode!r} is not available in this version; "
-            "allowed: 'static', 'quasistatic'"
+            f"mode = {mode!r} is not a simulation mode; allowed: 'static', 'quasistatic', 'dynamic'"
         )
     times = output_times(scene, mode)
     workers = max(1, min(len(scene.cables), os.cpu_count() or 1))
     with ThreadPoolExecutor(max_workers=workers) as pool:
-        futures = [pool.submit(_run_cable, scene, c, times, progress) for c in scene.cables]
+        futures = [pool.submit(_run_cable, scene, c, times, mode, progress) for c in scene.cables]
         outcomes = [f.result() for f in futures]
     cables = {res.name: res for res, _ in outcomes}
     errors = [f"cable '{res.name}': {err}" for res, err in outcomes if err]

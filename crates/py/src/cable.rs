@@ -8,7 +8,8 @@ use pyo3::types::PyDict;
 use rod::assembly::Workspace;
 use rod::routing::route;
 use rod::{
-    CableSpec, ClipKind, ClipSpec, NewtonOptions, PointLoad, Pose, Rod, Section, State, Statics,
+    CableSpec, ClipKind, ClipMotion, ClipSpec, DynamicOptions, Dynamics, NewtonOptions, PointLoad,
+    Pose, Rod, Section, State, Statics,
 };
 
 fn vec3(v: &[f64], what: &str) -> PyResult<Vector3<f64>> {
@@ -52,6 +53,9 @@ struct Record {
     substeps: Vec<i64>,
     residual: Vec<f64>,
     elastic_energy: Vec<f64>,
+    kinetic_energy: Vec<f64>,
+    load_potential: Vec<f64>,
+    dissipated_energy: Vec<f64>,
 }
 
 impl Record {
@@ -78,6 +82,12 @@ impl Record {
         self.substeps.push(stats.substeps as i64);
         self.residual.push(stats.residual);
         self.elastic_energy.push(ws.elastic_energy);
+        self.load_potential.push(ws.load_potential);
+    }
+
+    fn push_energies(&mut self, e: &rod::Energies) {
+        self.kinetic_energy.push(e.kinetic);
+        self.dissipated_energy.push(e.dissipated);
     }
 
     fn into_dict<'py>(
@@ -108,13 +118,53 @@ impl Record {
         d.set_item("iterations", PyArray1::from_vec(py, self.iterations))?;
         d.set_item("substeps", PyArray1::from_vec(py, self.substeps))?;
         d.set_item("residual", PyArray1::from_vec(py, self.residual))?;
-        d.set_item(
-            "elastic_energy",
-            PyArray1::from_vec(py, self.elastic_energy),
-        )?;
+        for (key, values) in [
+            ("elastic_energy", self.elastic_energy),
+            ("kinetic_energy", self.kinetic_energy),
+            ("load_potential", self.load_potential),
+            ("dissipated_energy", self.dissipated_energy),
+        ] {
+            d.set_item(key, PyArray1::from_vec(py, values))?;
+        }
         d.set_item("steps", t)?;
         Ok(d)
     }
+}
+
+fn read_poses(
+    pos: &numpy::ndarray::ArrayView3<f64>,
+    qs: &numpy::ndarray::ArrayView3<f64>,
+) -> PyResult<Vec<Vec<Pose>>> {
+    let (t, c, _) = pos.dim();
+    let mut poses = Vec::with_capacity(t);
+    for k in 0..t {
+        let mut step = Vec::with_capacity(c);
+        for j in 0..c {
+            let p = pos.slice(numpy::ndarray::s![k, j, ..]);
+            let q = qs.slice(numpy::ndarray::s![k, j, ..]);
+            step.push(Pose {
+                position: Vector3::new(p[0], p[1], p[2]),
+                orientation: quat(&[q[0], q[1], q[2], q[3]], "clip orientation")?,
+            });
+        }
+        poses.push(step);
+    }
+    Ok(poses)
+}
+
+/// Calls the progress callback and checks for Ctrl-C; returns why to stop, if so.
+fn poll(progress: &Option<Py<PyAny>>, done: usize, total: usize) -> Option<String> {
+    Python::attach(|py| {
+        if let Err(e) = py.check_signals() {
+            return Some(format!("interrupted: {e}"));
+        }
+        if let Some(cb) = progress {
+            if let Err(e) = cb.call1(py, (done, total)) {
+                return Some(format!("progress callback failed: {e}"));
+            }
+        }
+        None
+    })
 }
 
 /// One cable: mesh, state and solver.
@@ -246,19 +296,7 @@ impl Cable {
                 qs.dim()
             )));
         }
-        let mut poses: Vec<Vec<Pose>> = Vec::with_capacity(t);
-        for k in 0..t {
-            let mut step = Vec::with_capacity(c);
-            for j in 0..c {
-                let p = pos.slice(numpy::ndarray::s![k, j, ..]);
-                let q = qs.slice(numpy::ndarray::s![k, j, ..]);
-                step.push(Pose {
-                    position: Vector3::new(p[0], p[1], p[2]),
-                    orientation: quat(&[q[0], q[1], q[2], q[3]], "clip orientation")?,
-                });
-            }
-            poses.push(step);
-        }
+        let poses = read_poses(&pos, &qs)?;
         let rod = &self.rod;
         let solver = &mut self.solver;
         let state_slot = &mut self.state;
@@ -305,20 +343,9 @@ impl Cable {
                     }
                 }
                 if (k + 1) % every == 0 || k + 1 == poses.len() {
-                    let stop = Python::attach(|py| -> Option<String> {
-                        if let Err(e) = py.check_signals() {
-                            return Some(format!("interrupted: {e}"));
-                        }
-                        if let Some(cb) = &progress {
-                            if let Err(e) = cb.call1(py, (k + 1, poses.len())) {
-                                return Some(format!("progress callback failed: {e}"));
-                            }
-                        }
-                        None
-                    });
-                    if stop.is_some() {
+                    if let Some(stop) = poll(&progress, k + 1, poses.len()) {
                         *state_slot = Some(st);
-                        return (rec, stop);
+                        return (rec, Some(stop));
                     }
                 }
             }
@@ -327,6 +354,206 @@ impl Cable {
         });
         let d = record.into_dict(py, self.rod.arc.len(), n_clips)?;
         d.set_item("error", error)?;
+        Ok(d)
+    }
+
+    /// Dynamic run: static equilibrium at the clip poses of step 0, then generalized-α steps
+    /// of `time_step` through the clip kinematics (T, C, ·): positions, quaternions, velocities,
+    /// angular velocities, accelerations, angular accelerations (global). Every
+    /// `output_every`-th step is recorded (and step 0). τ: retardation times (GA₁, GA₂, EA),
+    /// (EI₁, EI₂, GJ). Returns the recorded arrays, energies and `error` as `run_sequence`.
+    #[pyo3(signature = (time_step, positions, quaternions, velocities, angular_velocities,
+        accelerations, angular_accelerations, output_every, tau_shear, tau_bend,
+        spectral_radius=0.9, progress=None, progress_every=100))]
+    #[allow(clippy::too_many_arguments)]
+    fn run_dynamic<'py>(
+        &mut self,
+        py: Python<'py>,
+        time_step: f64,
+        positions: PyReadonlyArray3<'py, f64>,
+        quaternions: PyReadonlyArray3<'py, f64>,
+        velocities: PyReadonlyArray3<'py, f64>,
+        angular_velocities: PyReadonlyArray3<'py, f64>,
+        accelerations: PyReadonlyArray3<'py, f64>,
+        angular_accelerations: PyReadonlyArray3<'py, f64>,
+        output_every: usize,
+        tau_shear: Vec<f64>,
+        tau_bend: Vec<f64>,
+        spectral_radius: f64,
+        progress: Option<Py<PyAny>>,
+        progress_every: usize,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        if !(time_step.is_finite() && time_step > 0.0) {
+            return Err(PyValueError::new_err(format!(
+                "time_step = {time_step}: must be > 0 s"
+            )));
+        }
+        if !(0.0..=1.0).contains(&spectral_radius) {
+            return Err(PyValueError::new_err(format!(
+                "spectral_radius = {spectral_radius}: allowed is 0 ≤ ρ∞ ≤ 1"
+            )));
+        }
+        let n_clips = self.rod.spec.clips.len();
+        let pos = positions.as_array();
+        let qs = quaternions.as_array();
+        let t = pos.dim().0;
+        let arrays = [
+            velocities.as_array(),
+            angular_velocities.as_array(),
+            accelerations.as_array(),
+            angular_accelerations.as_array(),
+        ];
+        if pos.dim() != (t, n_clips, 3)
+            || qs.dim() != (t, n_clips, 4)
+            || arrays.iter().any(|a| a.dim() != (t, n_clips, 3))
+        {
+            return Err(PyValueError::new_err(format!(
+                "clip kinematics must be (T, {n_clips}, 3), quaternions (T, {n_clips}, 4)"
+            )));
+        }
+        let poses = read_poses(&pos, &qs)?;
+        let vec_at = |a: &numpy::ndarray::ArrayView3<f64>, k: usize, j: usize| {
+            Vector3::new(a[[k, j, 0]], a[[k, j, 1]], a[[k, j, 2]])
+        };
+        let motions: Vec<Vec<ClipMotion>> = (0..t)
+            .map(|k| {
+                (0..n_clips)
+                    .map(|j| ClipMotion {
+                        pose: poses[k][j],
+                        velocity: vec_at(&arrays[0], k, j),
+                        angular_velocity: vec_at(&arrays[1], k, j),
+                        acceleration: vec_at(&arrays[2], k, j),
+                        angular_acceleration: vec_at(&arrays[3], k, j),
+                    })
+                    .collect()
+            })
+            .collect();
+        let opts = DynamicOptions {
+            rho_inf: spectral_radius,
+            tau_shear: vec3(&tau_shear, "tau_shear")?,
+            tau_bend: vec3(&tau_bend, "tau_bend")?,
+            ..Default::default()
+        };
+        let initial = route(&self.rod, poses.first().map(|p| p.as_slice()))
+            .map_err(|e| PyValueError::new_err(e.0))?;
+        let rod = &self.rod;
+        let solver = &mut self.solver;
+        let state_slot = &mut self.state;
+        let every = output_every.max(1);
+        let poll_every = progress_every.max(1);
+        let (record, error) = py.detach(move || {
+            let mut rec = Record::default();
+            let mut st = initial;
+            let stats = match solver.solve(rod, &mut st) {
+                Ok(s) => s,
+                Err(e) => return (rec, Some(format!("static equilibrium at t = 0: {e}"))),
+            };
+            let mut dy = Dynamics::new(rod, &st, &motions[0], opts);
+            if let Err(e) = dy.start(rod, &st) {
+                return (rec, Some(format!("start: {e}")));
+            }
+            rec.push(rod, &st, &dy.ws, &stats);
+            rec.push_energies(&dy.energies);
+            for k in 1..t {
+                match dy.advance(rod, &mut st, time_step, &motions[k - 1], &motions[k], 6) {
+                    Ok(s) => {
+                        if k % every == 0 {
+                            let stats = rod::SolveStats {
+                                iterations: s.iterations,
+                                residual: s.residual,
+                                substeps: s.factorizations,
+                            };
+                            rec.push(rod, &st, &dy.ws, &stats);
+                            rec.push_energies(&dy.energies);
+                        }
+                    }
+                    Err(e) => {
+                        *state_slot = Some(st);
+                        return (
+                            rec,
+                            Some(format!("step {k} (t = {:.6} s): {e}", k as f64 * time_step)),
+                        );
+                    }
+                }
+                if k % poll_every == 0 || k + 1 == t {
+                    if let Some(stop) = poll(&progress, k + 1, t) {
+                        *state_slot = Some(st);
+                        return (rec, Some(stop));
+                    }
+                }
+            }
+            *state_slot = Some(st);
+            (rec, None)
+        });
+        let d = record.into_dict(py, self.rod.arc.len(), n_clips)?;
+        d.set_item("error", error)?;
+        Ok(d)
+    }
+
+    /// Linearisation about the state of the last run (a static equilibrium): the tangent
+    /// stiffness K (n × n, dense, active unknowns only), the diagonal mass (n,), and for each
+    /// unknown its (block, slot); slots 0–2 node displacement, 3–5 edge rotation (body frame).
+    /// Massless unknowns (swivel twists) have mass 0.
+    fn linearize<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let st = self
+            .state
+            .as_ref()
+            .ok_or_else(|| PyValueError::new_err("run a static solve (run_sequence) first"))?;
+        let rod = &self.rod;
+        let ws = &mut self.solver.ws;
+        ws.assemble_static(rod, st, 1.0, true)
+            .map_err(|k| PyValueError::new_err(format!("kink at node {}", k.node)))?;
+        let mut dofs = Vec::new();
+        for (b, m) in rod.mask.iter().enumerate() {
+            for (k, &active) in m.iter().enumerate() {
+                if active {
+                    dofs.push((b, k));
+                }
+            }
+        }
+        let n = dofs.len();
+        let index: std::collections::HashMap<(usize, usize), usize> =
+            dofs.iter().enumerate().map(|(i, d)| (*d, i)).collect();
+        let mut k_dense = vec![0.0; n * n];
+        for (i, &(b, k)) in dofs.iter().enumerate() {
+            for bj in b.saturating_sub(1)..(b + 2).min(rod.mask.len()) {
+                let block = if bj == b {
+                    &ws.jac.diag[b]
+                } else if bj + 1 == b {
+                    &ws.jac.lower[b]
+                } else {
+                    &ws.jac.upper[b]
+                };
+                for kj in 0..6 {
+                    if let Some(&j) = index.get(&(bj, kj)) {
+                        k_dense[i * n + j] = block[(k, kj)];
+                    }
+                }
+            }
+        }
+        let sec = &rod.spec.section;
+        let mass: Vec<f64> = dofs
+            .iter()
+            .map(|&(b, k)| {
+                let node_free = rod.node_kind[b] == rod::model::NodeKind::Free;
+                let edge_free = b < rod.n_edges() && rod.edge_kind[b] == rod::model::EdgeKind::Free;
+                match k {
+                    0..=2 if node_free => rod.node_mass[b],
+                    3..=5 if edge_free => sec.rotary_inertia[k - 3] * rod.ds_edge[b],
+                    _ => 0.0,
+                }
+            })
+            .collect();
+        let d = PyDict::new(py);
+        d.set_item(
+            "stiffness",
+            PyArray1::from_vec(py, k_dense).reshape([n, n])?,
+        )?;
+        d.set_item("mass", PyArray1::from_vec(py, mass))?;
+        let blocks: Vec<i64> = dofs.iter().map(|d| d.0 as i64).collect();
+        let slots: Vec<i64> = dofs.iter().map(|d| d.1 as i64).collect();
+        d.set_item("block", PyArray1::from_vec(py, blocks))?;
+        d.set_item("slot", PyArray1::from_vec(py, slots))?;
         Ok(d)
     }
 

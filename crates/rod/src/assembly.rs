@@ -165,14 +165,23 @@ impl Workspace {
                 let vars = [node_var(rod, e), node_var(rod, e + 1), edge_var(rod, e)];
                 let mut h = kin.gauss_newton(&sec.shear_stiffness);
                 let geo = kin.geometric(&f);
-                let damp = rates.map(|r| (r.damping_factor, kin.gauss_newton(&r.shear_damping)));
                 for i in 0..3 {
                     for j in 0..3 {
                         h[i][j] += geo[i][j];
-                        if let Some((c, d)) = &damp {
-                            h[i][j] += *c * d[i][j];
-                        }
                         self.add(vars[i], vars[j], &h[i][j]);
+                    }
+                }
+                if let Some(r) = rates {
+                    let d = kin.gauss_newton(&r.shear_damping);
+                    let dvars = [
+                        node_var(rod, e),
+                        node_var(rod, e + 1),
+                        rate_var(rod, RotRef::Edge(e)),
+                    ];
+                    for i in 0..3 {
+                        for j in 0..3 {
+                            self.add(vars[i], dvars[j], &(r.damping_factor * d[i][j]));
+                        }
                     }
                 }
             }
@@ -204,14 +213,19 @@ impl Workspace {
                 let vars = [rot_var(rod, t.a), rot_var(rod, t.b)];
                 let mut h = kin.gauss_newton(&sec.bend_stiffness);
                 let geo = kin.geometric(&m);
-                let damp = rates.map(|r| (r.damping_factor, kin.gauss_newton(&r.bend_damping)));
                 for i in 0..2 {
                     for j in 0..2 {
                         h[i][j] += geo[i][j];
-                        if let Some((c, d)) = &damp {
-                            h[i][j] += *c * d[i][j];
-                        }
                         self.add(vars[i], vars[j], &h[i][j]);
+                    }
+                }
+                if let Some(r) = rates {
+                    let d = kin.gauss_newton(&r.bend_damping);
+                    let dvars = [rate_var(rod, t.a), rate_var(rod, t.b)];
+                    for i in 0..2 {
+                        for j in 0..2 {
+                            self.add(vars[i], dvars[j], &(r.damping_factor * d[i][j]));
+                        }
                     }
                 }
             }
@@ -350,6 +364,16 @@ fn edge_var(rod: &Rod, e: usize) -> Var {
     match rod.edge_kind[e] {
         EdgeKind::Prescribed { .. } => Var::None,
         _ => Var::Full(e, 1),
+    }
+}
+
+/// The rotation unknowns whose velocities the dynamics tracks (free edges): the damping matrix
+/// has columns only for these (every equation depends on them); the massless swivel twists are
+/// quasistatic, their rate is not modelled.
+fn rate_var(rod: &Rod, r: RotRef) -> Var {
+    match r {
+        RotRef::Edge(e) if rod.edge_kind[e] == EdgeKind::Free => Var::Full(e, 1),
+        _ => Var::None,
     }
 }
 

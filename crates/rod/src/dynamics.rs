@@ -15,7 +15,7 @@
 use crate::assembly::{KinkAt, Rates, Workspace};
 use crate::block_tridiag::Singular;
 use crate::model::{EdgeKind, NodeKind, Pose, Rod};
-use crate::rotation::{rotate_body, rotation_matrix, skew, Quat};
+use crate::rotation::{rotate_body, rotation_matrix, skew, slerp, Quat};
 use crate::state::State;
 use crate::statics::SolveError;
 use nalgebra::{Matrix3, Vector3, Vector6};
@@ -56,6 +56,22 @@ pub struct ClipMotion {
     pub angular_velocity: Vector3<f64>,
     pub acceleration: Vector3<f64>,
     pub angular_acceleration: Vector3<f64>,
+}
+
+impl ClipMotion {
+    /// The kinematics half-way to `other` (linear, rotations by slerp).
+    pub fn midpoint(&self, other: &ClipMotion) -> ClipMotion {
+        ClipMotion {
+            pose: Pose {
+                position: 0.5 * (self.pose.position + other.pose.position),
+                orientation: slerp(&self.pose.orientation, &other.pose.orientation, 0.5),
+            },
+            velocity: 0.5 * (self.velocity + other.velocity),
+            angular_velocity: 0.5 * (self.angular_velocity + other.angular_velocity),
+            acceleration: 0.5 * (self.acceleration + other.acceleration),
+            angular_acceleration: 0.5 * (self.angular_acceleration + other.angular_acceleration),
+        }
+    }
 }
 
 #[derive(Clone, Debug)]
@@ -113,6 +129,8 @@ pub struct Dynamics {
     // Values at t_n.
     x_n: Vec<Vector3<f64>>,
     p_n: Vec<Quat>,
+    ghost_n: Vec<Quat>,
+    pose_n: Vec<Pose>,
     v_n: Vec<Vector6<f64>>,
     vdot_n: Vec<Vector6<f64>>,
     a_n: Vec<Vector6<f64>>,
@@ -160,6 +178,8 @@ impl Dynamics {
             a: vec![Vector6::zeros(); n + 1],
             x_n: st.x.clone(),
             p_n: st.p.clone(),
+            ghost_n: st.ghost.clone(),
+            pose_n: st.clip_pose.clone(),
             v_n: vec![Vector6::zeros(); n + 1],
             vdot_n: vec![Vector6::zeros(); n + 1],
             a_n: vec![Vector6::zeros(); n + 1],
@@ -273,6 +293,8 @@ impl Dynamics {
         // Values at t_n.
         self.x_n.clone_from(&st.x);
         self.p_n.clone_from(&st.p);
+        self.ghost_n.clone_from(&st.ghost);
+        self.pose_n.clone_from(&st.clip_pose);
         self.v_n.clone_from(&self.rates.v);
         self.vdot_n.clone_from(&self.vdot);
         self.a_n.clone_from(&self.a);
@@ -366,6 +388,48 @@ impl Dynamics {
             residual: stats.residual,
             load_factor: 1.0,
         })
+    }
+
+    /// Returns to the values at the start of the last (failed) step.
+    fn rollback(&mut self, st: &mut State) {
+        st.x.clone_from(&self.x_n);
+        st.p.clone_from(&self.p_n);
+        st.ghost.clone_from(&self.ghost_n);
+        st.clip_pose.clone_from(&self.pose_n);
+        self.rates.v.clone_from(&self.v_n);
+        self.vdot.clone_from(&self.vdot_n);
+        self.a.clone_from(&self.a_n);
+        self.factor_valid = false;
+    }
+
+    /// Advances by h from the clip kinematics `from` (at t_n) to `to` (at t_n + h); a step whose
+    /// Newton iteration fails is rolled back and done as two half steps with the clip
+    /// kinematics interpolated in between, recursively up to 2^`max_depth` sub-steps.
+    pub fn advance(
+        &mut self,
+        rod: &Rod,
+        st: &mut State,
+        h: f64,
+        from: &[ClipMotion],
+        to: &[ClipMotion],
+        max_depth: usize,
+    ) -> Result<StepStats, SolveError> {
+        match self.step(rod, st, h, to) {
+            Ok(s) => Ok(s),
+            Err(e) if max_depth == 0 => Err(e),
+            Err(_) => {
+                self.rollback(st);
+                let mid: Vec<ClipMotion> =
+                    from.iter().zip(to).map(|(a, b)| a.midpoint(b)).collect();
+                let s1 = self.advance(rod, st, 0.5 * h, from, &mid, max_depth - 1)?;
+                let s2 = self.advance(rod, st, 0.5 * h, &mid, to, max_depth - 1)?;
+                Ok(StepStats {
+                    iterations: s1.iterations + s2.iterations,
+                    factorizations: s1.factorizations + s2.factorizations,
+                    residual: s2.residual,
+                })
+            }
+        }
     }
 
     /// a, v and q_{n+1} of the inertial unknowns from the current v̇_{n+1}.

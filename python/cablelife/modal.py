@@ -1,0 +1,109 @@
+"""Modal analysis of the mounted cable: natural frequencies and mode shapes, linearised about
+the static equilibrium (the tangent stiffness of the solver and the lumped masses).
+
+The massless unknowns (the free twists of swivel clips) are condensed out statically (exact for
+massless degrees of freedom); the generalized symmetric eigenproblem K φ = ω² M φ is solved with
+LAPACK for the lowest modes.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg
+
+from cablelife.scene import Cable, Scene, SceneError
+from cablelife.simulate import build_cable, clip_poses
+
+
+@dataclass
+class Modes:
+    """Natural frequencies and mode shapes of one cable."""
+
+    cable: str
+    omega: np.ndarray  # (k,) rad/s
+    shapes: np.ndarray  # (k, N+1, 3) node displacements, mass-normalised, global frame
+    arc_length: np.ndarray  # (N+1,)
+    equilibrium: np.ndarray  # (N+1, 3) node positions of the static equilibrium
+
+    @property
+    def frequencies(self) -> np.ndarray:
+        """Natural frequencies in Hz."""
+        return self.omega / (2 * np.pi)
+
+
+def cable_modes(scene: Scene, cable: Cable, count: int = 6) -> Modes:
+    """The ``count`` lowest modes of ``cable`` mounted at its clips at t = 0."""
+    if count < 1:
+        raise SceneError(f"count = {count}: ask for at least 1 mode")
+    core = build_cable(scene, cable)
+    pos, quat = clip_poses(scene, cable, np.array([0.0]))
+    try:
+        out = core.run_sequence(pos, quat)
+    except ValueError as err:
+        raise SceneError(f"cable '{cable.name}': {err}") from None
+    if out["error"]:
+        raise SceneError(f"cable '{cable.name}': no static equilibrium: {out['error']}")
+    lin = core.linearize()
+    k = lin["stiffness"]
+    k = 0.5 * (k + k.T)  # symmetric at equilibrium up to round-off (and dead moments)
+    m = lin["mass"]
+    massive = m > 0
+    k_mm = k[np.ix_(massive, massive)]
+    if not massive.all():
+        # Static condensation of the massless unknowns: K* = K_mm − K_m0 K_00⁻¹ K_0m.
+        k_m0 = k[np.ix_(massive, ~massive)]
+        k_00 = k[np.ix_(~massive, ~massive)]
+        k_mm = k_mm - k_m0 @ np.linalg.solve(k_00, k_m0.T)
+        k_mm = 0.5 * (k_mm + k_mm.T)
+    n = k_mm.shape[0]
+    count = min(count, n)
+    w2, vec = scipy.linalg.eigh(k_mm, np.diag(m[massive]), subset_by_index=[0, count - 1])
+    if w2[0] < -1e-8 * abs(w2[-1]):
+        raise SceneError(
+            f"cable '{cable.name}': the equilibrium is unstable (negative stiffness "
+            f"eigenvalue {w2[0]:.3g}); its modes are not defined"
+        )
+    omega = np.sqrt(np.clip(w2, 0.0, None))
+    blocks, slots = lin["block"][massive], lin["slot"][massive]
+    n_nodes = core.arc_length.size
+    shapes = np.zeros((count, n_nodes, 3))
+    disp = slots < 3
+    for i in range(count):
+        shapes[i, blocks[disp], slots[disp]] = vec[disp, i]
+    return Modes(
+        cable=cable.name,
+        omega=omega,
+        shapes=shapes,
+        arc_length=core.arc_length,
+        equilibrium=out["positions"][0],
+    )
+
+
+def modes(scene: Scene, count: int = 6) -> dict[str, Modes]:
+    """Modes of every cable of the scene."""
+    return {c.name: cable_modes(scene, c, count) for c in scene.cables}
+
+
+def retardation_times(scene: Scene, cable: Cable) -> tuple[list[float], list[float], dict]:
+    """Kelvin–Voigt retardation times (GA₁, GA₂, EA) and (EI₁, EI₂, GJ) of a cable, with how
+    they were set: τ = 2ζ/ω₁ from the first natural mode for a damping ratio ζ (the default
+    ζ = 1, critical), or the given τ; per-mode values override."""
+    from cablelife.scene import DEFAULT_DAMPING_RATIO
+
+    d = cable.damping
+    info: dict = {}
+    if d.retardation_time is not None:
+        tau = d.retardation_time
+        info["source"] = "retardation_time"
+    else:
+        zeta = d.ratio if d.ratio is not None else DEFAULT_DAMPING_RATIO
+        omega1 = float(cable_modes(scene, cable, 1).omega[0])
+        tau = 2 * zeta / omega1 if omega1 > 0 else 0.0
+        info.update(source="ratio", ratio=zeta, omega1=omega1)
+    info["tau"] = tau
+    pick = lambda v: tau if v is None else v  # noqa: E731
+    shear = [pick(d.shear), pick(d.shear), pick(d.extension)]
+    bend = [pick(d.bending), pick(d.bending), pick(d.torsion)]
+    return shear, bend, info
