@@ -54,6 +54,19 @@ def print_summary(result: Result) -> None:
             f"mean {s['newton_iterations_mean']:.1f}, max {s['newton_iterations_max']}",
         )
         t.add_row("solver wall time", f"{s['wall_time'] * 1e3:.1f} ms")
+        rtf = c.solver.get("real_time_factor")
+        if result.mode == "dynamic" and rtf is not None:
+            t.add_row("real-time factor (wall / simulated)", f"{rtf:.3f}")
+            tau = c.solver.get("tau_bend")
+            if c.solver.get("damping_source") == "ratio":
+                w1 = c.solver["omega1"]
+                t.add_row(
+                    "damping",
+                    f"ζ = {c.solver['damping_ratio']:g} of critical on mode 1 "
+                    f"(ω₁ = {w1:.4g} rad/s, f₁ = {w1 / 6.283185307:.4g} Hz) → τ = {tau[0]:.4g} s",
+                )
+            else:
+                t.add_row("damping", f"τ = {tau[0]:.4g} s (given)")
         console.print(t)
         ct = Table(title="clip reactions (max over time)", title_justify="left")
         ct.add_column("clip")
@@ -69,7 +82,7 @@ def print_summary(result: Result) -> None:
 def run(
     scene: Annotated[Path, typer.Argument(help="scene TOML file")],
     mode: Annotated[
-        str | None, typer.Option(help="static | quasistatic (overrides the scene)")
+        str | None, typer.Option(help="static | quasistatic | dynamic (overrides the scene)")
     ] = None,
     output: Annotated[Path | None, typer.Option("-o", "--output", help="result HDF5 file")] = None,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="no progress bar")] = False,
@@ -108,6 +121,29 @@ def run(
     if output is not None:
         result.save(output)
         console.print(f"result saved to {output}")
+
+
+@app.command()
+def modes(
+    scene: Annotated[Path, typer.Argument(help="scene TOML file")],
+    count: Annotated[int, typer.Option("--count", "-n", help="number of modes")] = 6,
+) -> None:
+    """Natural frequencies of each mounted cable about its static equilibrium."""
+    from cablelife.modal import modes as compute_modes
+
+    try:
+        sc = load_scene(scene)
+        found = compute_modes(sc, count)
+    except (SceneError, SignalError) as err:
+        raise fail(str(err)) from None
+    for name, m in found.items():
+        t = Table(title=f"cable '{name}': natural frequencies", title_justify="left")
+        t.add_column("mode", justify="right")
+        t.add_column("f [Hz]", justify="right")
+        t.add_column("ω [rad/s]", justify="right")
+        for i, (f, w) in enumerate(zip(m.frequencies, m.omega, strict=True), start=1):
+            t.add_row(str(i), f"{f:.4g}", f"{w:.4g}")
+        console.print(t)
 
 
 @app.command()

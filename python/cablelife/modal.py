@@ -34,11 +34,12 @@ class Modes:
 
 
 def cable_modes(scene: Scene, cable: Cable, count: int = 6) -> Modes:
-    """The ``count`` lowest modes of ``cable`` mounted at its clips at t = 0."""
+    """The ``count`` lowest modes of ``cable`` mounted at its clips in the reference
+    configuration (bodies at rest)."""
     if count < 1:
         raise SceneError(f"count = {count}: ask for at least 1 mode")
     core = build_cable(scene, cable)
-    pos, quat = clip_poses(scene, cable, np.array([0.0]))
+    pos, quat = clip_poses(scene, cable, np.array([0.0]), with_motion=False)
     try:
         out = core.run_sequence(pos, quat)
     except ValueError as err:

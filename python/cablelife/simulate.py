@@ -61,15 +61,18 @@ def output_times(scene: Scene, mode: str) -> np.ndarray:
     return time_grid(sim.duration, sim.output_step or sim.time_step)
 
 
-def clip_kinematics(scene: Scene, cable: Cable, times: np.ndarray) -> dict[str, np.ndarray]:
+def clip_kinematics(
+    scene: Scene, cable: Cable, times: np.ndarray, with_motion: bool = True
+) -> dict[str, np.ndarray]:
     """Clip kinematics on ``times``: positions (T, C, 3), quaternions scalar first (T, C, 4),
-    velocities, angular velocities, accelerations, angular accelerations (T, C, 3), global."""
+    velocities, angular velocities, accelerations, angular accelerations (T, C, 3), global.
+    Without ``with_motion``: the reference poses (bodies at rest)."""
     n_t, n_c = times.size, len(cable.clips)
     grid = times if n_t > 1 else np.array([times[0], times[0] + scene.simulation.time_step])
     motions = {}
     for body in scene.bodies:
         r0 = euler_matrix(body.orientation)
-        channels = body.channel_motions(scene.base_dir)
+        channels = body.channel_motions(scene.base_dir) if with_motion else []
         motion = body_motion(channels, grid, scene.base_dir, r0) if channels else None
         motions[body.name] = (body, r0, motion)
     out = {
@@ -114,16 +117,18 @@ def clip_kinematics(scene: Scene, cable: Cable, times: np.ndarray) -> dict[str, 
     return out
 
 
-def clip_poses(scene: Scene, cable: Cable, times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def clip_poses(
+    scene: Scene, cable: Cable, times: np.ndarray, with_motion: bool = True
+) -> tuple[np.ndarray, np.ndarray]:
     """Clip positions (T, C, 3) and orientations as quaternions, scalar first (T, C, 4)."""
-    k = clip_kinematics(scene, cable, times)
+    k = clip_kinematics(scene, cable, times, with_motion)
     return k["positions"], k["quaternions"]
 
 
 def build_cable(scene: Scene, cable: Cable) -> _core.Cable:
     """The Rust solver object of one cable at its reference clip poses."""
     props = cable.properties()
-    pos, quat = clip_poses(scene, cable, np.array([0.0]))
+    pos, quat = clip_poses(scene, cable, np.array([0.0]), with_motion=False)
     clips = [
         (c.name, c.s, c.length, c.type, pos[0, j].tolist(), quat[0, j].tolist())
         for j, c in enumerate(cable.clips)

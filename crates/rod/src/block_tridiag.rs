@@ -1,6 +1,6 @@
 //! Block-tridiagonal matrices with 6×6 blocks and their O(N) solve (block Thomas algorithm with
-//! LU-factored pivot blocks). Storage is allocated once; factor and solve do not allocate.
-use nalgebra::{Matrix3, Matrix6, Vector6, LU, U6};
+//! LU-inverted pivot blocks, so that substitutions are matrix–vector products). Storage is allocated once; factor and solve do not allocate.
+use nalgebra::{Matrix3, Matrix6, Vector6, LU};
 
 pub type Block = Matrix6<f64>;
 
@@ -12,7 +12,8 @@ pub struct BlockTridiag {
     pub lower: Vec<Block>,
     /// J[n][n+1] (last entry unused).
     pub upper: Vec<Block>,
-    lu: Vec<Option<LU<f64, U6, U6>>>,
+    /// D'_n⁻¹, the inverted pivot blocks (substitution is then matrix–vector products only).
+    inv: Vec<Block>,
     /// D'_n⁻¹ U_n of the forward elimination.
     elim: Vec<Block>,
 }
@@ -29,7 +30,7 @@ impl BlockTridiag {
             diag: vec![Block::zeros(); n_blocks],
             lower: vec![Block::zeros(); n_blocks],
             upper: vec![Block::zeros(); n_blocks],
-            lu: vec![None; n_blocks],
+            inv: vec![Block::zeros(); n_blocks],
             elim: vec![Block::zeros(); n_blocks],
         }
     }
@@ -101,10 +102,10 @@ impl BlockTridiag {
             if lo.is_nan() || lo <= 1e-14 * hi || !hi.is_finite() {
                 return Err(Singular { block: b });
             }
+            self.inv[b] = lu.try_inverse().ok_or(Singular { block: b })?;
             if b + 1 < n {
-                self.elim[b] = lu.solve(&self.upper[b]).ok_or(Singular { block: b })?;
+                self.elim[b] = self.inv[b] * self.upper[b];
             }
-            self.lu[b] = Some(lu);
         }
         Ok(())
     }
@@ -118,11 +119,7 @@ impl BlockTridiag {
             if b > 0 {
                 r -= self.lower[b] * rhs[b - 1];
             }
-            rhs[b] = self.lu[b]
-                .as_ref()
-                .expect("factor() first")
-                .solve(&r)
-                .unwrap();
+            rhs[b] = self.inv[b] * r;
         }
         // Backward: x_b = y_b − (D'_b⁻¹ U_b) x_{b+1}.
         for b in (0..n.saturating_sub(1)).rev() {
