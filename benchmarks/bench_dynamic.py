@@ -12,7 +12,6 @@ import sys
 import time
 
 import numpy as np
-
 from cablelife.scene import scene_from_dict
 from cablelife.simulate import simulate
 
@@ -22,28 +21,59 @@ BAND = (10.0, 200.0)
 
 def scene(segments: int, duration: float) -> dict:
     level = RMS**2 / (BAND[1] - BAND[0])  # flat displacement PSD, m²/Hz
-    psd = {"type": "psd", "quantity": "displacement", "seed": 7,
-           "breakpoints": [[BAND[0], level], [BAND[1], level]]}
+    psd = {
+        "type": "psd",
+        "quantity": "displacement",
+        "seed": 7,
+        "breakpoints": [[BAND[0], level], [BAND[1], level]],
+    }
     return {
-        "simulation": {"mode": "dynamic", "duration": duration, "time_step": 1e-3,
-                       "output_step": 5e-3},
-        "bodies": [{"name": "bracket", "origin": [0.9, 0.2, 0.0],
-                    "motion": [{"channel": "z", "signal": psd}]}],
-        "cables": [{
-            "name": "cable", "length": 1.2, "segments": segments,
-            "section": {"shape": "circle", "radius": 0.005},
-            "material": {"youngs_modulus": 1.0e8, "poisson_ratio": 0.45, "density": 2200.0},
-            "damping": {"ratio": 0.2},
-            "clips": [
-                {"name": "body-1", "s": 0.0, "position": [0, 0, 0], "direction": [1, 0, 0]},
-                {"name": "body-2", "s": 0.4, "position": [0.36, 0.05, -0.05],
-                 "direction": [1, 0.2, 0]},
-                {"name": "bracket-1", "s": 0.8, "body": "bracket",
-                 "position": [0.7, 0.15, -0.02], "direction": [1, 0.1, 0]},
-                {"name": "bracket-2", "s": 1.2, "body": "bracket",
-                 "position": [1.0, 0.25, 0.0], "direction": [1, 0, 0]},
-            ],
-        }],
+        "simulation": {
+            "mode": "dynamic",
+            "duration": duration,
+            "time_step": 1e-3,
+            "output_step": 5e-3,
+        },
+        "bodies": [
+            {
+                "name": "bracket",
+                "origin": [0.9, 0.2, 0.0],
+                "motion": [{"channel": "z", "signal": psd}],
+            }
+        ],
+        "cables": [
+            {
+                "name": "cable",
+                "length": 1.2,
+                "segments": segments,
+                "section": {"shape": "circle", "radius": 0.005},
+                "material": {"youngs_modulus": 1.0e8, "poisson_ratio": 0.45, "density": 2200.0},
+                "damping": {"ratio": 0.2},
+                "clips": [
+                    {"name": "body-1", "s": 0.0, "position": [0, 0, 0], "direction": [1, 0, 0]},
+                    {
+                        "name": "body-2",
+                        "s": 0.4,
+                        "position": [0.36, 0.05, -0.05],
+                        "direction": [1, 0.2, 0],
+                    },
+                    {
+                        "name": "bracket-1",
+                        "s": 0.8,
+                        "body": "bracket",
+                        "position": [0.7, 0.15, -0.02],
+                        "direction": [1, 0.1, 0],
+                    },
+                    {
+                        "name": "bracket-2",
+                        "s": 1.2,
+                        "body": "bracket",
+                        "position": [1.0, 0.25, 0.0],
+                        "direction": [1, 0, 0],
+                    },
+                ],
+            }
+        ],
     }
 
 
@@ -61,11 +91,15 @@ def main() -> None:
     duration = 1.0 if quick else 5.0
     wall, total, its = run(100, duration)
     print(f"N = 100, {duration:g} s at 1 ms ({int(duration / 1e-3)} steps), 10–200 Hz, 2 mm RMS:")
-    print(f"  solver wall {wall:.3f} s (with set-up and modal analysis {total:.3f} s), "
-          f"real-time factor {wall / duration:.4f} → {duration / wall:.1f}× faster than real time,"
-          f" {its:.2f} Newton iterations per saved step")
-    print(f"{'N':>5} {'wall [s] for 1 s':>17} {'per step [µs]':>14} {'× real time':>12} "
-          f"{'it/step':>8}")
+    print(
+        f"  solver wall {wall:.3f} s (with set-up and modal analysis {total:.3f} s), "
+        f"real-time factor {wall / duration:.4f} → {duration / wall:.1f}× faster than real time,"
+        f" {its:.2f} Newton iterations per saved step"
+    )
+    print(
+        f"{'N':>5} {'wall [s] for 1 s':>17} {'per step [µs]':>14} {'× real time':>12} "
+        f"{'it/step':>8}"
+    )
     for n in (25, 50, 100, 200, 400):
         wall, _, its = run(n, 1.0)
         print(f"{n:>5} {wall:>17.3f} {wall / 1000 * 1e6:>14.1f} {1.0 / wall:>12.1f} {its:>8.2f}")

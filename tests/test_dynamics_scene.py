@@ -7,7 +7,6 @@ import math
 
 import numpy as np
 import pytest
-
 from cablelife.modal import cable_modes, retardation_times
 from cablelife.scene import scene_from_dict
 from cablelife.simulate import simulate
