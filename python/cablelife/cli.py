@@ -1,4 +1,5 @@
-"""Command line: ``cablelife run``, ``signal``, ``lda``, ``compare``, ``schema``."""
+"""Command line: ``cablelife run``, ``modes``, ``signal``, ``volume``, ``report``, ``paraview``,
+``lda``, ``compare``, ``schema``."""
 
 from __future__ import annotations
 
@@ -168,6 +169,13 @@ def _register_optional() -> None:
         app.command(name="signal")(signal_command)
     except ImportError:  # pragma: no cover - package always ships signals
         pass
+    from cablelife.export.cli import paraview_command
+    from cablelife.report.cli import report_command
+    from cablelife.volume.cli import volume_command
+
+    app.command(name="volume")(volume_command)
+    app.command(name="report")(report_command)
+    app.command(name="paraview")(paraview_command)
     try:
         from cablelife.lda.cli import compare_command, lda_command
 

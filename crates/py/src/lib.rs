@@ -2,10 +2,12 @@
 use pyo3::prelude::*;
 
 mod cable;
+mod volume;
 
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     cable::register(m)?;
+    volume::register(m)?;
     Ok(())
 }

@@ -1,0 +1,54 @@
+"""``cablelife paraview``: a result as a ParaView time series."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+
+def paraview_command(
+    result: Annotated[Path, typer.Argument(help="result HDF5 file")],
+    output: Annotated[
+        Path, typer.Option("-o", "--output", help=".pvd index; step files go beside it")
+    ] = Path("cable.pvd"),
+    cable: Annotated[str | None, typer.Option(help="cable name (default: every cable)")] = None,
+    every: Annotated[int, typer.Option(help="write every k-th saved step")] = 1,
+    damage: Annotated[
+        Path | None, typer.Option(help="damage file (HDF5): adds a damage array per node")
+    ] = None,
+) -> None:
+    """Write one VTK PolyData file per saved step plus a .pvd index for ParaView."""
+    from rich.console import Console
+
+    from cablelife.export.paraview import write_paraview
+    from cablelife.plots.fatigue_data import load_damage
+    from cablelife.results import load_result
+
+    err = Console(stderr=True)
+    try:
+        if every < 1:
+            raise ValueError(f"every = {every}: must be >= 1")
+        res = load_result(result)
+        names = [cable] if cable is not None else list(res.cables)
+        maps = load_damage(damage) if damage is not None else {}
+        written = []
+        for name in names:
+            if name not in res.cables:
+                raise ValueError(f"cable = {name!r}: {str(result)!r} has {', '.join(res.cables)}")
+            out = output if len(names) == 1 else output.with_name(f"{output.stem}_{name}.pvd")
+            dm = maps.get(name) or (next(iter(maps.values())) if len(maps) == 1 else None)
+            written.append(
+                write_paraview(
+                    res.cables[name],
+                    out,
+                    damage=dm[0] if dm else None,
+                    steps=slice(None, None, every),
+                )
+            )
+    except (ValueError, FileNotFoundError) as e:
+        err.print(f"[bold red]error:[/] {e}", highlight=False)
+        raise typer.Exit(2) from None
+    for p in written:
+        Console().print(f"ParaView time series written to {p}")

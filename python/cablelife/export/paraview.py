@@ -1,0 +1,149 @@
+"""ParaView time series: one VTK XML PolyData file (.vtp) per saved step and a .pvd index with
+the times. The cable is N line cells (its edges) between N+1 points (its nodes).
+
+Point data (nodes): ``moment`` (M1, M2, M3, material frame, N m), ``bending_moment`` |M1, M2|,
+``torsion`` M3, ``curvature`` (1/m, material frame), ``bend_radius`` (m; straight stretches
+get 1e9), ``displacement`` (from the first saved step, m), ``arc_length`` (m) and, when
+given, ``damage``. Cell data (edges): ``force`` (F1, F2, F3 material frame, N), ``force_global``
+(N), ``shear_force`` |F1, F2|, ``tension`` F3. Field data: ``tube_radius`` (m), ``time`` (s).
+Data are written as ASCII (readable by any XML parser; fine for cables of a few hundred
+nodes). Every file is written atomically.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from xml.sax.saxutils import quoteattr
+
+import numpy as np
+
+from cablelife.export.atomic import write_text_atomic
+from cablelife.export.frames import to_global
+from cablelife.results import CableResult
+
+#: Bend radius written where the cable is straight (VTK readers dislike inf).
+STRAIGHT = 1e9
+
+
+def _array(name: str, values: np.ndarray, fmt: str = "%.9g") -> str:
+    v = np.asarray(values, dtype=np.float64)
+    comps = 1 if v.ndim == 1 else v.shape[1]
+    body = " ".join(fmt % x for x in v.ravel())
+    return (
+        f'<DataArray type="Float64" Name={quoteattr(name)} NumberOfComponents="{comps}" '
+        f'format="ascii">{body}</DataArray>'
+    )
+
+
+def _ints(name: str, values) -> str:
+    body = " ".join(str(int(x)) for x in values)
+    return f'<DataArray type="Int64" Name="{name}" format="ascii">{body}</DataArray>'
+
+
+def polydata_xml(
+    points: np.ndarray,
+    point_data: dict[str, np.ndarray],
+    cell_data: dict[str, np.ndarray],
+    field_data: dict[str, float],
+) -> str:
+    """A VTK XML PolyData document of a polyline stored as one line cell per segment."""
+    n = len(points)
+    conn = np.column_stack([np.arange(n - 1), np.arange(1, n)]).ravel()
+    offsets = 2 * np.arange(1, n)
+    pd = "".join(_array(k, v) for k, v in point_data.items())
+    cd = "".join(_array(k, v) for k, v in cell_data.items())
+    fd = "".join(
+        f'<DataArray type="Float64" Name={quoteattr(k)} NumberOfTuples="1" format="ascii">'
+        f"{float(v)!r}</DataArray>"
+        for k, v in field_data.items()
+    )
+    return (
+        '<?xml version="1.0"?>\n'
+        '<VTKFile type="PolyData" version="1.0" byte_order="LittleEndian" '
+        'header_type="UInt64">\n<PolyData>\n'
+        f"<FieldData>{fd}</FieldData>\n"
+        f'<Piece NumberOfPoints="{n}" NumberOfVerts="0" NumberOfLines="{n - 1}" '
+        'NumberOfStrips="0" NumberOfPolys="0">\n'
+        f"<PointData>{pd}</PointData>\n<CellData>{cd}</CellData>\n"
+        f"<Points>{_array('Points', points)}</Points>\n"
+        f"<Lines>{_ints('connectivity', conn)}{_ints('offsets', offsets)}</Lines>\n"
+        "</Piece>\n</PolyData>\n</VTKFile>\n"
+    )
+
+
+def pvd_xml(entries: list[tuple[float, str]]) -> str:
+    """A ParaView collection (.pvd) of (time, relative file name) entries."""
+    rows = "".join(
+        f'<DataSet timestep="{t!r}" group="" part="0" file={quoteattr(f)}/>\n' for t, f in entries
+    )
+    return (
+        '<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1" '
+        f'byte_order="LittleEndian">\n<Collection>\n{rows}</Collection>\n</VTKFile>\n'
+    )
+
+
+def _node_damage(cable: CableResult, damage) -> np.ndarray | None:
+    if damage is None:
+        return None
+    if hasattr(damage, "along_cable"):  # a DamageMap: max around the section, at the nodes
+        return np.interp(cable.arc_length, damage.arc_length, damage.along_cable)
+    d = np.asarray(damage, dtype=float)
+    if d.shape != cable.arc_length.shape:
+        raise ValueError(
+            f"damage has shape {d.shape}: must be one value per node {cable.arc_length.shape} "
+            "or a DamageMap"
+        )
+    return d
+
+
+def write_paraview(
+    cable: CableResult,
+    output: str | os.PathLike,
+    *,
+    damage=None,
+    steps=None,
+) -> Path:
+    """Writes the saved steps (all, or a slice/indices ``steps``) of ``cable`` as
+    ``<output>.pvd`` plus ``<output stem>/<stem>_<k>.vtp``; returns the .pvd path.
+    ``damage``: one value per node, or a DamageMap (its maximum around each section)."""
+    from cablelife.volume.sweep import select_steps
+
+    output = Path(output)
+    if output.suffix != ".pvd":
+        output = output.with_suffix(".pvd")
+    folder = output.parent / output.stem
+    idx = select_steps(cable.n_steps, steps)
+    if idx.size == 0:
+        raise ValueError(f"steps = {steps!r} selects no saved step")
+    node_damage = _node_damage(cable, damage)
+    radius = float(cable.section.get("outer_radius", 0.0))
+    curvature = cable.curvature
+    bend = cable.bend_radius()
+    entries = []
+    for k in idx:
+        x = cable.positions[k]
+        m = cable.moments[k]
+        f = cable.forces[k]
+        point_data = {
+            "arc_length": cable.arc_length,
+            "moment": m,
+            "bending_moment": np.hypot(m[:, 0], m[:, 1]),
+            "torsion": m[:, 2],
+            "curvature": curvature[k],
+            "bend_radius": np.minimum(bend[k], STRAIGHT),
+            "displacement": x - cable.positions[0],
+        }
+        if node_damage is not None:
+            point_data["damage"] = node_damage
+        cell_data = {
+            "force": f,
+            "force_global": to_global(cable.quaternions[k], f),
+            "shear_force": np.hypot(f[:, 0], f[:, 1]),
+            "tension": f[:, 2],
+        }
+        fields = {"tube_radius": radius, "time": float(cable.time[k])}
+        name = f"{output.stem}_{int(k):05d}.vtp"
+        write_text_atomic(folder / name, polydata_xml(x, point_data, cell_data, fields))
+        entries.append((float(cable.time[k]), f"{folder.name}/{name}"))
+    return write_text_atomic(output, pvd_xml(entries))

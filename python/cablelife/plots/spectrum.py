@@ -1,0 +1,58 @@
+"""Natural frequencies of the mounted cable over the excitation spectrum."""
+
+from __future__ import annotations
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from cablelife.plots.figure import new_figure
+
+
+def plot_frequencies_over_spectrum(
+    natural_frequencies,
+    frequency,
+    psd,
+    *,
+    psd_label: str = "excitation PSD",
+    psd_unit: str = "(m/s²)²/Hz",
+) -> Figure:
+    """The excitation PSD (``frequency`` (F,) Hz, ``psd`` (F,) or (C, F) for C channels) on
+    log-log axes, with a vertical line at each natural frequency (Hz) labelled by mode number.
+    Modes inside the excited band are drawn red."""
+    fn = np.atleast_1d(np.asarray(natural_frequencies, dtype=float))
+    f = np.asarray(frequency, dtype=float)
+    g = np.atleast_2d(np.asarray(psd, dtype=float))
+    if f.ndim != 1 or g.shape[1] != f.size:
+        raise ValueError(
+            f"psd has shape {np.shape(psd)}: must be (F,) or (C, F) with F = {f.size} frequencies"
+        )
+    if np.any(fn <= 0) or np.any(~np.isfinite(fn)):
+        raise ValueError(f"natural_frequencies = {fn}: must be finite and > 0 Hz")
+    fig, axes = new_figure(1, 1, height=3.6)
+    ax = axes[0, 0]
+    for k, row in enumerate(g):
+        ax.loglog(
+            f,
+            np.where(row > 0, row, np.nan),
+            color=f"C{k}",
+            label=f"{psd_label} {k + 1}" if len(g) > 1 else psd_label,
+        )
+    excited = (f[g.max(axis=0) > 0].min(), f[g.max(axis=0) > 0].max()) if np.any(g > 0) else (0, 0)
+    for i, x in enumerate(fn):
+        inside = excited[0] <= x <= excited[1]
+        ax.axvline(x, color="red" if inside else "gray", lw=1, ls="-" if inside else "--")
+        ax.annotate(
+            f"{i + 1}: {x:.3g} Hz",
+            (x, 1),
+            xycoords=("data", "axes fraction"),
+            rotation=90,
+            va="top",
+            ha="right",
+            fontsize=7,
+        )
+    ax.set_xlabel("frequency [Hz]")
+    ax.set_ylabel(f"PSD [{psd_unit}]")
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=8, loc="lower left")
+    ax.set_title("natural frequencies over the excitation spectrum (red: inside the excited band)")
+    return fig

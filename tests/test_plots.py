@@ -1,0 +1,131 @@
+"""Plots: the data drawn is the data asked for, PNGs are written, bad input is named."""
+
+from __future__ import annotations
+
+import copy
+
+import numpy as np
+import pytest
+from cablelife.plots import (
+    DamageMap,
+    RainflowMatrix,
+    Run,
+    check_bend_radius,
+    load_damage,
+    plot_bend_radius,
+    plot_clip_reactions,
+    plot_damage_along_cable,
+    plot_envelopes,
+    plot_frequencies_over_spectrum,
+    plot_maxima_over_time,
+    plot_rainflow_matrix,
+    save_png,
+)
+from cablelife.plots.runs import extreme_along
+
+PNG = b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.fixture(scope="module")
+def runs():
+    """A quasistatic run, and the same arrays labelled as a dynamic run with scaled loads."""
+    from cablelife.scene import scene_from_dict
+    from cablelife.simulate import simulate
+    from conftest import BASE
+
+    d = copy.deepcopy(BASE)
+    d["simulation"].update(mode="quasistatic", duration=1.0, time_step=0.05)
+    sine = {"type": "sine", "amplitude": 0.05, "frequency": 1.0}
+    d["bodies"] = [{"name": "engine", "motion": [{"channel": "z", "signal": sine}]}]
+    d["cables"][0]["clips"][1]["body"] = "engine"
+    qs = simulate(scene_from_dict(d)).cable
+    dyn = copy.deepcopy(qs)
+    dyn.forces = dyn.forces * 1.5
+    dyn.moments = dyn.moments * 1.5
+    return [Run("variant A", qs, "quasistatic"), Run("variant A", dyn, "dynamic")]
+
+
+def test_extreme_along_keeps_the_sign():
+    v = np.array([[1.0, -3.0, 2.0], [0.5, 0.2, 0.1]])
+    np.testing.assert_array_equal(extreme_along(v), [-3.0, 0.5])
+
+
+def test_maxima_over_time_draws_fig2(runs, tmp_path):
+    fig = plot_maxima_over_time(runs)
+    axes = fig.axes
+    assert len(axes) == 4
+    qs, dyn = runs
+    tension = axes[1].get_lines()
+    assert [ln.get_linestyle() for ln in tension] == ["--", "-"]
+    np.testing.assert_allclose(tension[0].get_ydata(), extreme_along(qs.cable.forces[..., 2]))
+    bending = axes[2].get_lines()[1].get_ydata()
+    np.testing.assert_allclose(bending, 1.5 * np.hypot(*qs.cable.moments[..., :2].T).T.max(1))
+    path = save_png(fig, tmp_path / "fig2.png")
+    assert path.read_bytes()[:8] == PNG
+
+
+def test_envelopes_bound_every_step(runs):
+    fig = plot_envelopes(runs)
+    shear_hi = fig.axes[0].get_lines()[0].get_ydata()
+    f = runs[0].cable.forces
+    assert np.all(shear_hi >= np.hypot(f[..., 0], f[..., 1]) - 1e-12)
+    assert len(fig.axes[0].get_lines()[0].get_xdata()) == f.shape[1]  # edge midpoints
+
+
+def test_bend_radius_rule(runs):
+    c = runs[0].cable
+    chk = check_bend_radius(c, factor=10)
+    assert chk.allowed == pytest.approx(10 * 2 * c.section["outer_radius"])
+    np.testing.assert_allclose(chk.min_radius, c.bend_radius().min(axis=0))
+    strict = check_bend_radius(c, factor=1e4)  # allowed 100 m: everything bent violates
+    assert not strict.ok and strict.violations[0][2] == pytest.approx(chk.min_radius.min())
+    fig = plot_bend_radius(runs, factor=10)
+    assert fig.axes[0].get_yscale() == "log"
+    with pytest.raises(ValueError, match="factor = -1"):
+        check_bend_radius(c, factor=-1)
+
+
+def test_clip_reactions(runs):
+    fig = plot_clip_reactions(runs)
+    assert len(fig.axes) == 2 * len(runs[0].cable.clips)
+    force_a = fig.axes[0].get_lines()[0].get_ydata()
+    np.testing.assert_allclose(force_a, np.linalg.norm(runs[0].cable.clips["a"].force, axis=1))
+
+
+def test_frequencies_over_spectrum():
+    f = np.geomspace(10, 2000, 50)
+    fig = plot_frequencies_over_spectrum([3.0, 25.0, 140.0], f, 10 / (1 + (f / 300) ** 2))
+    ax = fig.axes[0]
+    colours = [ln.get_color() for ln in ax.get_lines()[1:]]
+    assert colours == ["gray", "red", "red"]  # 3 Hz lies below the excited band
+    with pytest.raises(ValueError, match="psd has shape"):
+        plot_frequencies_over_spectrum([3.0], f, np.ones(3))
+
+
+def test_rainflow_and_damage(tmp_path):
+    import h5py
+
+    m = RainflowMatrix(np.arange(5.0), np.linspace(-2, 2, 4), np.arange(12.0).reshape(4, 3))
+    save_png(plot_rainflow_matrix(m), tmp_path / "rf.png")
+    with pytest.raises(ValueError, match=r"counts has shape \(2, 2\): must be \(4, 3\)"):
+        RainflowMatrix(np.arange(5.0), np.linspace(-2, 2, 4), np.ones((2, 2)))
+    s = np.linspace(0, 1, 51)
+    g = np.linspace(0, 2 * np.pi, 16, endpoint=False)
+    dmg = np.exp(-((s[:, None] - 0.2) ** 2) / 0.001) * (1 + np.cos(g - 1.0)) + 1e-6
+    dmg[40] = 0.5 * dmg.max()
+    dm = DamageMap(s, g, dmg, "A")
+    spots = dm.hot_spots(2)
+    assert spots[0].arc_length == pytest.approx(0.2) and spots[0].angle == pytest.approx(g[3])
+    assert spots[1].arc_length == pytest.approx(0.8)
+    save_png(plot_damage_along_cable([dm], clips={"a": 0.0, "b": 1.0}), tmp_path / "d.png")
+    with h5py.File(tmp_path / "damage.h5", "w") as f:
+        grp = f.create_group("cables/hose")
+        grp["arc_length"], grp["angle"], grp["damage"] = s, g, dmg
+        grp["rainflow/range_edges"], grp["rainflow/mean_edges"] = m.range_edges, m.mean_edges
+        grp["rainflow/counts"] = m.counts
+    maps = load_damage(tmp_path / "damage.h5")
+    loaded, rf = maps["hose"]
+    np.testing.assert_array_equal(loaded.damage, dmg)
+    np.testing.assert_array_equal(rf.counts, m.counts)
+    with pytest.raises(ValueError, match="damage has shape"):
+        DamageMap(s, g, dmg[:, :3])
