@@ -7,20 +7,32 @@ use rod::{CableSpec, ClipKind, ClipSpec, Pose, Rod, Section};
 use std::time::Instant;
 
 fn main() {
-    let n: usize = std::env::args().nth(1).and_then(|a| a.parse().ok()).unwrap_or(100);
+    let n: usize = std::env::args()
+        .nth(1)
+        .and_then(|a| a.parse().ok())
+        .unwrap_or(100);
     let section = Section {
         shear_stiffness: Vector3::new(1e4, 1e4, 3e4),
         bend_stiffness: Vector3::new(0.02, 0.02, 0.015),
         mass_per_length: 0.1,
         rotary_inertia: Vector3::new(1e-7, 1e-7, 2e-7),
     };
-    let pose = Pose { position: Vector3::zeros(), orientation: Quaternion::identity() };
+    let pose = Pose {
+        position: Vector3::zeros(),
+        orientation: Quaternion::identity(),
+    };
     let spec = CableSpec {
         length: 1.0,
         segments: n,
         section,
         natural_curvature: Vector3::new(0.5, 0.0, 0.0),
-        clips: vec![ClipSpec { name: "a".into(), s: 0.0, length: 0.0, kind: ClipKind::Fixed, pose }],
+        clips: vec![ClipSpec {
+            name: "a".into(),
+            s: 0.0,
+            length: 0.0,
+            kind: ClipKind::Fixed,
+            pose,
+        }],
         loads: vec![],
         gravity: Vector3::new(0.0, 0.0, -9.81),
     };
@@ -33,12 +45,21 @@ fn main() {
         for _ in 0..reps {
             f();
         }
-        println!("{label:>28}: {:8.2} µs", t0.elapsed().as_secs_f64() / reps as f64 * 1e6);
+        println!(
+            "{label:>28}: {:8.2} µs",
+            t0.elapsed().as_secs_f64() / reps as f64 * 1e6
+        );
     };
-    time("assembly, residual only", &mut || ws.assemble_static(&rod, &st, 1.0, false).unwrap());
-    time("assembly with Jacobian", &mut || ws.assemble_static(&rod, &st, 1.0, true).unwrap());
+    time("assembly, residual only", &mut || {
+        ws.assemble_static(&rod, &st, 1.0, false).unwrap()
+    });
+    time("assembly with Jacobian", &mut || {
+        ws.assemble_static(&rod, &st, 1.0, true).unwrap()
+    });
     let mut jac = ws.jac.clone();
     time("block LU factorisation", &mut || jac.factor().unwrap());
     let mut rhs = vec![Vector6::repeat(1.0); n + 1];
-    time("forward/back substitution", &mut || jac.solve_factored(&mut rhs));
+    time("forward/back substitution", &mut || {
+        jac.solve_factored(&mut rhs)
+    });
 }

@@ -5,11 +5,12 @@
 //! energy Hessian plus ½[g]× on each rotation's own block (g its energy gradient), which comes
 //! from exp(δ)exp(θ) = exp(δ + θ + ½ δ×θ + …), plus the derivative of dead moments −[Rᵀ M]×.
 use crate::bending::{BendKinematics, Kink};
-use crate::block_tridiag::BlockTridiag;
+use crate::block_tridiag::{BlockTridiag, Singular};
 use crate::model::{EdgeKind, NodeKind, Rod, RotRef};
 use crate::rotation::{rotation_matrix, skew, Quat};
 use crate::shear::ShearKinematics;
 use crate::state::State;
+use crate::statics::SolveError;
 use nalgebra::{Matrix3, Vector3, Vector6};
 
 /// Scratch and outputs of one assembly; allocated once per cable.
@@ -328,6 +329,31 @@ impl Workspace {
             m += rotation_matrix(&st.ghost[g]) * self.ghost_grad[g];
         }
         (f, m)
+    }
+
+    /// Factors the assembled Jacobian; a singular pivot is reported at its node.
+    pub fn factor(&mut self, rod: &Rod) -> Result<(), SolveError> {
+        self.jac
+            .factor()
+            .map_err(|Singular { block }| SolveError::Singular {
+                node: block,
+                s: rod.arc[block.min(rod.arc.len() - 1)],
+            })
+    }
+
+    /// The Newton correction Δ = −J⁻¹ r with the current factorisation, and its largest
+    /// position and rotation components (|Δx|, |θ|).
+    pub fn newton_correction(&self, delta: &mut [Vector6<f64>]) -> (f64, f64) {
+        for (d, r) in delta.iter_mut().zip(&self.rhs) {
+            *d = -r;
+        }
+        self.jac.solve_factored(delta);
+        let (mut dx, mut dth) = (0.0f64, 0.0f64);
+        for d in delta.iter() {
+            dx = dx.max(d.fixed_rows::<3>(0).amax());
+            dth = dth.max(d.fixed_rows::<3>(3).amax());
+        }
+        (dx, dth)
     }
 
     /// Scaled residual norms (max over blocks): forces in N, moments divided by `length`.

@@ -232,44 +232,11 @@ mod tests {
             &mut e,
         )
         .unwrap();
-        let h = 1e-6;
-        let scale = e.grad[0].amax().max(e.grad[1].amax());
-        for i in 0..6 {
-            let mut zp = [0.0; 6];
-            let mut zm = [0.0; 6];
-            zp[i] = h;
-            zm[i] = -h;
-            let fd = (energy_at(&zp) - energy_at(&zm)) / (2.0 * h);
-            let an = e.grad[i / 3][i % 3];
-            assert!(
-                (fd - an).abs() < 1e-6 * scale,
-                "grad {i}: fd {fd} analytic {an}"
-            );
-        }
-        let h = 1e-4;
-        let hscale = e
-            .hess
-            .iter()
-            .flatten()
-            .map(|m| m.amax())
-            .fold(0.0, f64::max);
-        for i in 0..6 {
-            for j in 0..6 {
-                let f = |si: f64, sj: f64| {
-                    let mut z = [0.0; 6];
-                    z[i] += si * h;
-                    z[j] += sj * h;
-                    energy_at(&z)
-                };
-                let fd =
-                    (f(1.0, 1.0) - f(1.0, -1.0) - f(-1.0, 1.0) + f(-1.0, -1.0)) / (4.0 * h * h);
-                let an = e.hess[i / 3][j / 3][(i % 3, j % 3)];
-                assert!(
-                    (fd - an).abs() < 1e-5 * hscale,
-                    "hess {i},{j}: fd {fd} analytic {an}"
-                );
-            }
-        }
+        crate::fd_check::check_derivatives::<6>(
+            energy_at,
+            |i| e.grad[i / 3][i % 3],
+            |i, j| e.hess[i / 3][j / 3][(i % 3, j % 3)],
+        );
     }
 
     #[test]

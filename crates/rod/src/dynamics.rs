@@ -13,7 +13,6 @@
 //! iteration contracts fast. Prescribed unknowns follow the clips; the free twist of swivel
 //! clips is massless (quasistatic within the step).
 use crate::assembly::{KinkAt, Rates, Workspace};
-use crate::block_tridiag::Singular;
 use crate::model::{EdgeKind, NodeKind, Pose, Rod};
 use crate::rotation::{rotate_body, rotation_matrix, skew, slerp, Quat};
 use crate::state::State;
@@ -339,27 +338,13 @@ impl Dynamics {
                     s: rod.arc[k.node],
                 })?;
             if refactor {
-                self.ws
-                    .jac
-                    .factor()
-                    .map_err(|Singular { block }| SolveError::Singular {
-                        node: block,
-                        s: rod.arc[block.min(rod.arc.len() - 1)],
-                    })?;
+                self.ws.factor(rod)?;
                 self.factor_valid = true;
                 self.factor_h = h;
                 stats.factorizations += 1;
             }
-            for (d, r) in self.delta.iter_mut().zip(&self.ws.rhs) {
-                *d = -r;
-            }
-            self.ws.jac.solve_factored(&mut self.delta);
-            let mut norm = 0.0f64;
-            for d in &self.delta {
-                norm = norm
-                    .max(d.fixed_rows::<3>(0).amax() / l)
-                    .max(d.fixed_rows::<3>(3).amax());
-            }
+            let (dx, dth) = self.ws.newton_correction(&mut self.delta);
+            let norm = (dx / l).max(dth);
             if !refactor && (!norm.is_finite() || norm >= last_norm) {
                 // The reused matrix no longer contracts: refactor at this iterate.
                 self.factor_valid = false;

@@ -5,6 +5,8 @@ pub mod assembly;
 pub mod bending;
 pub mod block_tridiag;
 pub mod dynamics;
+#[cfg(test)]
+mod fd_check;
 pub mod model;
 pub mod rotation;
 pub mod routing;

@@ -2,7 +2,6 @@
 //! search on the scaled residual, load continuation when plain Newton fails, and sub-stepped
 //! clip motions for sequences of equilibria.
 use crate::assembly::{KinkAt, Workspace};
-use crate::block_tridiag::Singular;
 use crate::model::{Pose, Rod};
 use crate::rotation::slerp;
 use crate::state::State;
@@ -157,22 +156,8 @@ impl Statics {
                 stats.residual = rinf;
                 return Ok(stats);
             }
-            self.ws
-                .jac
-                .factor()
-                .map_err(|Singular { block }| SolveError::Singular {
-                    node: block,
-                    s: rod.arc[block.min(rod.arc.len() - 1)],
-                })?;
-            for (d, r) in self.delta.iter_mut().zip(&self.ws.rhs) {
-                *d = -r;
-            }
-            self.ws.jac.solve_factored(&mut self.delta);
-            let (mut dx, mut dth) = (0.0f64, 0.0f64);
-            for d in &self.delta {
-                dx = dx.max(d.fixed_rows::<3>(0).amax());
-                dth = dth.max(d.fixed_rows::<3>(3).amax());
-            }
+            self.ws.factor(rod)?;
+            let (dx, dth) = self.ws.newton_correction(&mut self.delta);
             if !(dx.is_finite() && dth.is_finite()) {
                 return Err(SolveError::Singular { node: 0, s: 0.0 });
             }
@@ -283,22 +268,8 @@ impl Statics {
                     }
                 }
             }
-            self.ws
-                .jac
-                .factor()
-                .map_err(|Singular { block }| SolveError::Singular {
-                    node: block,
-                    s: rod.arc[block.min(rod.arc.len() - 1)],
-                })?;
-            for (d, r) in self.delta.iter_mut().zip(&self.ws.rhs) {
-                *d = -r;
-            }
-            self.ws.jac.solve_factored(&mut self.delta);
-            let (mut dx, mut dth) = (0.0f64, 0.0f64);
-            for d in &self.delta {
-                dx = dx.max(d.fixed_rows::<3>(0).amax());
-                dth = dth.max(d.fixed_rows::<3>(3).amax());
-            }
+            self.ws.factor(rod)?;
+            let (dx, dth) = self.ws.newton_correction(&mut self.delta);
             let step = (dx / l).max(dth);
             let alpha = 1.0f64.min(self.opts.max_rotation_step / dth.max(1e-300));
             self.base.clone_from(st);
