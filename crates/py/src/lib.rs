@@ -2,6 +2,7 @@
 use pyo3::prelude::*;
 
 mod cable;
+mod fatigue;
 mod volume;
 
 #[pymodule]
@@ -9,5 +10,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     cable::register(m)?;
     volume::register(m)?;
+    fatigue::register(m)?;
     Ok(())
 }

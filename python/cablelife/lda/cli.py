@@ -1,0 +1,117 @@
+"""CLI functions ``lda`` and ``compare`` (typer-compatible; registered by cablelife.cli)."""
+
+from __future__ import annotations
+
+import warnings
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from cablelife.lda.planes import DEFAULT_PLANE_STEP_DEG
+
+
+def lda_command(
+    result: Annotated[Path, typer.Argument(help="Result file (HDF5) of a run.")],
+    output: Annotated[
+        Path | None, typer.Option("--output", "-o", help="Damage file [RESULT.damage.h5].")
+    ] = None,
+    wohler_k: Annotated[float, typer.Option(help="Wöhler slope k (curve in RANGES).")] = 5.0,
+    wohler_alpha: Annotated[
+        float | None,
+        typer.Option(help="Wöhler constant α in Pa^k for absolute damage [pseudo-damage]."),
+    ] = None,
+    knee_range: Annotated[
+        float | None, typer.Option(help="Knee stress range ΔS_D in Pa [no knee].")
+    ] = None,
+    knee_kind: Annotated[str, typer.Option(help="Below the knee: haibach | cutoff.")] = "haibach",
+    points: Annotated[int, typer.Option(help="Surface points per section.")] = 16,
+    plane_step: Annotated[
+        float, typer.Option(help="Critical-plane step in degrees.")
+    ] = DEFAULT_PLANE_STEP_DEG,
+    section_step: Annotated[int, typer.Option(help="Analyse every k-th node.")] = 1,
+    residue: Annotated[
+        str, typer.Option(help="Residue: half (ASTM) | discard | full | repeated.")
+    ] = "half",
+    hysteresis: Annotated[float, typer.Option(help="Hysteresis gate in Pa.")] = 0.0,
+    threads: Annotated[int | None, typer.Option(help="Threads [all cores].")] = None,
+    hot_spots: Annotated[int, typer.Option(help="Hot spots to list.")] = 5,
+) -> None:
+    """Comparative load data analysis: pseudo-damage map of a result."""
+    from rich.console import Console
+    from rich.progress import Progress
+
+    from cablelife.lda.pipeline import analyse, default_damage_path
+    from cablelife.lda.sampling import SamplingWarning
+    from cablelife.lda.wohler import WohlerCurve, pseudo_damage_curve
+
+    console = Console()
+    try:
+        curve = (
+            pseudo_damage_curve(wohler_k)
+            if wohler_alpha is None
+            else WohlerCurve(k=wohler_k, alpha=wohler_alpha)
+        )
+        if knee_range is not None:
+            curve = WohlerCurve(
+                k=curve.k,
+                alpha=curve.alpha,
+                knee_range=knee_range,
+                knee_kind=knee_kind,
+                pseudo=curve.pseudo,
+            )
+        with (
+            Progress(console=console, transient=True) as bar,
+            warnings.catch_warnings(record=True) as caught,
+        ):
+            warnings.simplefilter("always", SamplingWarning)
+            tasks = {}
+
+            def progress(cable, done, total):
+                if cable not in tasks:
+                    tasks[cable] = bar.add_task(f"LDA {cable}", total=total)
+                bar.update(tasks[cable], completed=done)
+
+            analysis = analyse(
+                result,
+                curve=curve,
+                n_points=points,
+                plane_step_deg=plane_step,
+                section_step=section_step,
+                residue=residue,
+                hysteresis=hysteresis,
+                threads=threads,
+                progress=progress,
+            )
+        for w in caught:
+            console.print(f"[yellow]warning:[/] {w.message}")
+        path = analysis.save(output or default_damage_path(result))
+    except (ValueError, FileNotFoundError) as e:
+        console.print(f"[red]error:[/] {e}")
+        raise typer.Exit(1) from e
+    console.print(analysis.summary(hot_spots), soft_wrap=True, highlight=False)
+    console.print(f"damage file: {path}")
+
+
+def compare_command(
+    files: Annotated[list[Path], typer.Argument(help="Damage files (or result files).")],
+    labels: Annotated[str | None, typer.Option(help="Comma-separated labels [file names].")] = None,
+    hot_spots: Annotated[int, typer.Option(help="Hot spots per variant.")] = 1,
+    force: Annotated[
+        bool, typer.Option(help="Compare even if the Wöhler curves or settings differ.")
+    ] = False,
+) -> None:
+    """Rank variants by maximum pseudo-damage, with ratios to the best and hot spots."""
+    from rich.console import Console
+
+    from cablelife.lda.compare import compare
+
+    console = Console()
+    try:
+        names = None if labels is None else [s.strip() for s in labels.split(",")]
+        cmp = compare(files, names, check_settings=not force, n_hot_spots=hot_spots)
+    except (ValueError, FileNotFoundError, TypeError) as e:
+        console.print(f"[red]error:[/] {e}")
+        raise typer.Exit(1) from e
+    console.print(cmp.table(hot_spots), soft_wrap=True, highlight=False)
+    console.print(f"best: {cmp.best.label}")
