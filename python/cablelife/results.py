@@ -20,12 +20,13 @@ HDF5 layout (every dataset carries a ``unit`` attribute)::
 from __future__ import annotations
 
 import os
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import h5py
 import numpy as np
+
+from cablelife.h5files import atomic_h5, open_h5, plain
 
 FORMAT = "cablelife-result"
 FORMAT_VERSION = 1
@@ -125,32 +126,6 @@ def _put(group: h5py.Group, name: str, data: np.ndarray, unit: str | None = None
     ds.attrs["unit"] = unit if unit is not None else _UNITS.get(name, "1")
 
 
-def atomic_h5(path: str | os.PathLike):
-    """Context manager: an ``h5py.File`` open on a temporary file that replaces ``path`` on
-    success and is removed on failure."""
-    return _AtomicH5(Path(path))
-
-
-class _AtomicH5:
-    def __init__(self, path: Path):
-        self.path = path
-
-    def __enter__(self) -> h5py.File:
-        self.path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(prefix=self.path.name + ".", suffix=".tmp", dir=self.path.parent)
-        os.close(fd)
-        self.tmp = Path(tmp)
-        self.file = h5py.File(self.tmp, "w")
-        return self.file
-
-    def __exit__(self, exc_type, exc, tb) -> None:
-        self.file.close()
-        if exc_type is None:
-            os.replace(self.tmp, self.path)
-        else:
-            self.tmp.unlink(missing_ok=True)
-
-
 def save_result(result: Result, path: str | os.PathLike) -> Path:
     """Write ``result`` to ``path`` (HDF5) atomically."""
     from cablelife import __version__
@@ -191,12 +166,7 @@ def save_result(result: Result, path: str | os.PathLike) -> Path:
 
 def load_result(path: str | os.PathLike) -> Result:
     """Read a result written by :func:`save_result`."""
-    path = Path(path)
-    if not path.exists():
-        raise FileNotFoundError(f"result file {str(path)!r} does not exist")
-    with h5py.File(path, "r") as f:
-        if f.attrs.get("format") != FORMAT:
-            raise ValueError(f"{str(path)!r} is not a cablelife result file (no format attribute)")
+    with open_h5(path, FORMAT, "result") as f:
         cables = {}
         for name, g in f["cables"].items():
             clips = {
@@ -217,8 +187,8 @@ def load_result(path: str | os.PathLike) -> Result:
                 forces=g["forces"][()],
                 moments=g["moments"][()],
                 clips=clips,
-                section={k: _plain(v) for k, v in g["section"].attrs.items()},
-                solver={k: _plain(v) for k, v in solver.items()},
+                section={k: plain(v) for k, v in g["section"].attrs.items()},
+                solver={k: plain(v) for k, v in solver.items()},
                 energies=energies,
             )
         return Result(
@@ -228,11 +198,3 @@ def load_result(path: str | os.PathLike) -> Result:
             complete=bool(f.attrs.get("complete", True)),
             message=str(f.attrs.get("message", "")),
         )
-
-
-def _plain(v):
-    if isinstance(v, np.generic):
-        return v.item()
-    if isinstance(v, bytes):
-        return v.decode()
-    return v

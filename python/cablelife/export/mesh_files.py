@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from cablelife.export.atomic import write_atomic
+from cablelife.atomic import write_atomic
 
 UNIT_SCALE = {"m": 1.0, "mm": 1000.0}
 

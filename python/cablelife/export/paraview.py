@@ -18,7 +18,7 @@ from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
-from cablelife.export.atomic import write_text_atomic
+from cablelife.atomic import write_text_atomic
 from cablelife.export.frames import to_global
 from cablelife.results import CableResult
 

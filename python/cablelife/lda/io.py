@@ -30,11 +30,11 @@ from pathlib import Path
 import h5py
 import numpy as np
 
+from cablelife.h5files import atomic_h5, open_h5, plain
 from cablelife.lda.pipeline import CableDamage, DamageAnalysis
 from cablelife.lda.sampling import SamplingCheck
 from cablelife.lda.stress import CircularSection
 from cablelife.lda.wohler import WohlerCurve
-from cablelife.results import atomic_h5
 
 FORMAT = "cablelife-damage"
 FORMAT_VERSION = 1
@@ -116,20 +116,15 @@ def is_damage_file(path: str | os.PathLike) -> bool:
 
 def load_damage(path: str | os.PathLike) -> DamageAnalysis:
     """Read a damage file written by :func:`save_damage`."""
-    path = Path(path)
-    if not path.exists():
-        raise FileNotFoundError(f"damage file {str(path)!r} does not exist")
-    with h5py.File(path, "r") as f:
-        if f.attrs.get("format") != FORMAT:
-            raise ValueError(f"{str(path)!r} is not a cablelife damage file (format attribute)")
-        a = {k: _plain(v) for k, v in f.attrs.items()}
+    with open_h5(path, FORMAT, "damage") as f:
+        a = {k: plain(v) for k, v in f.attrs.items()}
         curve = WohlerCurve.from_attrs(a)
         settings = {
             k: a[k] for k in ("n_points", "plane_step_deg", "section_step", "residue", "hysteresis")
         }
         cables = {}
         for name, g in f["cables"].items():
-            ga = {k: _plain(v) for k, v in g.attrs.items()}
+            ga = {k: plain(v) for k, v in g.attrs.items()}
             spp = float(ga["samples_per_period"])
             sampling = (
                 None
@@ -159,11 +154,3 @@ def load_damage(path: str | os.PathLike) -> DamageAnalysis:
                 sampling=sampling,
             )
     return DamageAnalysis(cables=cables, curve=curve, settings=settings, source=str(a["source"]))
-
-
-def _plain(v):
-    if isinstance(v, np.generic):
-        return v.item()
-    if isinstance(v, bytes):
-        return v.decode()
-    return v

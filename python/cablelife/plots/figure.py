@@ -9,7 +9,7 @@ from pathlib import Path
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from cablelife.export.atomic import write_atomic
+from cablelife.atomic import write_atomic
 
 DPI = 110
 

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from cablelife.export.atomic import write_text_atomic
+from cablelife.atomic import write_text_atomic
 from cablelife.plots import (
     DamageMap,
     RainflowMatrix,

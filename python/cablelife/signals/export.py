@@ -2,41 +2,18 @@
 
 from __future__ import annotations
 
-import os
-import tempfile
-from collections.abc import Callable
 from pathlib import Path
 
 import h5py
 import numpy as np
 
+from cablelife.atomic import atomic_path
 from cablelife.signals.errors import SignalError
 from cablelife.signals.specfile import ChannelSeries
 from cablelife.signals.units import si_amplitude_name
 
 FORMAT = "cablelife-signal"
 FORMAT_VERSION = 1
-
-
-def _umask() -> int:
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask
-
-
-def atomic_write(path: Path, write: Callable[[Path], None]) -> None:
-    """Call ``write(temp_path)`` in the target directory, then move the file into place."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    os.close(fd)
-    try:
-        write(Path(tmp))
-        os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; give the usual permissions
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
 
 
 def _units(series: ChannelSeries) -> tuple[str, str, str]:
@@ -70,7 +47,8 @@ def write_csv(path: Path, time: np.ndarray, series: list[ChannelSeries], derivat
             comments="",
         )
 
-    atomic_write(path, write)
+    with atomic_path(path) as tmp:
+        write(tmp)
 
 
 def write_hdf5(path: Path, time: np.ndarray, series: list[ChannelSeries], spec_toml: str = ""):
@@ -91,7 +69,8 @@ def write_hdf5(path: Path, time: np.ndarray, series: list[ChannelSeries], spec_t
                 for key, unit in zip(("value", "velocity", "acceleration"), _units(s), strict=True):
                     g.create_dataset(key, data=getattr(s.kinematics, key)).attrs["unit"] = unit
 
-    atomic_write(path, write)
+    with atomic_path(path) as tmp:
+        write(tmp)
 
 
 def write_signals(

@@ -8,7 +8,7 @@ import numpy as np
 from matplotlib.figure import Figure
 from scipy.signal import welch
 
-from cablelife.signals.export import atomic_write
+from cablelife.atomic import atomic_path
 from cablelife.signals.generate import quantity_series
 from cablelife.signals.spec import PsdSignal, SineSignal, SweepSignal
 from cablelife.signals.specfile import ChannelSeries, target_quantity
@@ -47,7 +47,8 @@ def plot_signals(path: Path, time: np.ndarray, series: list[ChannelSeries]) -> N
     def write(tmp: Path) -> None:
         fig.savefig(tmp, dpi=110, format="png")
 
-    atomic_write(path, write)
+    with atomic_path(path) as tmp:
+        write(tmp)
 
 
 def _time_history(ax, time: np.ndarray, s: ChannelSeries) -> None:

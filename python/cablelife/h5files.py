@@ -1,0 +1,43 @@
+"""The HDF5 files of cablelife (results, damage maps): written atomically, opened with a check
+of their ``format`` attribute, attributes read back as plain Python values."""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+
+import h5py
+import numpy as np
+
+from cablelife.atomic import atomic_path
+
+
+@contextmanager
+def atomic_h5(path: str | os.PathLike) -> Iterator[h5py.File]:
+    """An ``h5py.File`` on a temporary file that replaces ``path`` on success and is removed on
+    failure."""
+    with atomic_path(path) as tmp, h5py.File(tmp, "w") as f:
+        yield f
+
+
+@contextmanager
+def open_h5(path: str | os.PathLike, fmt: str, what: str) -> Iterator[h5py.File]:
+    """Opens a cablelife file for reading; clear errors when it is missing or of another kind."""
+    path = Path(path)
+    if not path.exists():
+        raise FileNotFoundError(f"{what} file {str(path)!r} does not exist")
+    with h5py.File(path, "r") as f:
+        if f.attrs.get("format") != fmt:
+            raise ValueError(f"{str(path)!r} is not a cablelife {what} file (format attribute)")
+        yield f
+
+
+def plain(value):
+    """An HDF5 attribute as a plain Python value (numpy scalars → numbers, bytes → str)."""
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, bytes):
+        return value.decode()
+    return value
