@@ -307,28 +307,11 @@ impl Cable {
         let (record, error) = py.detach(move || {
             let mut rec = Record::default();
             let mut st = initial;
-            let mut prev: Option<State> = None;
             for (k, target) in poses.iter().enumerate() {
                 let result = if k == 0 {
                     solver.solve(rod, &mut st)
                 } else {
-                    // Predictor: extrapolate the free unknowns from the last two equilibria.
-                    let before = st.clone();
-                    if let Some(p0) = &prev {
-                        let p1 = st.clone();
-                        st.extrapolate_free(rod, p0, &p1);
-                    }
-                    let r = solver.step_to(rod, &mut st, target);
-                    if r.is_err() {
-                        st = before.clone();
-                        // Retry from the last equilibrium without the predictor.
-                        let r2 = solver.step_to(rod, &mut st, target);
-                        prev = Some(before);
-                        r2
-                    } else {
-                        prev = Some(before);
-                        r
-                    }
+                    solver.sequence_step(rod, &mut st, target)
                 };
                 match result {
                     Ok(stats) => {
@@ -555,15 +538,6 @@ impl Cable {
         d.set_item("block", PyArray1::from_vec(py, blocks))?;
         d.set_item("slot", PyArray1::from_vec(py, slots))?;
         Ok(d)
-    }
-
-    /// Node positions of the routed initial shape at the reference clip poses (N+1, 3).
-    fn routed_positions<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        let st = route(&self.rod, None).map_err(|e| PyValueError::new_err(e.0))?;
-        let flat: Vec<f64> = st.x.iter().flat_map(|x| [x.x, x.y, x.z]).collect();
-        Ok(PyArray1::from_vec(py, flat)
-            .reshape([st.x.len(), 3])?
-            .into_any())
     }
 }
 

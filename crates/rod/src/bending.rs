@@ -194,7 +194,8 @@ mod tests {
 
     const K: [f64; 3] = [0.02, 0.03, 0.015];
 
-    fn energy_at(z: &[f64; 6]) -> f64 {
+    /// The element about a fixed base state, rotated by z = (θ_a, θ_b).
+    fn eval_at(z: &[f64; 6], want_hess: bool) -> BendEval {
         let pa = rotate_body(
             &exp_half(&Vector3::new(0.3, 0.2, -0.5)),
             &Vector3::new(z[0], z[1], z[2]),
@@ -204,36 +205,16 @@ mod tests {
             &Vector3::new(z[3], z[4], z[5]),
         );
         let mut e = BendEval::default();
-        bend_element(
-            &pa,
-            &pb,
-            0.05,
-            &Vector3::from(K),
-            &Vector3::new(1.0, 0.0, 0.5),
-            false,
-            &mut e,
-        )
-        .unwrap();
-        e.energy
+        let k0 = Vector3::new(1.0, 0.0, 0.5);
+        bend_element(&pa, &pb, 0.05, &Vector3::from(K), &k0, want_hess, &mut e).unwrap();
+        e
     }
 
     #[test]
     fn gradient_and_hessian_match_finite_differences() {
-        let pa = exp_half(&Vector3::new(0.3, 0.2, -0.5));
-        let pb = exp_half(&Vector3::new(0.45, 0.1, -0.3));
-        let mut e = BendEval::default();
-        bend_element(
-            &pa,
-            &pb,
-            0.05,
-            &Vector3::from(K),
-            &Vector3::new(1.0, 0.0, 0.5),
-            true,
-            &mut e,
-        )
-        .unwrap();
+        let e = eval_at(&[0.0; 6], true);
         crate::fd_check::check_derivatives::<6>(
-            energy_at,
+            |z| eval_at(z, false).energy,
             |i| e.grad[i / 3][i % 3],
             |i, j| e.hess[i / 3][j / 3][(i % 3, j % 3)],
         );

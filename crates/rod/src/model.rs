@@ -356,11 +356,6 @@ impl Rod {
         self.ds_edge.len()
     }
 
-    /// Whether the clips hold the cable at all (a static solve needs at least one clip).
-    pub fn is_held(&self) -> bool {
-        !self.spec.clips.is_empty()
-    }
-
     /// Global position of the cable point at node n when held by clip c at pose `pose`.
     pub fn clip_node_position(&self, c: usize, n: usize, pose: &Pose) -> Vector3<f64> {
         let offset = self.arc[n] - self.spec.clips[c].s;

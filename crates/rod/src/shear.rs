@@ -138,50 +138,28 @@ mod tests {
     use super::*;
     use crate::rotation::{exp_half, rotate_body};
 
-    fn energy(xa: &Vector3<f64>, xb: &Vector3<f64>, p: &Quat) -> f64 {
-        let mut e = ShearEval::default();
-        let k = Vector3::new(3.0e3, 2.0e3, 1.0e4);
-        shear_element(
-            xa,
-            xb,
-            p,
-            0.1,
-            &k,
-            &Vector3::new(0.01, 0.0, -0.02),
-            false,
-            &mut e,
-        );
-        e.energy
-    }
-
-    /// Energy as a function of the 9 coordinates (x_a, x_b, θ) about a base state.
-    fn energy_at(z: &[f64; 9]) -> f64 {
+    /// The element about a fixed base state, moved by z = (x_a, x_b, θ).
+    fn eval_at(z: &[f64; 9], want_hess: bool) -> ShearEval {
         let xa = Vector3::new(0.1, -0.2, 0.05) + Vector3::new(z[0], z[1], z[2]);
         let xb = Vector3::new(0.13, -0.17, 0.14) + Vector3::new(z[3], z[4], z[5]);
-        let p0 = exp_half(&Vector3::new(0.4, -0.3, 0.9));
-        let p = rotate_body(&p0, &Vector3::new(z[6], z[7], z[8]));
-        energy(&xa, &xb, &p)
+        let p = rotate_body(
+            &exp_half(&Vector3::new(0.4, -0.3, 0.9)),
+            &Vector3::new(z[6], z[7], z[8]),
+        );
+        let (k, strain0) = (
+            Vector3::new(3.0e3, 2.0e3, 1.0e4),
+            Vector3::new(0.01, 0.0, -0.02),
+        );
+        let mut e = ShearEval::default();
+        shear_element(&xa, &xb, &p, 0.1, &k, &strain0, want_hess, &mut e);
+        e
     }
 
     #[test]
     fn gradient_and_hessian_match_finite_differences() {
-        let xa = Vector3::new(0.1, -0.2, 0.05);
-        let xb = Vector3::new(0.13, -0.17, 0.14);
-        let p = exp_half(&Vector3::new(0.4, -0.3, 0.9));
-        let mut e = ShearEval::default();
-        let k = Vector3::new(3.0e3, 2.0e3, 1.0e4);
-        shear_element(
-            &xa,
-            &xb,
-            &p,
-            0.1,
-            &k,
-            &Vector3::new(0.01, 0.0, -0.02),
-            true,
-            &mut e,
-        );
+        let e = eval_at(&[0.0; 9], true);
         crate::fd_check::check_derivatives::<9>(
-            energy_at,
+            |z| eval_at(z, false).energy,
             |i| e.grad[i / 3][i % 3],
             |i, j| e.hess[i / 3][j / 3][(i % 3, j % 3)],
         );

@@ -100,6 +100,12 @@ pub struct Statics {
     delta: Vec<Vector6<f64>>,
     trial: Vec<Vector6<f64>>,
     base: State,
+    /// Buffers of a sequence of equilibria (reused: no allocation per step).
+    saved: State,
+    start_poses: Vec<Pose>,
+    last: State,
+    prev: State,
+    has_prev: bool,
     force_scale: f64,
 }
 
@@ -121,6 +127,11 @@ impl Statics {
             delta: vec![Vector6::zeros(); rod.n_edges() + 1],
             trial: vec![Vector6::zeros(); rod.n_edges() + 1],
             base: State::empty(),
+            saved: State::empty(),
+            start_poses: Vec::new(),
+            last: State::empty(),
+            prev: State::empty(),
+            has_prev: false,
             force_scale: weight.max(loads).max(bend).max(1e-12),
         }
     }
@@ -316,6 +327,7 @@ impl Statics {
     /// continuation from the unloaded routed shape (gravity and loads ramped), with plain and
     /// then damped Newton steps.
     pub fn solve(&mut self, rod: &Rod, st: &mut State) -> Result<SolveStats, SolveError> {
+        self.has_prev = false; // a new sequence starts here
         let start = st.clone();
         // Plain Newton converges in a handful of iterations from a good guess; a slow start
         // means a poor guess, for which the pseudo-transient path is the better use of time.
@@ -391,13 +403,13 @@ impl Statics {
         st: &mut State,
         target: &[Pose],
     ) -> Result<SolveStats, SolveError> {
-        let start_poses = st.clip_pose.clone();
-        let saved = st.clone();
+        self.start_poses.clone_from(&st.clip_pose);
+        self.saved.clone_from(st);
         st.set_clip_poses(rod, target);
         match self.newton(rod, st, 1.0, false) {
             Ok(s) => return Ok(s),
             Err(e @ SolveError::Singular { .. }) => return Err(e),
-            Err(_) => st.clone_from(&saved),
+            Err(_) => st.clone_from(&self.saved),
         }
         // Bisect the motion: fractions of the way from start to target.
         let mut total = SolveStats::default();
@@ -408,10 +420,11 @@ impl Statics {
         while done < 1.0 {
             let f = (done + df).min(1.0);
             for (c, pose) in poses.iter_mut().enumerate() {
-                pose.position = start_poses[c].position.lerp(&target[c].position, f);
-                pose.orientation = slerp(&start_poses[c].orientation, &target[c].orientation, f);
+                let from = self.start_poses[c];
+                pose.position = from.position.lerp(&target[c].position, f);
+                pose.orientation = slerp(&from.orientation, &target[c].orientation, f);
             }
-            let saved = st.clone();
+            self.saved.clone_from(st);
             st.set_clip_poses(rod, &poses);
             match self.newton(rod, st, 1.0, false) {
                 Ok(s) => {
@@ -425,7 +438,7 @@ impl Statics {
                     }
                 }
                 Err(e) => {
-                    st.clone_from(&saved);
+                    st.clone_from(&self.saved);
                     df *= 0.5;
                     depth += 1;
                     if depth > self.opts.max_substep_depth {
@@ -435,6 +448,31 @@ impl Statics {
             }
         }
         Ok(total)
+    }
+
+    /// The next equilibrium of a sequence (after a `solve` for the first): the free unknowns
+    /// are extrapolated linearly from the last two equilibria (predictor), then `step_to`;
+    /// if that fails, it is retried from the last equilibrium without the predictor.
+    pub fn sequence_step(
+        &mut self,
+        rod: &Rod,
+        st: &mut State,
+        target: &[Pose],
+    ) -> Result<SolveStats, SolveError> {
+        self.last.clone_from(st);
+        if self.has_prev {
+            st.extrapolate_free(rod, &self.prev, &self.last);
+        }
+        let result = match self.step_to(rod, st, target) {
+            Ok(s) => Ok(s),
+            Err(_) => {
+                st.clone_from(&self.last);
+                self.step_to(rod, st, target)
+            }
+        };
+        std::mem::swap(&mut self.prev, &mut self.last);
+        self.has_prev = true;
+        result
     }
 }
 
