@@ -3,7 +3,9 @@ crates/rod/tests/dynamics.rs against Euler–Bernoulli, energy, order and decrem
 
 from __future__ import annotations
 
+import copy
 import math
+import warnings
 
 import numpy as np
 import pytest
@@ -124,3 +126,28 @@ def test_slow_excitation_gives_the_quasistatic_result(scene_dict):
     assert np.abs(dyn.moments[..., :2] - qs.moments[..., :2]).max() < 0.01 * span
     np.testing.assert_allclose(dyn.positions, qs.positions, atol=0.01 * 0.05)
     assert "kinetic_energy" in dyn.energies and dyn.solver["real_time_factor"] > 0
+
+
+def test_a_moving_start_warns_and_a_faded_one_does_not(scene_dict):
+    from cablelife.simulate import StartUpWarning
+
+    psd = {
+        "type": "psd",
+        "quantity": "displacement",
+        "breakpoints": [[5, 1e-7], [50, 1e-7]],
+        "seed": 3,
+    }
+    d = copy.deepcopy(scene_dict)
+    d["simulation"].update(mode="dynamic", duration=0.3, time_step=1e-3)
+    d["bodies"] = [{"name": "shaker", "motion": [{"channel": "z", "signal": psd}]}]
+    d["cables"][0]["clips"][0]["body"] = "shaker"
+    with pytest.warns(StartUpWarning, match="starts with .* m/s"):
+        simulate(scene_from_dict(d))
+    psd["fade_in"] = 0.1
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", StartUpWarning)
+        res = simulate(scene_from_dict(d))
+    assert res.complete
+    # a static run of the same scene takes the pose at t = 0 (no signal on a 2-sample grid)
+    static = simulate(scene_from_dict(d), mode="static")
+    assert static.cable.n_steps == 1

@@ -165,3 +165,19 @@ def test_rotation_psd_in_degrees():
     )
     value = generate(spec, time_grid(100.0, 0.01))
     assert np.std(value) == pytest.approx(np.deg2rad(np.sqrt(0.04 * 9)), rel=1e-6)
+
+
+def test_fade_in_starts_at_rest_and_keeps_the_derivatives_consistent():
+    time = time_grid(4.0, 5e-5)
+    plain = kinematics(accel_psd(seed=5), time)
+    faded = kinematics(accel_psd(seed=5, fade_in=0.5), time)
+    assert faded.value[0] == faded.velocity[0] == faded.acceleration[0] == 0.0
+    after = time >= 0.5
+    np.testing.assert_array_equal(faded.value[after], plain.value[after])
+    np.testing.assert_array_equal(faded.acceleration[after], plain.acceleration[after])
+    # product rule: finite differences of the faded signal agree with its derivatives
+    for value, derivative in ((faded.value, faded.velocity), (faded.velocity, faded.acceleration)):
+        fd = np.gradient(value, 5e-5)  # truncation error (2π·400 Hz·dt)²/6 = 0.26 %
+        assert np.max(np.abs(fd - derivative)[5:-5]) < 0.01 * np.max(np.abs(derivative))
+    with pytest.raises(ValueError, match="fade_in"):
+        accel_psd(fade_in=-1.0)

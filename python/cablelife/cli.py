@@ -1,5 +1,5 @@
 """Command line: ``cablelife run``, ``modes``, ``signal``, ``volume``, ``report``, ``paraview``,
-``lda``, ``compare``, ``schema``."""
+``lda``, ``compare``, ``study``, ``demo``, ``schema``."""
 
 from __future__ import annotations
 
@@ -183,6 +183,11 @@ def _register_optional() -> None:
         app.command(name="compare")(compare_command)
     except ImportError:
         pass
+    from cablelife.demo_cli import demo_command
+    from cablelife.study.cli import study_command
+
+    app.command(name="study")(study_command)
+    app.command(name="demo")(demo_command)
 
 
 _register_optional()

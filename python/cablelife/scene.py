@@ -362,8 +362,9 @@ class Scene(_Model):
         return tomli_w.dumps(data)
 
 
-def _format_errors(err: ValidationError, source: str) -> str:
-    lines = [f"invalid scene {source}:"]
+def format_validation_errors(err: ValidationError, source: str, what: str = "scene") -> str:
+    """One line per validation error: key path, message and the offending value."""
+    lines = [f"invalid {what} {source}:"]
     for e in err.errors():
         loc = ".".join(str(p) if not isinstance(p, int) else f"[{p}]" for p in e["loc"])
         loc = loc.replace(".[", "[")
@@ -388,7 +389,7 @@ def scene_from_dict(data: dict, base_dir: Path | None = None, source: str = "") 
     try:
         scene = Scene.model_validate(data)
     except ValidationError as err:
-        raise SceneError(_format_errors(err, source)) from None
+        raise SceneError(format_validation_errors(err, source)) from None
     scene.base_dir = base_dir
     return scene
 

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import os
 import time as _time
+import warnings
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 
@@ -68,7 +69,14 @@ def clip_kinematics(
     velocities, angular velocities, accelerations, angular accelerations (T, C, 3), global.
     Without ``with_motion``: the reference poses (bodies at rest)."""
     n_t, n_c = times.size, len(cable.clips)
-    grid = times if n_t > 1 else np.array([times[0], times[0] + scene.simulation.time_step])
+    grid = times
+    if n_t == 1:  # one pose (static run): the motions' value at that time on their usual grid
+        sim = scene.simulation
+        grid = (
+            time_grid(sim.duration, sim.time_step, times[0])
+            if sim.duration is not None and sim.duration > sim.time_step
+            else np.array([times[0], times[0] + sim.time_step])
+        )
     motions = {}
     for body in scene.bodies:
         r0 = euler_matrix(body.orientation)
@@ -167,6 +175,30 @@ def output_every(scene: Scene) -> int:
     return k
 
 
+class StartUpWarning(UserWarning):
+    """A dynamic run starts with moving clips while the cable is at rest."""
+
+
+def _warn_moving_start(cable: Cable, kin: dict[str, np.ndarray]) -> None:
+    """Warn when a clip's velocity at t = 0 is a sizeable part of its largest velocity: the
+    cable starts at rest in its static equilibrium, so the run begins with a start-up transient
+    (large damping forces in the first steps) that also enters the fatigue analysis."""
+    for key, unit in (("velocities", "m/s"), ("angular_velocities", "rad/s")):
+        v = np.linalg.norm(kin[key], axis=-1)  # (T, C)
+        peak = v.max(axis=0)
+        for j, clip in enumerate(cable.clips):
+            if peak[j] > 0 and v[0, j] > 0.05 * peak[j]:
+                warnings.warn(
+                    f"cable '{cable.name}', clip '{clip.name}': the motion starts with "
+                    f"{v[0, j]:.3g} {unit} ({100 * v[0, j] / peak[j]:.0f} % of its peak) while "
+                    "the cable starts at rest: expect a start-up transient; fade the signal in "
+                    "(fade_in = ... s on sine and psd signals)",
+                    StartUpWarning,
+                    stacklevel=4,
+                )
+                return
+
+
 def _run_cable(scene: Scene, cable: Cable, times: np.ndarray, mode: str, progress: Progress | None):
     core = build_cable(scene, cable)
     callback = (lambda k, n: progress(cable.name, k, n)) if progress else None
@@ -179,6 +211,7 @@ def _run_cable(scene: Scene, cable: Cable, times: np.ndarray, mode: str, progres
             tau_shear, tau_bend, info = retardation_times(scene, cable)
             every = output_every(scene)
             kin = clip_kinematics(scene, cable, times)
+            _warn_moving_start(cable, kin)
             start = _time.perf_counter()
             out = core.run_dynamic(
                 scene.simulation.time_step,

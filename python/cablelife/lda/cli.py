@@ -43,23 +43,21 @@ def lda_command(
 
     from cablelife.lda.pipeline import analyse, default_damage_path
     from cablelife.lda.sampling import SamplingWarning
-    from cablelife.lda.wohler import WohlerCurve, pseudo_damage_curve
+    from cablelife.lda.settings import LdaSettings
 
     console = Console()
     try:
-        curve = (
-            pseudo_damage_curve(wohler_k)
-            if wohler_alpha is None
-            else WohlerCurve(k=wohler_k, alpha=wohler_alpha)
+        settings = LdaSettings.from_options(
+            wohler_k=wohler_k,
+            wohler_alpha=wohler_alpha,
+            knee_range=knee_range,
+            knee_kind=knee_kind,
+            points=points,
+            plane_step=plane_step,
+            section_step=section_step,
+            residue=residue,
+            hysteresis=hysteresis,
         )
-        if knee_range is not None:
-            curve = WohlerCurve(
-                k=curve.k,
-                alpha=curve.alpha,
-                knee_range=knee_range,
-                knee_kind=knee_kind,
-                pseudo=curve.pseudo,
-            )
         with (
             Progress(console=console, transient=True) as bar,
             warnings.catch_warnings(record=True) as caught,
@@ -73,15 +71,7 @@ def lda_command(
                 bar.update(tasks[cable], completed=done)
 
             analysis = analyse(
-                result,
-                curve=curve,
-                n_points=points,
-                plane_step_deg=plane_step,
-                section_step=section_step,
-                residue=residue,
-                hysteresis=hysteresis,
-                threads=threads,
-                progress=progress,
+                result, threads=threads, progress=progress, **settings.analyse_kwargs()
             )
         for w in caught:
             console.print(f"[yellow]warning:[/] {w.message}")

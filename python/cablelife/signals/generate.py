@@ -37,7 +37,8 @@ def kinematics(spec: Signal, time: np.ndarray, base_dir: Path | None = None) -> 
         return sweep(spec, t)
     if isinstance(spec, PsdSignal):
         f_low, f_high = spec.band
-        return synthesise(spec.psd(), t.size, dt, spec.seed, f_low, f_high)
+        kin = synthesise(spec.psd(), t.size, dt, spec.seed, f_low, f_high)
+        return kin.faded_in(t, spec.fade_in)
     if isinstance(spec, MeasuredSignal):
         return measured(spec, t, base_dir)
     if isinstance(spec, TableSignal):

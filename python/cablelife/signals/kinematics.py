@@ -27,6 +27,21 @@ class Kinematics:
             self.acceleration + other.acceleration,
         )
 
+    def faded_in(self, time: np.ndarray, fade_in: float) -> Kinematics:
+        """This motion multiplied by the quintic ramp w over ``fade_in`` s from t = 0 (product
+        rule for the derivatives): it starts at rest, with continuous velocity and
+        acceleration. ``fade_in = 0`` returns it unchanged."""
+        if fade_in <= 0:
+            return self
+        from cablelife.signals.ramp import smoothstep
+
+        w, dw, ddw = smoothstep(np.asarray(time, dtype=float), 0.0, fade_in)
+        return Kinematics(
+            w * self.value,
+            dw * self.value + w * self.velocity,
+            ddw * self.value + 2 * dw * self.velocity + w * self.acceleration,
+        )
+
     @classmethod
     def zeros(cls, n: int) -> Kinematics:
         return cls(np.zeros(n), np.zeros(n), np.zeros(n))

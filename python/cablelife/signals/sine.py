@@ -5,7 +5,6 @@ from __future__ import annotations
 import numpy as np
 
 from cablelife.signals.kinematics import Kinematics
-from cablelife.signals.ramp import smoothstep
 from cablelife.signals.spec import SineSignal
 from cablelife.signals.units import DERIVATIVE_ORDER
 
@@ -24,10 +23,6 @@ def sine(spec: SineSignal, time: np.ndarray) -> Kinematics:
     x_amp = amplitude / omega**order
     theta = omega * t + spec.phase - order * np.pi / 2
     s, c = np.sin(theta), np.cos(theta)
-    w, dw, ddw = smoothstep(t, 0.0, spec.fade_in)
-    if spec.fade_in <= 0:
-        w, dw, ddw = np.ones_like(t), np.zeros_like(t), np.zeros_like(t)
-    value = w * x_amp * s + spec.offset
-    velocity = x_amp * (dw * s + w * omega * c)
-    acceleration = x_amp * (ddw * s + 2 * dw * omega * c - w * omega**2 * s)
-    return Kinematics(value, velocity, acceleration)
+    pure = Kinematics(x_amp * s, x_amp * omega * c, -x_amp * omega**2 * s)
+    faded = pure.faded_in(t, spec.fade_in)
+    return Kinematics(faded.value + spec.offset, faded.velocity, faded.acceleration)

@@ -141,7 +141,9 @@ class PsdSignal(_Spec):
     interpolated. ``profile`` names a standard profile (see ``cablelife.signals.profiles``).
     ``scale`` multiplies the signal (the PSD by scale²). Content outside [f_low, f_high] is zero;
     defaults: the lowest and highest breakpoints. ``seed`` makes the signal reproducible; give
-    channels that must be independent different seeds.
+    channels that must be independent different seeds. ``fade_in`` (s) multiplies the signal by
+    the quintic ramp of the sine's fade-in, so a dynamic run starts at rest instead of with the
+    random signal's velocity at t = 0 (a start-up transient); the RMS then counts the ramp.
     """
 
     type: Literal["psd"]
@@ -153,6 +155,7 @@ class PsdSignal(_Spec):
     seed: Annotated[int, Field(ge=0)] = 0
     f_low: PositiveFloat | None = None  # Hz
     f_high: PositiveFloat | None = None  # Hz
+    fade_in: NonNegativeFloat = 0.0  # s
 
     @model_validator(mode="after")
     def _check(self) -> PsdSignal:
