@@ -218,3 +218,49 @@ def test_zero_damage_and_single_step_results(tmp_path):
     assert back.max_damage == 0.0
     cmp = compare([res, back], labels=["a", "b"])
     assert [v.ratio for v in cmp.variants] == [1.0, 1.0]
+
+
+def test_rainflow_matrix_of_the_most_damaged_series(tmp_path):
+    """The stored range–mean matrix counts the cycles of the critical series: for the cosine
+    bending, 10 cycles of range 2σ_a at mean 0 at node 3, γ = 90°, φ = 0°; for a two-tone
+    load, the same cycles (recounted here from the loads) whose Miner sum is the maximum."""
+    import h5py
+    from cablelife.lda import plane_weights, rainflow_cycles, section_series, surface_angles
+    from cablelife.lda.pipeline import RAINFLOW_BINS
+
+    a = analyse(make_result())
+    rf = a.cables["harness"].rainflow
+    assert (rf.section_index, rf.angle, rf.plane, rf.unit) == (3, 90.0, 0.0, "Pa")
+    assert rf.arc_length == pytest.approx(0.3)
+    assert rf.counts.shape == (RAINFLOW_BINS, RAINFLOW_BINS) and rf.total == 10.0
+    i, j = np.unravel_index(rf.counts.argmax(), rf.counts.shape)
+    assert rf.counts[i, j] == 10.0 and rf.range_edges[i + 1] == pytest.approx(2 * SIGMA_A)
+    assert rf.mean_edges[j] <= 0.0 <= rf.mean_edges[j + 1]
+    back = load_damage(a.save(tmp_path / "a.h5")).cables["harness"].rainflow
+    np.testing.assert_array_equal(back.counts, rf.counts)
+    np.testing.assert_array_equal(back.range_edges, rf.range_edges)
+    assert (back.section_index, back.angle, back.plane) == (3, 90.0, 0.0)
+
+    r = make_result(scale=0.0)
+    t = r.cable.time
+    wave = np.cos(2 * np.pi * F * t) + 0.4 * np.sin(2 * np.pi * 23 * t)
+    r.cable.moments[:, 5, 1] = 1.0 + wave
+    r.cable.forces[:, :, 2] = 50.0 * wave[:, None]  # in phase: N/A − M2 cos γ a/I peaks at 180°
+    cd = analyse(r, residue="full").cables["harness"]
+    rf = cd.rainflow
+    assert rf.section_index == 5 and rf.angle == pytest.approx(180.0) and rf.plane == 0.0
+    sec = CircularSection(A, 0.0, 0.3)
+    w = plane_weights(sec, surface_angles(16), np.deg2rad(np.arange(0, 180, 10.0)))
+    loads = np.concatenate([node_forces(r.cable.forces)[:, 5], r.cable.moments[:, 5]], axis=1)
+    row = 8 * 18 + 0  # γ = 180°, φ = 0°
+    cycles = rainflow_cycles(section_series(loads, w)[row], residue="full")
+    assert cycles.total == rf.total > 20
+    assert pseudo(cycles.range, cycles.count).sum() == pytest.approx(cd.max_damage, rel=1e-12)
+    h, _, _ = np.histogram2d(
+        cycles.range, cycles.mean, bins=(rf.range_edges, rf.mean_edges), weights=cycles.count
+    )
+    np.testing.assert_array_equal(h, rf.counts)
+    static = analyse(make_result(scale=0.0))
+    assert static.cables["harness"].rainflow is None
+    with h5py.File(static.save(tmp_path / "z.h5")) as f:
+        assert "rainflow" not in f["cables/harness"]

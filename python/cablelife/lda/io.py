@@ -19,6 +19,10 @@ Layout (every dataset has a ``unit`` attribute)::
                                        from_measured, duration, n_steps,
                                        f_max, samples_per_period (−1: not checked)
     /cables/<name>/clips        attrs: clip name -> arc length (m)
+    /cables/<name>/rainflow/{range_edges (R+1,) Pa, mean_edges (M+1,) Pa, counts (R, M) 1}
+                                rainflow range–mean matrix of the most damaged series; attrs
+                                section_index, arc_length (m), angle, plane (deg); absent
+                                when the damage is zero
 """
 
 from __future__ import annotations
@@ -32,6 +36,7 @@ import numpy as np
 
 from cablelife.h5files import atomic_h5, open_h5, plain
 from cablelife.lda.pipeline import CableDamage, DamageAnalysis
+from cablelife.lda.rainflow import RainflowMatrix
 from cablelife.lda.sampling import SamplingCheck
 from cablelife.lda.stress import CircularSection
 from cablelife.lda.wohler import WohlerCurve
@@ -84,6 +89,8 @@ def save_damage(analysis: DamageAnalysis, path: str | os.PathLike) -> Path:
             clips = g.create_group("clips")
             for cn, s in c.clips.items():
                 clips.attrs[cn] = s
+            if c.rainflow is not None:
+                _put_rainflow(g.create_group("rainflow"), c.rainflow)
             spots = c.hot_spots(N_HOT_SPOTS)
             h = g.create_group("hot_spots")
             _put(h, "arc_length", [x.arc_length for x in spots], "m")
@@ -104,6 +111,31 @@ def save_damage(analysis: DamageAnalysis, path: str | os.PathLike) -> Path:
                 "m",
             )
     return path
+
+
+def _put_rainflow(g: h5py.Group, m: RainflowMatrix) -> None:
+    _put(g, "range_edges", m.range_edges, m.unit)
+    _put(g, "mean_edges", m.mean_edges, m.unit)
+    _put(g, "counts", m.counts, "1")
+    g.attrs["section_index"] = m.section_index
+    g.attrs["arc_length"] = m.arc_length
+    g.attrs["angle"] = m.angle
+    g.attrs["plane"] = m.plane
+
+
+def _get_rainflow(g: h5py.Group, cable: str) -> RainflowMatrix:
+    a = {k: plain(v) for k, v in g.attrs.items()}
+    return RainflowMatrix(
+        g["range_edges"][()],
+        g["mean_edges"][()],
+        g["counts"][()],
+        unit=str(plain(g["range_edges"].attrs.get("unit", "Pa"))),
+        label=cable,
+        section_index=int(a["section_index"]),
+        arc_length=float(a["arc_length"]),
+        angle=float(a["angle"]),
+        plane=float(a["plane"]),
+    )
 
 
 def is_damage_file(path: str | os.PathLike) -> bool:
@@ -152,5 +184,6 @@ def load_damage(path: str | os.PathLike) -> DamageAnalysis:
                 duration=float(ga["duration"]),
                 n_steps=int(ga["n_steps"]),
                 sampling=sampling,
+                rainflow=_get_rainflow(g["rainflow"], name) if "rainflow" in g else None,
             )
     return DamageAnalysis(cables=cables, curve=curve, settings=settings, source=str(a["source"]))

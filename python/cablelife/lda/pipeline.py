@@ -19,7 +19,7 @@ import numpy as np
 
 from cablelife.lda.damage import damage_combined, equivalent_range_from_damage
 from cablelife.lda.planes import DEFAULT_PLANE_STEP_DEG, plane_angles, plane_weights
-from cablelife.lda.rainflow import check_residue
+from cablelife.lda.rainflow import RainflowMatrix, check_residue, rainflow_cycles
 from cablelife.lda.sampling import SamplingCheck, check_sampling
 from cablelife.lda.stations import section_loads
 from cablelife.lda.stress import CircularSection, surface_angles
@@ -27,6 +27,8 @@ from cablelife.lda.wohler import WohlerCurve, pseudo_damage_curve
 from cablelife.results import CableResult, Result, load_result
 
 DEFAULT_POINTS = 16
+#: Range and mean bins of the stored rainflow matrix.
+RAINFLOW_BINS = 32
 
 
 @dataclass(frozen=True)
@@ -69,6 +71,7 @@ class CableDamage:
     duration: float = 0.0  # s, analysed time span
     n_steps: int = 0
     sampling: SamplingCheck | None = None
+    rainflow: RainflowMatrix | None = None  # of the most damaged series (None: no damage)
 
     @property
     def damage(self) -> np.ndarray:
@@ -239,6 +242,21 @@ def analyse_cable(
         if progress is not None:
             progress(stop, n_sec)
     time = np.asarray(cable.time, float)
+    rainflow = None
+    if out.size and out.max() > 0:
+        i, row = np.unravel_index(int(out.argmax()), out.shape)
+        p, q = divmod(int(row), planes.size)
+        series = weights[row] @ loads[i].T  # the critical comparison-stress series
+        rainflow = RainflowMatrix.of_cycles(
+            rainflow_cycles(series, residue=residue, hysteresis=hysteresis),
+            RAINFLOW_BINS,
+            unit="Pa",
+            label=cable.name,
+            section_index=int(idx[i]),
+            arc_length=float(s[i]),
+            angle=math.degrees(angles[p]),
+            plane=math.degrees(planes[q]),
+        )
     return CableDamage(
         cable=cable.name,
         section_index=idx,
@@ -251,6 +269,7 @@ def analyse_cable(
         duration=float(time[-1] - time[0]) if time.size else 0.0,
         n_steps=int(n_steps),
         sampling=sampling,
+        rainflow=rainflow,
     )
 
 

@@ -105,6 +105,45 @@ def range_mean_matrix(
     return h, re, me
 
 
+@dataclass
+class RainflowMatrix:
+    """Cycle counts (R, M) in bins of range (edges (R+1,)) and mean (edges (M+1,)), in
+    ``unit``. The LDA stores the one of its most damaged series (``section_index`` node,
+    surface angle ``angle`` and plane ``plane`` in degrees)."""
+
+    range_edges: np.ndarray
+    mean_edges: np.ndarray
+    counts: np.ndarray
+    unit: str = "Pa"
+    label: str = ""
+    section_index: int | None = None
+    arc_length: float | None = None  # m
+    angle: float | None = None  # deg, surface angle γ from d1 towards d2
+    plane: float | None = None  # deg, critical plane φ from the cable axis
+
+    def __post_init__(self):
+        self.range_edges = np.asarray(self.range_edges, dtype=float)
+        self.mean_edges = np.asarray(self.mean_edges, dtype=float)
+        self.counts = np.asarray(self.counts, dtype=float)
+        want = (self.range_edges.size - 1, self.mean_edges.size - 1)
+        if self.counts.shape != want:
+            raise ValueError(
+                f"counts has shape {self.counts.shape}: must be {want} "
+                "(len(range_edges) - 1, len(mean_edges) - 1)"
+            )
+
+    @property
+    def total(self) -> float:
+        """Number of cycles (half cycles count 0.5)."""
+        return float(self.counts.sum())
+
+    @classmethod
+    def of_cycles(cls, cycles: Cycles, bins: int = 32, **kw) -> RainflowMatrix:
+        """The range–mean matrix of ``cycles`` (see :func:`range_mean_matrix`)."""
+        counts, re, me = range_mean_matrix(cycles, bins)
+        return cls(re, me, counts, **kw)
+
+
 def from_to_matrix(
     series, cycles: Cycles, bins: int = 32, limits=None
 ) -> tuple[np.ndarray, np.ndarray]:
