@@ -11,7 +11,7 @@ from cablelife.plots import (
     RainflowMatrix,
     Run,
     check_bend_radius,
-    load_damage,
+    damage_maps,
     plot_bend_radius,
     plot_clip_reactions,
     plot_damage_along_cable,
@@ -22,6 +22,7 @@ from cablelife.plots import (
     save_png,
 )
 from cablelife.plots.runs import extreme_along
+from cablelife.plots.spectrum import excited_band
 
 PNG = b"\x89PNG\r\n\x1a\n"
 
@@ -98,13 +99,21 @@ def test_frequencies_over_spectrum():
     ax = fig.axes[0]
     colours = [ln.get_color() for ln in ax.get_lines()[1:]]
     assert colours == ["gray", "red", "red"]  # 3 Hz lies below the excited band
+    assert ax.get_xlim()[0] < 3.0  # every natural frequency is on the axis
+    # With a level the band ends where the PSD falls below 0.1 × its peak (f = 900 Hz here).
+    assert excited_band(f, 10 / (1 + (f / 300) ** 2), 0.1)[1] == pytest.approx(900, rel=0.1)
+    fig = plot_frequencies_over_spectrum(
+        [25.0, 1500.0], f, 10 / (1 + (f / 300) ** 2), band_level=0.1, labels=["clip b"]
+    )
+    assert [ln.get_color() for ln in fig.axes[0].get_lines()[1:]] == ["red", "gray"]
+    assert fig.axes[0].get_legend().get_texts()[0].get_text() == "clip b"
     with pytest.raises(ValueError, match="psd has shape"):
         plot_frequencies_over_spectrum([3.0], f, np.ones(3))
+    with pytest.raises(ValueError, match="labels: 2 given for 1 PSD channels"):
+        plot_frequencies_over_spectrum([3.0], f, np.ones(50), labels=["a", "b"])
 
 
 def test_rainflow_and_damage(tmp_path):
-    import h5py
-
     m = RainflowMatrix(np.arange(5.0), np.linspace(-2, 2, 4), np.arange(12.0).reshape(4, 3))
     save_png(plot_rainflow_matrix(m), tmp_path / "rf.png")
     with pytest.raises(ValueError, match=r"counts has shape \(2, 2\): must be \(4, 3\)"):
@@ -118,14 +127,44 @@ def test_rainflow_and_damage(tmp_path):
     assert spots[0].arc_length == pytest.approx(0.2) and spots[0].angle == pytest.approx(g[3])
     assert spots[1].arc_length == pytest.approx(0.8)
     save_png(plot_damage_along_cable([dm], clips={"a": 0.0, "b": 1.0}), tmp_path / "d.png")
-    with h5py.File(tmp_path / "damage.h5", "w") as f:
-        grp = f.create_group("cables/hose")
-        grp["arc_length"], grp["angle"], grp["damage"] = s, g, dmg
-        grp["rainflow/range_edges"], grp["rainflow/mean_edges"] = m.range_edges, m.mean_edges
-        grp["rainflow/counts"] = m.counts
-    maps = load_damage(tmp_path / "damage.h5")
-    loaded, rf = maps["hose"]
-    np.testing.assert_array_equal(loaded.damage, dmg)
-    np.testing.assert_array_equal(rf.counts, m.counts)
     with pytest.raises(ValueError, match="damage has shape"):
         DamageMap(s, g, dmg[:, :3])
+
+
+def test_damage_on_other_stations_and_angles():
+    """Exact at the map's own points, linear in s, periodic-linear in γ across 2π."""
+    g = np.deg2rad([0.0, 90.0, 180.0, 270.0])
+    dm = DamageMap([0.0, 1.0], g, [[0.0, 1.0, 2.0, 3.0], [4.0, 5.0, 6.0, 7.0]])
+    np.testing.assert_allclose(dm.on_surface([0.0, 1.0], g), dm.damage)
+    np.testing.assert_allclose(dm.on_surface([0.5], np.deg2rad([45.0])), [[2.5]])
+    np.testing.assert_allclose(dm.on_surface([0.0], np.deg2rad([315.0, -45.0])), [[1.5, 1.5]])
+    with pytest.raises(ValueError, match="spans s = 0 … 1 m, but the cable spans 0 … 0.9 m"):
+        dm.check_fits(np.linspace(0, 0.9, 4))
+
+
+def test_damage_maps_read_the_lda_damage_file(tmp_path):
+    """The plots take the LDA's own file through its reader: the map (max over planes), the
+    hot spots (with plane and nearest clip) and the rainflow matrix of the critical series."""
+    from cablelife.lda import analyse
+    from test_lda_pipeline import make_result
+
+    a = analyse(make_result())
+    maps = damage_maps(a.save(tmp_path / "a.damage.h5"), "variant A")
+    dm, rf = maps["harness"]
+    cd = a.cables["harness"]
+    np.testing.assert_array_equal(dm.damage, cd.damage)
+    np.testing.assert_array_equal(dm.angle, cd.angles)
+    assert dm.label == "variant A"
+    for mine, theirs in zip(dm.hot_spots(5), cd.hot_spots(5), strict=True):
+        assert mine.arc_length == theirs.arc_length and mine.damage == theirs.damage
+        assert np.degrees(mine.angle) == pytest.approx(theirs.angle)
+        assert mine.nearest_clip == theirs.nearest_clip
+    assert "clip C" in dm.hot_spots(1)[0].describe()
+    np.testing.assert_array_equal(rf.counts, cd.rainflow.counts)
+    fig = plot_rainflow_matrix(rf)
+    assert fig.axes[0].get_ylabel() == "range [MPa]"
+    assert "γ = 90°" in fig.axes[0].get_title() and "10 cycles" in fig.axes[0].get_title()
+    with pytest.raises(TypeError, match="give a DamageAnalysis or the path"):
+        damage_maps(42)
+    with pytest.raises(ValueError, match="not a cablelife damage file"):
+        damage_maps(make_result().save(tmp_path / "result.h5"))

@@ -15,5 +15,15 @@ def test_visuals_example_runs(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     exec(compile(code, "docs/visuals.md", "exec"), {"__name__": "docs_example"})
     out = tmp_path / "out"
-    for name in ("volume.stl", "fig2.png", "modes.png", "run.pvd", "report.html"):
+    for name in (
+        "volume.stl",
+        "fig2.png",
+        "modes.png",
+        "damage.png",
+        "rainflow.png",
+        "run.pvd",
+        "run/run_tube_00000.vtp",
+        "report.html",
+    ):
         assert (out / name).stat().st_size > 0, name
+    assert "rainflow matrix of hose" in (out / "report.html").read_text()

@@ -16,14 +16,15 @@ def paraview_command(
     cable: Annotated[str | None, typer.Option(help="cable name (default: every cable)")] = None,
     every: Annotated[int, typer.Option(help="write every k-th saved step")] = 1,
     damage: Annotated[
-        Path | None, typer.Option(help="damage file (HDF5): adds a damage array per node")
+        Path | None,
+        typer.Option(help="damage file of cablelife lda: damage on the line and on a tube part"),
     ] = None,
 ) -> None:
     """Write one VTK PolyData file per saved step plus a .pvd index for ParaView."""
     from rich.console import Console
 
     from cablelife.export.paraview import write_paraview
-    from cablelife.plots.fatigue_data import load_damage
+    from cablelife.plots.fatigue_data import damage_maps
     from cablelife.results import load_result
 
     err = Console(stderr=True)
@@ -32,20 +33,22 @@ def paraview_command(
             raise ValueError(f"every = {every}: must be >= 1")
         res = load_result(result)
         names = [cable] if cable is not None else list(res.cables)
-        maps = load_damage(damage) if damage is not None else {}
+        maps = damage_maps(damage) if damage is not None else {}
+        if maps and not set(maps) & set(names):
+            raise ValueError(
+                f"damage file {str(damage)!r} has the cables {', '.join(maps)}; the result "
+                f"{str(result)!r} has {', '.join(res.cables)}"
+            )
         written = []
         for name in names:
             if name not in res.cables:
                 raise ValueError(f"cable = {name!r}: {str(result)!r} has {', '.join(res.cables)}")
             out = output if len(names) == 1 else output.with_name(f"{output.stem}_{name}.pvd")
-            dm = maps.get(name) or (next(iter(maps.values())) if len(maps) == 1 else None)
+            dm = maps[name][0] if name in maps else None
+            if dm is not None:
+                dm.check_fits(res.cables[name].arc_length, f"cable {name!r} of {str(result)!r}")
             written.append(
-                write_paraview(
-                    res.cables[name],
-                    out,
-                    damage=dm[0] if dm else None,
-                    steps=slice(None, None, every),
-                )
+                write_paraview(res.cables[name], out, damage=dm, steps=slice(None, None, every))
             )
     except (ValueError, FileNotFoundError) as e:
         err.print(f"[bold red]error:[/] {e}", highlight=False)

@@ -6,6 +6,11 @@ Point data (nodes): ``moment`` (M1, M2, M3, material frame, N m), ``bending_mome
 get 1e9), ``displacement`` (from the first saved step, m), ``arc_length`` (m) and, when
 given, ``damage``. Cell data (edges): ``force`` (F1, F2, F3 material frame, N), ``force_global``
 (N), ``shear_force`` |F1, F2|, ``tension`` F3. Field data: ``tube_radius`` (m), ``time`` (s).
+
+With a damage map (an LDA result) every step also gets the tube surface as a second part
+(``<stem>_tube_<k>.vtp``, triangles): point data ``damage`` at each vertex (surface angle γ
+from d1 towards d2, as in the LDA), ``surface_angle`` (deg), ``arc_length``; cell data
+``damage`` (mean of the triangle's vertices).
 Data are written as ASCII (readable by any XML parser; fine for cables of a few hundred
 nodes). Every file is written atomically.
 """
@@ -72,10 +77,42 @@ def polydata_xml(
     )
 
 
-def pvd_xml(entries: list[tuple[float, str]]) -> str:
-    """A ParaView collection (.pvd) of (time, relative file name) entries."""
+def surface_xml(
+    points: np.ndarray,
+    faces: np.ndarray,
+    point_data: dict[str, np.ndarray],
+    cell_data: dict[str, np.ndarray],
+    field_data: dict[str, float],
+) -> str:
+    """A VTK XML PolyData document of a triangle surface."""
+    pd = "".join(_array(k, v) for k, v in point_data.items())
+    cd = "".join(_array(k, v) for k, v in cell_data.items())
+    fd = "".join(
+        f'<DataArray type="Float64" Name={quoteattr(k)} NumberOfTuples="1" format="ascii">'
+        f"{float(v)!r}</DataArray>"
+        for k, v in field_data.items()
+    )
+    return (
+        '<?xml version="1.0"?>\n'
+        '<VTKFile type="PolyData" version="1.0" byte_order="LittleEndian" '
+        'header_type="UInt64">\n<PolyData>\n'
+        f"<FieldData>{fd}</FieldData>\n"
+        f'<Piece NumberOfPoints="{len(points)}" NumberOfVerts="0" NumberOfLines="0" '
+        f'NumberOfStrips="0" NumberOfPolys="{len(faces)}">\n'
+        f"<PointData>{pd}</PointData>\n<CellData>{cd}</CellData>\n"
+        f"<Points>{_array('Points', points)}</Points>\n"
+        f"<Polys>{_ints('connectivity', np.ravel(faces))}"
+        f"{_ints('offsets', 3 * np.arange(1, len(faces) + 1))}</Polys>\n"
+        "</Piece>\n</PolyData>\n</VTKFile>\n"
+    )
+
+
+def pvd_xml(entries: list[tuple]) -> str:
+    """A ParaView collection (.pvd) of (time, relative file name[, part]) entries."""
     rows = "".join(
-        f'<DataSet timestep="{t!r}" group="" part="0" file={quoteattr(f)}/>\n' for t, f in entries
+        f'<DataSet timestep="{e[0]!r}" group="" part="{e[2] if len(e) > 2 else 0}" '
+        f"file={quoteattr(e[1])}/>\n"
+        for e in entries
     )
     return (
         '<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1" '
@@ -83,18 +120,51 @@ def pvd_xml(entries: list[tuple[float, str]]) -> str:
     )
 
 
+def _damage_map(damage):
+    """A DamageMap from a DamageMap or an LDA CableDamage; None for per-node arrays."""
+    from cablelife.plots.fatigue_data import DamageMap
+
+    if isinstance(damage, DamageMap):
+        return damage
+    if hasattr(damage, "damage_planes"):  # cablelife.lda CableDamage
+        return DamageMap.from_lda(damage)
+    return None
+
+
 def _node_damage(cable: CableResult, damage) -> np.ndarray | None:
     if damage is None:
         return None
-    if hasattr(damage, "along_cable"):  # a DamageMap: max around the section, at the nodes
-        return np.interp(cable.arc_length, damage.arc_length, damage.along_cable)
+    dmap = _damage_map(damage)
+    if dmap is not None:  # max around the section, at the nodes
+        return np.interp(cable.arc_length, dmap.arc_length, dmap.along_cable)
     d = np.asarray(damage, dtype=float)
     if d.shape != cable.arc_length.shape:
         raise ValueError(
-            f"damage has shape {d.shape}: must be one value per node {cable.arc_length.shape} "
-            "or a DamageMap"
+            f"damage has shape {d.shape}: must be one value per node {cable.arc_length.shape}, "
+            "a DamageMap or an LDA CableDamage"
         )
     return d
+
+
+def tube_angles(dmap) -> int:
+    """Vertices per ring of the damage tube: the map's own surface points when there are at
+    least 8 of them (no interpolation around the circumference at uniform angles), else 16."""
+    return int(dmap.angle.size) if dmap.angle.size >= 8 else 16
+
+
+def _tube_xml(cable: CableResult, k: int, dmap, radius: float, n_angles: int) -> str:
+    from cablelife.report.tube import tube_mesh
+
+    m = tube_mesh(cable.positions[k], cable.quaternions[k], radius, n_angles)
+    d = dmap.on_surface(cable.arc_length, m.angles).ravel()
+    point_data = {
+        "damage": d,
+        "surface_angle": np.tile(np.degrees(m.angles), cable.arc_length.size),
+        "arc_length": np.repeat(cable.arc_length, n_angles),
+    }
+    cell_data = {"damage": d[m.faces].mean(axis=1)}
+    fields = {"tube_radius": radius, "time": float(cable.time[k])}
+    return surface_xml(m.vertices, m.faces, point_data, cell_data, fields)
 
 
 def write_paraview(
@@ -106,7 +176,8 @@ def write_paraview(
 ) -> Path:
     """Writes the saved steps (all, or a slice/indices ``steps``) of ``cable`` as
     ``<output>.pvd`` plus ``<output stem>/<stem>_<k>.vtp``; returns the .pvd path.
-    ``damage``: one value per node, or a DamageMap (its maximum around each section)."""
+    ``damage``: one value per node, or a DamageMap or LDA CableDamage (its maximum around
+    each section on the line, the full map on an extra tube part ``<stem>_tube_<k>.vtp``)."""
     from cablelife.volume.sweep import select_steps
 
     output = Path(output)
@@ -117,7 +188,12 @@ def write_paraview(
     if idx.size == 0:
         raise ValueError(f"steps = {steps!r} selects no saved step")
     node_damage = _node_damage(cable, damage)
+    dmap = _damage_map(damage) if damage is not None else None
     radius = float(cable.section.get("outer_radius", 0.0))
+    if dmap is not None and not radius > 0:
+        raise ValueError(
+            f"cable {cable.name!r}: section outer_radius = {radius}: the damage tube needs > 0"
+        )
     curvature = cable.curvature
     bend = cable.bend_radius()
     entries = []
@@ -146,4 +222,8 @@ def write_paraview(
         name = f"{output.stem}_{int(k):05d}.vtp"
         write_text_atomic(folder / name, polydata_xml(x, point_data, cell_data, fields))
         entries.append((float(cable.time[k]), f"{folder.name}/{name}"))
+        if dmap is not None:
+            tube = f"{output.stem}_tube_{int(k):05d}.vtp"
+            write_text_atomic(folder / tube, _tube_xml(cable, k, dmap, radius, tube_angles(dmap)))
+            entries.append((float(cable.time[k]), f"{folder.name}/{tube}", 1))
     return write_text_atomic(output, pvd_xml(entries))

@@ -5,7 +5,7 @@ excitation spectrum, rainflow matrices and damage along the cable. See docs/visu
 from cablelife.plots.bend_radius import BendRadiusCheck, check_bend_radius, plot_bend_radius
 from cablelife.plots.clips import plot_clip_reactions
 from cablelife.plots.fatigue import plot_damage_along_cable, plot_rainflow_matrix
-from cablelife.plots.fatigue_data import DamageMap, HotSpot, RainflowMatrix, load_damage
+from cablelife.plots.fatigue_data import DamageMap, HotSpot, RainflowMatrix, damage_maps
 from cablelife.plots.figure import png_bytes, save_png
 from cablelife.plots.loads import plot_envelopes, plot_maxima_over_time
 from cablelife.plots.runs import QUANTITIES, Run, as_runs, quantity
@@ -20,7 +20,7 @@ __all__ = [
     "Run",
     "as_runs",
     "check_bend_radius",
-    "load_damage",
+    "damage_maps",
     "plot_bend_radius",
     "plot_clip_reactions",
     "plot_damage_along_cable",

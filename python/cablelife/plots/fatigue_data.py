@@ -1,61 +1,59 @@
-"""The inputs the pictures take from the fatigue analysis (LDA): a pseudo-damage map on the
-cable surface and a rainflow range–mean matrix. Plain arrays, so any analysis can feed them.
+"""The inputs the pictures take from the fatigue analysis (LDA): a damage map on the cable
+surface with its hot spots, and a rainflow range–mean matrix. Plain arrays, so any analysis can
+feed them; :func:`damage_maps` makes them from an LDA result or damage file (read by
+:func:`cablelife.lda.io.load_damage`, the one reader of damage files).
 
-A damage file (HDF5) is read by :func:`load_damage` when it holds, either at the root or in
-``/cables/<name>/`` (one map per cable)::
-
-    arc_length   (S,)    m     stations along the cable (cross sections)
-    angle        (G,)    rad   surface angle γ of the sample points (``surface_angle`` too)
-    damage       (S, G)  1     damage per station and surface point (max over planes)
-    rainflow/range_edges (R+1,), rainflow/mean_edges (M+1,), rainflow/counts (R, M)  optional
+Angle convention (as in the LDA): the surface angle γ is measured from the section axis d1
+towards d2, so the surface point is x + r (cos γ d1 + sin γ d2).
 """
 
 from __future__ import annotations
 
+import math
 import os
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
+from cablelife.lda.rainflow import RainflowMatrix
 
-@dataclass
-class RainflowMatrix:
-    """Cycle counts (R, M) in bins of range (edges (R+1,)) and mean (edges (M+1,))."""
-
-    range_edges: np.ndarray
-    mean_edges: np.ndarray
-    counts: np.ndarray
-    unit: str = "MPa"
-    label: str = ""
-
-    def __post_init__(self):
-        self.range_edges = np.asarray(self.range_edges, dtype=float)
-        self.mean_edges = np.asarray(self.mean_edges, dtype=float)
-        self.counts = np.asarray(self.counts, dtype=float)
-        want = (self.range_edges.size - 1, self.mean_edges.size - 1)
-        if self.counts.shape != want:
-            raise ValueError(
-                f"counts has shape {self.counts.shape}: must be {want} "
-                "(len(range_edges) - 1, len(mean_edges) - 1)"
-            )
+__all__ = ["DamageMap", "HotSpot", "RainflowMatrix", "damage_maps"]
 
 
 @dataclass
 class HotSpot:
+    """A damage maximum on the surface; the LDA's hot spots also give the plane and clip."""
+
     arc_length: float  # m
-    angle: float  # rad
+    angle: float  # rad, surface angle γ
     damage: float
+    plane: float | None = None  # rad, critical plane φ from the cable axis
+    nearest_clip: str | None = None
+    clip_distance: float | None = None  # m
+
+    def describe(self) -> str:
+        """One line: s, γ, damage and, when known, the nearest clip."""
+        clip = (
+            f", {self.clip_distance * 1e3:.0f} mm from clip {self.nearest_clip}"
+            if self.nearest_clip is not None and self.clip_distance is not None
+            else ""
+        )
+        return (
+            f"s = {self.arc_length:.3f} m, γ = {math.degrees(self.angle):.0f}°, "
+            f"D = {self.damage:.3g}{clip}"
+        )
 
 
 @dataclass
 class DamageMap:
-    """Damage (S, G) over stations ``arc_length`` (S,) m and surface angles ``angle`` (G,) rad."""
+    """Damage (S, G) over stations ``arc_length`` (S,) m and surface angles ``angle`` (G,) rad;
+    ``spots``: the analysis' own hot spots (else :meth:`hot_spots` finds them)."""
 
     arc_length: np.ndarray
     angle: np.ndarray
     damage: np.ndarray
     label: str = ""
+    spots: list[HotSpot] | None = None
 
     def __post_init__(self):
         self.arc_length = np.asarray(self.arc_length, dtype=float)
@@ -70,13 +68,47 @@ class DamageMap:
         if np.any(self.damage < 0) or not np.all(np.isfinite(self.damage)):
             raise ValueError("damage: must be finite and >= 0")
 
+    @classmethod
+    def from_lda(cls, cable_damage, label: str = "", n_hot_spots: int = 5) -> DamageMap:
+        """The map of an LDA :class:`~cablelife.lda.pipeline.CableDamage` (max over the
+        planes) with the LDA's hot spots (local maxima along s, nearest clip)."""
+        spots = [
+            HotSpot(
+                h.arc_length,
+                math.radians(h.angle),
+                h.damage,
+                math.radians(h.plane),
+                h.nearest_clip,
+                h.clip_distance,
+            )
+            for h in cable_damage.hot_spots(n_hot_spots)
+        ]
+        c = cable_damage
+        return cls(c.arc_length, c.angles, c.damage, label or c.cable, spots)
+
+    def check_fits(self, arc_length: np.ndarray, what: str = "the cable") -> None:
+        """ValueError unless the map's stations lie on ``arc_length`` (a cable's nodes, m)."""
+        s = np.asarray(arc_length, dtype=float)
+        tol = 1e-9 * max(1.0, float(abs(s).max()))
+        if self.arc_length.size and (
+            self.arc_length.min() < s[0] - tol or self.arc_length.max() > s[-1] + tol
+        ):
+            raise ValueError(
+                f"damage map {self.label!r} spans s = {self.arc_length.min():.4g} … "
+                f"{self.arc_length.max():.4g} m, but {what} spans {s[0]:.4g} … {s[-1]:.4g} m: "
+                "the damage file belongs to another result"
+            )
+
     @property
     def along_cable(self) -> np.ndarray:
         """Largest damage around the circumference per station, (S,)."""
         return self.damage.max(axis=1)
 
     def hot_spots(self, count: int = 3, separation: float = 0.05) -> list[HotSpot]:
-        """The ``count`` largest damages at stations at least ``separation`` (m) apart."""
+        """The analysis' hot spots when given, else the ``count`` largest damages at stations
+        at least ``separation`` (m) apart."""
+        if self.spots is not None:
+            return self.spots[:count]
         along = self.along_cable
         spots: list[HotSpot] = []
         for i in np.argsort(along)[::-1]:
@@ -88,29 +120,35 @@ class DamageMap:
                 spots.append(HotSpot(float(s), float(self.angle[j]), float(self.damage[i, j])))
         return spots
 
+    def on_surface(self, arc_length: np.ndarray, angles: np.ndarray) -> np.ndarray:
+        """Damage (len(arc_length), len(angles)) at other stations and surface angles: linear
+        in s (constant beyond the ends), periodic-linear in γ."""
+        s = np.asarray(arc_length, dtype=float)
+        along = np.array([np.interp(s, self.arc_length, col) for col in self.damage.T]).T
+        order = np.argsort(np.mod(self.angle, 2 * np.pi))
+        a = np.mod(self.angle, 2 * np.pi)[order]
+        a = np.concatenate([a, [a[0] + 2 * np.pi]])
+        rows = np.concatenate([along[:, order], along[:, order[:1]]], axis=1)
+        g = np.mod(np.asarray(angles, dtype=float) - a[0], 2 * np.pi) + a[0]
+        return np.array([np.interp(g, a, row) for row in rows])
 
-def _group_maps(g, label: str) -> tuple[DamageMap, RainflowMatrix | None]:
-    angle_key = "angle" if "angle" in g else "surface_angle"
-    for key in ("arc_length", angle_key, "damage"):
-        if key not in g:
-            raise ValueError(f"damage file group {g.name!r} has no dataset {key!r}")
-    dm = DamageMap(g["arc_length"][()], g[angle_key][()], g["damage"][()], label)
-    rf = None
-    if "rainflow" in g:
-        r = g["rainflow"]
-        rf = RainflowMatrix(r["range_edges"][()], r["mean_edges"][()], r["counts"][()], label=label)
-    return dm, rf
 
+def damage_maps(source, label: str = "") -> dict[str, tuple[DamageMap, RainflowMatrix | None]]:
+    """Damage map and rainflow matrix (None when the file has none) per cable of an LDA
+    result: a :class:`~cablelife.lda.pipeline.DamageAnalysis` or a damage file written by
+    ``cablelife lda``."""
+    from cablelife.lda.io import load_damage
+    from cablelife.lda.pipeline import DamageAnalysis
 
-def load_damage(path: str | os.PathLike) -> dict[str, tuple[DamageMap, RainflowMatrix | None]]:
-    """Damage maps (and rainflow matrices when present) per cable from an HDF5 damage file; a
-    file with the datasets at its root gives one entry named after the file."""
-    import h5py
-
-    path = Path(path)
-    if not path.exists():
-        raise FileNotFoundError(f"damage file {str(path)!r} does not exist")
-    with h5py.File(path, "r") as f:
-        if "cables" in f:
-            return {n: _group_maps(g, f"{path.stem}: {n}") for n, g in f["cables"].items()}
-        return {path.stem: _group_maps(f, path.stem)}
+    if isinstance(source, str | os.PathLike):
+        source = load_damage(source)
+    if not isinstance(source, DamageAnalysis):
+        raise TypeError(
+            f"damage source: got {type(source).__name__}; give a DamageAnalysis or the path of "
+            "a damage file (cablelife lda RESULT.h5 -o DAMAGE.h5)"
+        )
+    out = {}
+    for name, c in source.cables.items():
+        lab = f"{label}: {name}" if label and len(source.cables) > 1 else (label or name)
+        out[name] = (DamageMap.from_lda(c, lab), c.rainflow)
+    return out

@@ -8,6 +8,15 @@ from matplotlib.figure import Figure
 from cablelife.plots.figure import new_figure
 
 
+def excited_band(frequency, psd, band_level: float = 0.0) -> tuple[float, float]:
+    """(lowest, highest) frequency where the largest of the PSDs ((F,) or (C, F)) exceeds
+    ``band_level`` × its peak; (0, 0) when every PSD is zero."""
+    f = np.asarray(frequency, dtype=float)
+    top = np.atleast_2d(np.asarray(psd, dtype=float)).max(axis=0)
+    band = f[top > band_level * top.max()] if np.any(top > 0) else f[:0]
+    return (float(band.min()), float(band.max())) if band.size else (0.0, 0.0)
+
+
 def plot_frequencies_over_spectrum(
     natural_frequencies,
     frequency,
@@ -15,10 +24,13 @@ def plot_frequencies_over_spectrum(
     *,
     psd_label: str = "excitation PSD",
     psd_unit: str = "(m/s²)²/Hz",
+    labels: list[str] | None = None,
+    band_level: float = 0.0,
 ) -> Figure:
-    """The excitation PSD (``frequency`` (F,) Hz, ``psd`` (F,) or (C, F) for C channels) on
-    log-log axes, with a vertical line at each natural frequency (Hz) labelled by mode number.
-    Modes inside the excited band are drawn red."""
+    """The excitation PSD (``frequency`` (F,) Hz, ``psd`` (F,) or (C, F) for C channels, named
+    by ``labels``) on log-log axes, with a vertical line at each natural frequency (Hz)
+    labelled by mode number. Modes inside the excited band (where the largest PSD exceeds
+    ``band_level`` × its peak) are drawn red."""
     fn = np.atleast_1d(np.asarray(natural_frequencies, dtype=float))
     f = np.asarray(frequency, dtype=float)
     g = np.atleast_2d(np.asarray(psd, dtype=float))
@@ -28,6 +40,10 @@ def plot_frequencies_over_spectrum(
         )
     if np.any(fn <= 0) or np.any(~np.isfinite(fn)):
         raise ValueError(f"natural_frequencies = {fn}: must be finite and > 0 Hz")
+    if labels is not None and len(labels) != len(g):
+        raise ValueError(f"labels: {len(labels)} given for {len(g)} PSD channels")
+    if not 0.0 <= band_level < 1.0:
+        raise ValueError(f"band_level = {band_level}: must be in [0, 1)")
     fig, axes = new_figure(1, 1, height=3.6)
     ax = axes[0, 0]
     for k, row in enumerate(g):
@@ -35,9 +51,9 @@ def plot_frequencies_over_spectrum(
             f,
             np.where(row > 0, row, np.nan),
             color=f"C{k}",
-            label=f"{psd_label} {k + 1}" if len(g) > 1 else psd_label,
+            label=labels[k] if labels else (f"{psd_label} {k + 1}" if len(g) > 1 else psd_label),
         )
-    excited = (f[g.max(axis=0) > 0].min(), f[g.max(axis=0) > 0].max()) if np.any(g > 0) else (0, 0)
+    excited = excited_band(f, g, band_level)
     for i, x in enumerate(fn):
         inside = excited[0] <= x <= excited[1]
         ax.axvline(x, color="red" if inside else "gray", lw=1, ls="-" if inside else "--")
@@ -50,6 +66,7 @@ def plot_frequencies_over_spectrum(
             ha="right",
             fontsize=7,
         )
+    ax.set_xlim(min(f[f > 0].min(initial=fn.min()), fn.min()) / 1.2, max(f.max(), fn.max()) * 1.2)
     ax.set_xlabel("frequency [Hz]")
     ax.set_ylabel(f"PSD [{psd_unit}]")
     ax.grid(alpha=0.3, which="both")

@@ -21,10 +21,44 @@ def is_result_file(path: Path) -> bool:
         raise ValueError(f"{str(path)!r} is not a readable HDF5 file: {e}") from None
 
 
+def _made_from(source: str, damage: Path, result: Path) -> bool:
+    """Whether a damage file's ``source`` (the result path given to ``cablelife lda``) names
+    ``result``: the same file seen from here or from the damage file's folder."""
+    if not source:
+        return False
+    src = Path(source)
+    for base in (Path.cwd(), damage.parent):
+        q = src if src.is_absolute() else base / src
+        if q.exists() and q.resolve() == result.resolve():
+            return True
+    return False
+
+
+def attach_damage(results: list[Path], damages: list[tuple[Path, object]]) -> dict[int, object]:
+    """Result index → damage analysis: a damage file goes to the result it was made from (its
+    ``source``), the others to the remaining results in order."""
+    attached: dict[int, object] = {}
+    rest = []
+    for path, analysis in damages:
+        hits = [i for i, r in enumerate(results) if _made_from(analysis.source, path, r)]
+        if len(hits) == 1 and hits[0] not in attached:
+            attached[hits[0]] = analysis
+        else:
+            rest.append((path, analysis))
+    free = [i for i in range(len(results)) if i not in attached]
+    if len(rest) > len(free):
+        raise ValueError(
+            f"{len(damages)} damage files for {len(results)} results: give at most one "
+            "damage file per result (matched by the result it was made from, else in order)"
+        )
+    attached.update((i, a) for i, (_, a) in zip(free, rest, strict=False))
+    return attached
+
+
 def report_runs(files: list[Path]):
-    """Result files become runs (labelled by file stem); damage files are attached to the
-    results in order: the k-th damage file to the k-th result."""
-    from cablelife.plots.fatigue_data import load_damage
+    """Result files become runs (labelled by file stem); each damage file (``cablelife lda``)
+    is attached to the result it was made from, else to the results in order."""
+    from cablelife.lda.io import load_damage
     from cablelife.report.html import ReportRun
     from cablelife.results import load_result
 
@@ -32,27 +66,28 @@ def report_runs(files: list[Path]):
     for p in files:
         if not p.exists():
             raise FileNotFoundError(f"file {str(p)!r} does not exist")
-        (results if is_result_file(p) else damages).append(p)
+        if is_result_file(p):
+            results.append(p)
+        else:
+            damages.append((p, load_damage(p)))
     if not results:
         raise ValueError("files: give at least one result file (RESULT.h5)")
-    if len(damages) > len(results):
-        raise ValueError(
-            f"{len(damages)} damage files for {len(results)} results: give at most one "
-            "damage file per result, in the same order"
-        )
+    attached = attach_damage(results, damages)
     runs = []
     for k, p in enumerate(results):
         stem = (
             p.stem if [q.stem for q in results].count(p.stem) == 1 else f"{p.parent.name}/{p.stem}"
         )
-        damage = load_damage(damages[k]) if k < len(damages) else {}
-        runs.append(ReportRun(stem, load_result(p), damage))
+        runs.append(ReportRun(stem, load_result(p), attached.get(k)))
     return runs
 
 
 def report_command(
     files: Annotated[
-        list[Path], typer.Argument(help="result files, then damage files in the same order")
+        list[Path],
+        typer.Argument(
+            help="result files and damage files (cablelife lda), each matched to its result"
+        ),
     ],
     output: Annotated[Path, typer.Option("-o", "--output", help="HTML file")] = Path("report.html"),
     color_by: Annotated[

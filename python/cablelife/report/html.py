@@ -1,12 +1,13 @@
-"""The HTML report: one self-contained, offline page (plotly.js embedded once, PNGs inline)
-with a comparison of the runs, and per run its scene summary, solver statistics, maxima, bend
-radius check, clip reactions, 3D views and, when damage maps are given, the damage pictures
-and hot spots. The page records in ``<body data-*>`` how many figures and images rendered and
-any script errors (used by the test in headless Chromium)."""
+"""The HTML report: one self-contained, offline page (plotly.js embedded once, every plot
+interactive) with a comparison of the runs (ranking by pseudo-damage via
+:func:`cablelife.lda.compare`, motion volumes overlaid), and per run its scene summary, solver
+statistics, maxima, bend radius check, clip reactions, natural frequencies over the excitation
+spectrum, 3D views and, with an LDA result, the damage pictures, hot spots and rainflow matrix.
+The page records in ``<body data-*>`` how many figures rendered and any script errors (used by
+the test in headless Chromium)."""
 
 from __future__ import annotations
 
-import base64
 import datetime as _dt
 import html
 import os
@@ -16,46 +17,68 @@ from pathlib import Path
 import numpy as np
 
 from cablelife.atomic import write_text_atomic
+from cablelife.lda.pipeline import DamageAnalysis
 from cablelife.plots import (
     DamageMap,
     RainflowMatrix,
     Run,
     check_bend_radius,
+    damage_maps,
     plot_bend_radius,
     plot_clip_reactions,
     plot_damage_along_cable,
     plot_envelopes,
+    plot_frequencies_over_spectrum,
     plot_rainflow_matrix,
-    png_bytes,
 )
 from cablelife.plots.bend_radius import DEFAULT_FACTOR
+from cablelife.plots.spectrum import excited_band
 from cablelife.report.interactive import maxima_over_time_figure
-from cablelife.report.scene3d import FRAMES, cable_figure, damage_figure
+from cablelife.report.scene3d import FRAMES, cable_figure, damage_figure, volumes_figure
 from cablelife.results import Result
 from cablelife.summary import cable_summary
+
+#: Natural frequencies computed per cable, and the excited band's level below the PSD peak.
+N_MODES = 10
+BAND_LEVEL = 1e-4
 
 
 @dataclass
 class ReportRun:
-    """One run in the report: its result, a label, and damage data per cable (optional)."""
+    """One run in the report: a label, its result and optionally its LDA result (a
+    DamageAnalysis or the path of a damage file of ``cablelife lda``)."""
 
     label: str
     result: Result
-    damage: dict[str, tuple[DamageMap, RainflowMatrix | None]] = field(default_factory=dict)
+    damage: DamageAnalysis | str | os.PathLike | None = None
+    _maps: dict = field(default_factory=dict, init=False, repr=False)
 
-    def damage_of(self, cable: str):
-        if cable in self.damage:
-            return self.damage[cable]
-        if len(self.damage) == 1 and len(self.result.cables) == 1:
-            return next(iter(self.damage.values()))
-        return None
+    def __post_init__(self):
+        if self.damage is None:
+            return
+        if isinstance(self.damage, str | os.PathLike):
+            from cablelife.lda.io import load_damage
+
+            self.damage = load_damage(self.damage)
+        self._maps = damage_maps(self.damage, self.label)
+        have = list(self.result.cables)
+        for name, (dm, _) in self._maps.items():
+            if name not in self.result.cables:
+                raise ValueError(
+                    f"run {self.label!r}: the damage data has cable {name!r}, the result has "
+                    f"{have}: the damage file belongs to another result"
+                )
+            dm.check_fits(self.result.cables[name].arc_length, f"cable {name!r} of {self.label!r}")
+
+    def damage_of(self, cable: str) -> tuple[DamageMap, RainflowMatrix | None] | None:
+        """Damage map and rainflow matrix of ``cable`` (None without damage data)."""
+        return self._maps.get(cable)
 
 
 class _Page:
     def __init__(self):
         self.parts: list[str] = []
         self.figures = 0
-        self.images = 0
 
     def add(self, text: str) -> None:
         self.parts.append(text)
@@ -64,12 +87,13 @@ class _Page:
         a = f' id="{html.escape(anchor)}"' if anchor else ""
         self.add(f"<h{level}{a}>{html.escape(text)}</h{level}>")
 
-    def png(self, fig, alt: str) -> None:
-        data = base64.b64encode(png_bytes(fig)).decode("ascii")
-        self.images += 1
-        self.add(f'<img class="plot" alt="{html.escape(alt)}" src="data:image/png;base64,{data}">')
+    def plot(self, fig, alt: str) -> None:
+        """A matplotlib figure, drawn interactively (plotly) from the same artists."""
+        from cablelife.report.mpl_plotly import to_plotly
 
-    def plotly(self, fig) -> None:
+        self.plotly(to_plotly(fig), alt)
+
+    def plotly(self, fig, alt: str = "") -> None:
         import plotly.io as pio
 
         self.figures += 1
@@ -81,7 +105,8 @@ class _Page:
             auto_play=False,
             config={"displaylogo": False},
         )
-        self.add(f'<div class="figure">{div}</div>')
+        label = f' aria-label="{html.escape(alt)}"' if alt else ""
+        self.add(f'<div class="figure"{label}>{div}</div>')
 
     def table(self, header: list[str], rows: list[list], caption: str = "") -> None:
         cap = f"<caption>{html.escape(caption)}</caption>" if caption else ""
@@ -120,11 +145,66 @@ def _runs_of(runs: list[ReportRun]) -> list[Run]:
     return out
 
 
-def _max_damage(r: ReportRun) -> float | None:
-    values = [
-        float(d[0].damage.max()) for n in r.result.cables if (d := r.damage_of(n)) is not None
+def _ranking(page: _Page, runs: list[ReportRun], summaries) -> None:
+    """Ranking by maximum (pseudo-)damage with ratios and hot spots when every run has an LDA
+    result with the same settings, else by maximum bending moment (the reason noted)."""
+    from cablelife.lda.compare import compare
+
+    missing = [r.label for r in runs if r.damage is None]
+    reason = "no run has a damage file"
+    if not missing:
+        try:
+            cmp = compare([r.damage for r in runs], labels=[r.label for r in runs])
+        except ValueError as e:
+            reason = str(e)
+        else:
+            kind = (
+                "pseudo-damage" if all(v.analysis.curve.pseudo for v in cmp.variants) else "damage"
+            )
+            rows = []
+            for i, v in enumerate(cmp.variants, 1):
+                for j, h in enumerate(v.hot_spots or [None]):
+                    head = [i, v.label, _g(v.max_damage), _g(v.ratio)] if j == 0 else [""] * 4
+                    rows.append(head + _spot_cells(h))
+            page.table(
+                ["rank", "variant", f"max {kind}", "ratio to best", *SPOT_HEADER],
+                rows,
+                f"ranking by maximum {kind} (lower is better) with the hot spots",
+            )
+            return
+    elif len(missing) < len(runs):
+        reason = f"no damage file for {', '.join(missing)}"
+    page.note(f"no damage ranking: {reason}", "warning" if not missing else "note")
+    ranked = sorted(summaries, key=lambda x: x[1]["max_bending"])
+    page.table(
+        ["rank", "variant", "max bending moment"],
+        [[i + 1, lab, _g(s["max_bending"], "N m")] for i, (lab, s) in enumerate(ranked)],
+        "ranking by maximum bending moment",
+    )
+
+
+SPOT_HEADER = ["hot spot s [m]", "angle γ [°]", "plane φ [°]", "damage", "nearest clip"]
+
+
+def _spot_cells(h) -> list[str]:
+    """Table cells of a hot spot (an LDA HotSpot, angles in degrees, or a plots HotSpot)."""
+    if h is None:
+        return ["–"] * len(SPOT_HEADER)
+    lda = hasattr(h, "section_index")
+    angle = h.angle if lda else np.degrees(h.angle)
+    plane = h.plane if lda else (None if h.plane is None else np.degrees(h.plane))
+    clip = "–"
+    if h.nearest_clip is not None:
+        clip = h.nearest_clip
+        if h.clip_distance is not None:
+            clip += f" ({h.clip_distance * 1e3:.0f} mm away)"
+    return [
+        f"{h.arc_length:.3f}",
+        f"{angle:.0f}",
+        "–" if plane is None else f"{plane:.0f}",
+        _g(h.damage),
+        clip,
     ]
-    return max(values) if values else None
 
 
 def _comparison(page: _Page, runs: list[ReportRun], volumes: dict, voxel: float, factor: float):
@@ -136,25 +216,7 @@ def _comparison(page: _Page, runs: list[ReportRun], volumes: dict, voxel: float,
         [[lab, *[_g(s[key], unit) for _, s in summaries]] for key, lab, unit in MAXIMA],
         "maxima over time and arc length",
     )
-    damages = [(r.label, _max_damage(r)) for r in runs]
-    if all(d is not None for _, d in damages):
-        ranked = sorted(damages, key=lambda x: x[1])
-        best = ranked[0][1]
-        page.table(
-            ["rank", "variant", "max pseudo-damage", "ratio to best"],
-            [
-                [i + 1, lab, _g(d), _g(d / best if best > 0 else np.inf)]
-                for i, (lab, d) in enumerate(ranked)
-            ],
-            "ranking by maximum pseudo-damage (lower is better)",
-        )
-    else:
-        ranked = sorted(summaries, key=lambda x: x[1]["max_bending"])
-        page.table(
-            ["rank", "variant", "max bending moment"],
-            [[i + 1, lab, _g(s["max_bending"], "N m")] for i, (lab, s) in enumerate(ranked)],
-            "ranking by maximum bending moment (not every run has a damage file)",
-        )
+    _ranking(page, runs, summaries)
     if len(volumes) == 2:
         from cablelife.volume import compare_volumes
 
@@ -174,17 +236,69 @@ def _comparison(page: _Page, runs: list[ReportRun], volumes: dict, voxel: float,
             ],
             f"motion volumes at {voxel * 1e3:g} mm voxels",
         )
+    if len(volumes) >= 2:
+        cables = {r.label: r.result.cable for r in runs if len(r.result.cables) == 1}
+        page.plotly(volumes_figure(volumes, cables), "motion volumes of the runs")
     page.plotly(maxima_over_time_figure(plot_runs))
-    page.png(plot_envelopes(plot_runs), "envelopes along the cable")
-    page.png(plot_bend_radius(plot_runs, factor), "smallest bend radius along the cable")
+    page.plot(plot_envelopes(plot_runs), "envelopes along the cable")
+    page.plot(plot_bend_radius(plot_runs, factor), "smallest bend radius along the cable")
     maps = [
-        DamageMap(d[0].arc_length, d[0].angle, d[0].damage, r.label)
+        d[0]
         for r in runs
         for n in r.result.cables
-        if (d := r.damage_of(n)) is not None
+        if (d := r.damage_of(n)) is not None and d[0].damage.max() > 0
     ]
     if maps:
-        page.png(plot_damage_along_cable(maps), "damage along the cable")
+        page.plot(plot_damage_along_cable(maps), "damage along the cable")
+
+
+def _frequencies(page: _Page, res: Result, name: str) -> None:
+    """Natural frequencies of the mounted cable (about its static equilibrium, bodies at rest)
+    over the acceleration PSD at its clips on moving bodies."""
+    from cablelife.modal import cable_modes
+    from cablelife.report.scene_data import excitation_psd, result_scene
+    from cablelife.scene import SceneError
+    from cablelife.signals import SignalError
+
+    try:
+        scene = result_scene(res.scene_toml)
+        spec = next(c for c in scene.cables if c.name == name)
+        fn = cable_modes(scene, spec, N_MODES).frequencies
+    except (SceneError, SignalError, StopIteration, ValueError) as e:
+        page.note(f"natural frequencies not available: {e or 'cable not in the scene'}")
+        return
+    try:
+        exc = excitation_psd(scene, name, res.mode)
+    except (SceneError, SignalError, ValueError, OSError) as e:
+        page.table(
+            ["mode", *range(1, fn.size + 1)],
+            [["f [Hz]", *[f"{x:.4g}" for x in fn]]],
+            f"natural frequencies of the mounted cable (no excitation spectrum: {e})",
+        )
+        return
+    lo, hi = excited_band(exc.frequency, exc.psd, BAND_LEVEL)
+    inside = [i + 1 for i, x in enumerate(fn) if lo <= x <= hi]
+    page.table(
+        ["mode", *range(1, fn.size + 1)],
+        [
+            ["f [Hz]", *[f"{x:.4g}" for x in fn]],
+            ["excited", *["yes" if i + 1 in inside else "" for i in range(fn.size)]],
+        ],
+        f"natural frequencies of the mounted cable; excited band {lo:.3g} – {hi:.3g} Hz "
+        f"(acceleration PSD above {BAND_LEVEL:g} × its peak)",
+    )
+    if inside and res.mode == "quasistatic":
+        page.note(
+            f"modes {inside} lie inside the excited band: the quasistatic run ignores their "
+            "resonance; run the scene in dynamic mode",
+            "warning",
+        )
+    page.plot(
+        plot_frequencies_over_spectrum(
+            fn, exc.frequency, exc.psd, labels=exc.labels, band_level=BAND_LEVEL
+        ),
+        f"natural frequencies of {name} over the excitation spectrum",
+    )
 
 
 def _run_section(page, k, run: ReportRun, volumes, color_by, frames, factor):
@@ -257,43 +371,70 @@ def _run_section(page, k, run: ReportRun, volumes, color_by, frames, factor):
                 + " × ".join(f"[{a:.1f}, {b:.1f}]" for a, b in zip(box[0], box[1], strict=True))
                 + " mm"
             )
-        page.plotly(cable_figure(c, color_by, frames=frames, volume=vol, scene_toml=res.scene_toml))
+        page.plotly(
+            cable_figure(
+                c, color_by, frames=frames, volume=vol, scene_toml=res.scene_toml, mode=res.mode
+            )
+        )
         one = [Run(run.label, c, res.mode)]
         page.plotly(maxima_over_time_figure(one))
-        page.png(plot_envelopes(one), f"envelopes of {name}")
-        page.png(plot_bend_radius(one, factor), f"bend radius of {name}")
+        page.plot(plot_envelopes(one), f"envelopes of {name}")
+        page.plot(plot_bend_radius(one, factor), f"bend radius of {name}")
         if c.clips:
-            page.png(plot_clip_reactions(one), f"clip reactions of {name}")
-        dmg = run.damage_of(name)
-        if dmg is not None:
-            dm, rf = dmg
-            spots = dm.hot_spots(5)
-            page.table(
-                ["hot spot", "s [m]", "angle γ [°]", "damage", "nearest clip"],
-                [
-                    [
-                        i + 1,
-                        f"{h.arc_length:.3f}",
-                        f"{np.degrees(h.angle):.0f}",
-                        _g(h.damage),
-                        _nearest_clip(c, h.arc_length),
-                    ]
-                    for i, h in enumerate(spots)
-                ],
-                "damage hot spots",
-            )
-            page.plotly(damage_figure(c, dm))
-            clips = {n: r.s for n, r in c.clips.items()}
-            page.png(plot_damage_along_cable([dm], clips), f"damage along {name}")
-            if rf is not None:
-                page.png(plot_rainflow_matrix(rf), f"rainflow matrix of {name}")
+            page.plot(plot_clip_reactions(one), f"clip reactions of {name}")
+        _frequencies(page, res, name)
+        if run.damage_of(name) is not None:
+            _damage_section(page, run, name)
 
 
-def _nearest_clip(c, s: float) -> str:
-    if not c.clips:
-        return "–"
-    n, r = min(c.clips.items(), key=lambda kv: abs(kv[1].s - s))
-    return f"{n} ({abs(r.s - s) * 1e3:.0f} mm away)"
+def _damage_section(page: _Page, run: ReportRun, name: str) -> None:
+    """LDA settings, hot spots, the damage on the surface (3D), along the cable and the
+    rainflow matrix of the most damaged series."""
+    res, c = run.result, run.result.cables[name]
+    dm, rf = run.damage_of(name)
+    a = run.damage
+    curve = a.curve
+    kind = "pseudo-damage" if curve.pseudo else "damage"
+    st = a.settings
+    cd = a.cables[name]
+    rows = [
+        [f"max {kind}", _g(cd.max_damage)],
+        [
+            "Wöhler curve (ranges)",
+            f"k = {curve.k:g}, α = {curve.alpha:.4g} Pa^k"
+            + ("" if curve.knee_range is None else f", knee {curve.knee_range:.4g} Pa"),
+        ],
+        [
+            "settings",
+            f"{st['n_points']} surface points, planes every {st['plane_step_deg']:g}°, "
+            f"section step {st['section_step']}, residue {st['residue']}",
+        ],
+    ]
+    if cd.sampling is not None:
+        rows.append(
+            [
+                "sampling",
+                f"{cd.sampling.samples_per_period:.1f} samples per period of "
+                f"{cd.sampling.f_max:.3g} Hz"
+                + ("" if cd.sampling.ok else " (damage undercounted)"),
+            ]
+        )
+    page.table(["fatigue analysis (LDA)", "value"], rows)
+    if dm.damage.max() <= 0:
+        page.note(f"{kind} is zero everywhere: no load cycles")
+        return
+    page.table(
+        ["#", *SPOT_HEADER],
+        [[i + 1, *_spot_cells(h)] for i, h in enumerate(dm.hot_spots(5))],
+        "damage hot spots (local maxima along the cable)",
+    )
+    page.plotly(damage_figure(c, dm, scene_toml=res.scene_toml, mode=res.mode))
+    clips = {n: r.s for n, r in c.clips.items()}
+    page.plot(plot_damage_along_cable([dm], clips), f"damage along {name}")
+    if rf is not None:
+        page.plot(plot_rainflow_matrix(rf), f"rainflow matrix of {name}")
+    else:
+        page.note("the damage file has no rainflow matrix (older file): rerun cablelife lda")
 
 
 CSS = """
@@ -302,7 +443,7 @@ h1{font-size:1.6em}h2{border-bottom:2px solid #ccd;padding-bottom:.2em;margin-to
 table{border-collapse:collapse;margin:.8em 0;font-size:.9em}
 caption{text-align:left;font-weight:600;padding:.3em 0}
 th,td{border:1px solid #ccd;padding:.25em .6em;text-align:left}th{background:#eef}
-img.plot{max-width:100%;display:block;margin:.8em 0}.figure{margin:1em 0}
+.figure{margin:1em 0}
 .warning{color:#a00;font-weight:600}.note{color:#335}nav a{margin-right:1em}
 """
 
@@ -317,9 +458,7 @@ window.addEventListener('load',function(){setTimeout(function(){
 var figs=document.querySelectorAll('.js-plotly-plot'),ok=0;
 figs.forEach(function(f){var L=f._fullLayout||{},gl=L._has&&L._has('gl3d');
 if(f.querySelector('.main-svg')&&L.width>0&&(!gl||f.querySelector('canvas')))ok++});
-var imgs=document.querySelectorAll('img.plot'),iok=0;
-imgs.forEach(function(i){if(i.complete&&i.naturalWidth>0)iok++});
-var b=document.body.dataset;b.renderedFigures=ok;b.renderedImages=iok;
+var b=document.body.dataset;b.renderedFigures=ok;
 b.errors=JSON.stringify(window.__errors);b.checked='yes';},1500)});
 </script>"""
 
@@ -365,7 +504,7 @@ def build_report(
         '<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8">'
         f"<title>{html.escape(title)}</title><style>{CSS}</style>{CHECK_HEAD}"
         f'<script type="text/javascript">{get_plotlyjs()}</script></head>'
-        f'<body data-expected-figures="{page.figures}" data-expected-images="{page.images}">'
+        f'<body data-expected-figures="{page.figures}">'
         f"\n{body}\n{CHECK_TAIL}</body></html>\n"
     )
 

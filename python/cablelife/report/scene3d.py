@@ -1,6 +1,6 @@
 """Interactive 3D views (plotly): the cable as a tube colour-coded by a section quantity with a
-time slider, clips marked, the motion volume as a translucent mesh, and the damage map on the
-tube surface with its hot spots labelled."""
+time slider, clips and bodies (origin, axes, links to their clips) marked, the motion volume as
+a translucent mesh, and the damage map on the tube surface with its hot spots labelled."""
 
 from __future__ import annotations
 
@@ -10,8 +10,10 @@ import numpy as np
 
 from cablelife.plots.fatigue_data import DamageMap
 from cablelife.plots.runs import QUANTITIES, quantity
-from cablelife.report.tube import tube_mesh
+from cablelife.report.scene_data import BodyPose
+from cablelife.report.tube import node_frames, tube_mesh
 from cablelife.results import CableResult
+from cablelife.scene import SceneError
 
 #: Default number of animation frames (the saved steps are subsampled evenly).
 FRAMES = 40
@@ -27,6 +29,36 @@ def clip_bodies(scene_toml: str, cable: str) -> dict[str, str]:
         if c.get("name") == cable:
             return {k.get("name", ""): k.get("body", "world") for k in c.get("clips", [])}
     return {}
+
+
+def scene_bodies(scene_toml: str, cable: CableResult, mode: str | None = None) -> list[BodyPose]:
+    """The bodies of a result's scene at the cable's saved steps (``mode``: the run's mode,
+    default the scene's); at rest when the motions cannot be evaluated (e.g. a measured file
+    that is not at hand), none when the scene is unknown."""
+    from cablelife.report.scene_data import body_poses, result_scene
+    from cablelife.signals import SignalError
+    from cablelife.simulate import euler_matrix
+
+    try:
+        scene = result_scene(scene_toml)
+    except (SceneError, ValueError):
+        return []
+    mode = mode or scene.simulation.mode
+    try:
+        return body_poses(scene, cable.name, cable.time, mode)
+    except (SceneError, SignalError, OSError, ValueError):
+        n = cable.n_steps
+        bodies = clip_bodies(scene_toml, cable.name)
+        return [
+            BodyPose(
+                b.name,
+                np.tile(np.asarray(b.origin, float), (n, 1)),
+                np.tile(euler_matrix(b.orientation), (n, 1, 1)),
+                [c for c, name in bodies.items() if name == b.name],
+                False,
+            )
+            for b in scene.bodies
+        ]
 
 
 def frame_steps(n_steps: int, frames: int) -> np.ndarray:
@@ -60,13 +92,16 @@ def _layout(fig, title: str, box: np.ndarray) -> None:
     )
 
 
+def _clip_nodes(cable: CableResult) -> dict[str, int]:
+    return {n: int(np.argmin(np.abs(cable.arc_length - c.s))) for n, c in cable.clips.items()}
+
+
 def _clip_trace(cable: CableResult, k: int, bodies: dict[str, str]):
     import plotly.graph_objects as go
 
-    names = list(cable.clips)
-    idx = [int(np.argmin(np.abs(cable.arc_length - cable.clips[n].s))) for n in names]
-    p = cable.positions[k, idx] if idx else np.zeros((0, 3))
-    text = [f"{n} ({bodies.get(n, 'world')})" for n in names]
+    nodes = _clip_nodes(cable)
+    p = cable.positions[k, list(nodes.values())] if nodes else np.zeros((0, 3))
+    text = [f"{n} ({bodies.get(n, 'world')})" for n in nodes]
     return go.Scatter3d(
         x=p[:, 0],
         y=p[:, 1],
@@ -79,6 +114,73 @@ def _clip_trace(cable: CableResult, k: int, bodies: dict[str, str]):
     )
 
 
+AXIS_COLOURS = ("red", "green", "blue")
+
+
+def _segments(pairs) -> list[np.ndarray]:
+    """x, y, z lists of line segments separated by gaps (None)."""
+    pts: list = []
+    for a, b in pairs:
+        pts += [a, b, [None] * 3]
+    arr = np.array(pts, dtype=object).reshape(-1, 3)
+    return [arr[:, i].tolist() for i in range(3)]
+
+
+def _body_traces(cable: CableResult, k: int, bodies: list[BodyPose], length: float) -> list:
+    """Body origins (labelled with their clips), their x/y/z axes (red, green, blue) and dotted
+    links from each origin to the clips it carries, at saved step ``k``."""
+    import plotly.graph_objects as go
+
+    if not bodies:
+        return []
+    o = np.array([b.origin[k] for b in bodies])
+    labels = [f"body {b.name}" + (f" → {', '.join(b.clips)}" if b.clips else "") for b in bodies]
+    traces = [
+        go.Scatter3d(
+            x=o[:, 0],
+            y=o[:, 1],
+            z=o[:, 2],
+            mode="markers+text",
+            text=labels,
+            name="bodies",
+            marker={"size": 5, "color": "purple", "symbol": "square"},
+            textposition="bottom center",
+        )
+    ]
+    for i, colour in enumerate(AXIS_COLOURS):
+        x, y, z = _segments((b.origin[k], b.origin[k] + length * b.axes[k][:, i]) for b in bodies)
+        traces.append(
+            go.Scatter3d(
+                x=x,
+                y=y,
+                z=z,
+                mode="lines",
+                line={"color": colour, "width": 5},
+                name="body axes x, y, z (red, green, blue)",
+                legendgroup="body axes",
+                showlegend=i == 0,
+                hoverinfo="skip",
+            )
+        )
+    nodes = _clip_nodes(cable)
+    links = [
+        (b.origin[k], cable.positions[k, nodes[c]]) for b in bodies for c in b.clips if c in nodes
+    ]
+    x, y, z = _segments(links) if links else ([], [], [])
+    traces.append(
+        go.Scatter3d(
+            x=x,
+            y=y,
+            z=z,
+            mode="lines",
+            line={"color": "purple", "width": 2, "dash": "dot"},
+            name="body → clip",
+            hoverinfo="skip",
+        )
+    )
+    return traces
+
+
 def cable_figure(
     cable: CableResult,
     color_by: str = "bending",
@@ -86,12 +188,14 @@ def cable_figure(
     frames: int = FRAMES,
     volume=None,
     scene_toml: str = "",
+    mode: str | None = None,
     n_angles: int = 16,
     title: str | None = None,
 ):
     """A plotly figure: the tube coloured by ``color_by`` (one of the plot quantities) at up
     to ``frames`` saved steps with a slider and play button, clips marked with their bodies,
-    and ``volume`` (a MotionVolume or TriangleMesh) as a translucent mesh."""
+    the bodies of ``scene_toml`` (the result's scene; ``mode`` the run's mode) with their axes
+    and clips, and ``volume`` (a MotionVolume or TriangleMesh) as a translucent mesh."""
     import plotly.graph_objects as go
 
     if color_by not in QUANTITIES:
@@ -102,6 +206,7 @@ def cable_figure(
     steps = frame_steps(cable.n_steps, frames)
     lo, hi = float(values[steps].min()), float(values[steps].max())
     bodies = clip_bodies(scene_toml, cable.name)
+    poses = scene_bodies(scene_toml, cable, mode)
 
     def tube(k):
         m = tube_mesh(cable.positions[k], cable.quaternions[k], radius, n_angles)
@@ -125,9 +230,18 @@ def cable_figure(
         flatshading=False,
         hovertemplate=f"{label}: %{{intensity:.4g}} {unit}<extra></extra>",
     )
-    traces = [tube_trace, _clip_trace(cable, steps[0], bodies)]
     box = cable.positions.reshape(-1, 3)
     box = np.stack([box.min(axis=0) - radius, box.max(axis=0) + radius])
+    axis_length = 0.08 * float((box[1] - box[0]).max())
+    traces = [
+        tube_trace,
+        _clip_trace(cable, steps[0], bodies),
+        *_body_traces(cable, steps[0], poses, axis_length),
+    ]
+    moving = list(range(len(traces)))
+    if poses:
+        o = np.concatenate([b.origin for b in poses])
+        box = np.stack([np.minimum(box[0], o.min(0)), np.maximum(box[1], o.max(0))])
     if volume is not None:
         mesh = getattr(volume, "mesh", volume)
         if len(mesh.faces):
@@ -155,8 +269,9 @@ def cable_figure(
             data=[
                 go.Mesh3d(x=m.vertices[:, 0], y=m.vertices[:, 1], z=m.vertices[:, 2], intensity=v),
                 _clip_trace(cable, k, bodies),
+                *_body_traces(cable, k, poses, axis_length),
             ],
-            traces=[0, 1],
+            traces=moving,
         )
         for k in steps
         for m, v in [tube(k)]
@@ -214,16 +329,19 @@ def damage_figure(
     step: int = 0,
     hot_spots: int = 3,
     n_angles: int = 32,
+    scene_toml: str = "",
+    mode: str | None = None,
     title: str | None = None,
 ):
     """Paper Fig. 8: the damage map on the tube surface at saved step ``step`` (log colours),
-    interpolated from the map's stations and surface angles onto the tube's rings; hot spots
-    marked and labelled with arc length, angle and value."""
+    interpolated from the map's stations and surface angles onto the tube's rings (a vertex at
+    γ sits at x + r (cos γ d1 + sin γ d2), the LDA's convention); hot spots marked and labelled
+    with arc length, angle, damage and nearest clip; clips and bodies marked."""
     import plotly.graph_objects as go
 
     radius = float(cable.section.get("outer_radius", 0.005))
     m = tube_mesh(cable.positions[step], cable.quaternions[step], radius, n_angles)
-    per_node = _damage_on_rings(damage, cable.arc_length, m.angles)
+    per_node = damage.on_surface(cable.arc_length, m.angles)
     positive = damage.damage[damage.damage > 0]
     floor = positive.min() if positive.size else 1.0
     log = np.log10(np.maximum(per_node.ravel(), floor))
@@ -241,17 +359,23 @@ def damage_figure(
             name="damage",
             colorbar={"title": "log10 damage"},
             hovertemplate="log10 damage: %{intensity:.2f}<extra></extra>",
-        )
+        ),
+        _clip_trace(cable, step, clip_bodies(scene_toml, cable.name)),
     ]
     spots = damage.hot_spots(hot_spots)
     if spots:
         pts, text = [], []
+        d1, d2 = node_frames(cable.positions[step], cable.quaternions[step])
         for rank, h in enumerate(spots, 1):
-            d1, d2 = _frame_at(cable, step, h.arc_length)
+            n = int(np.argmin(np.abs(cable.arc_length - h.arc_length)))
             x = _position_at(cable, step, h.arc_length)
-            pts.append(x + 1.6 * radius * (np.cos(h.angle) * d1 + np.sin(h.angle) * d2))
+            pts.append(x + 1.6 * radius * (np.cos(h.angle) * d1[n] + np.sin(h.angle) * d2[n]))
+            clip = "" if h.nearest_clip is None else f", near {h.nearest_clip}"
+            if h.nearest_clip is not None and h.clip_distance is not None:
+                clip += f" ({h.clip_distance * 1e3:.0f} mm)"
             text.append(
-                f"#{rank} s={h.arc_length:.3f} m γ={np.degrees(h.angle):.0f}° D={h.damage:.3g}"
+                f"#{rank} s={h.arc_length:.3f} m γ={np.degrees(h.angle):.0f}° "
+                f"D={h.damage:.3g}{clip}"
             )
         p = np.array(pts)
         traces.append(
@@ -266,30 +390,64 @@ def damage_figure(
                 textposition="top center",
             )
         )
-    fig = go.Figure(data=traces)
     box = np.stack([m.vertices.min(0), m.vertices.max(0)])
+    poses = scene_bodies(scene_toml, cable, mode)
+    traces += _body_traces(cable, step, poses, 0.08 * float((box[1] - box[0]).max()))
+    fig = go.Figure(data=traces)
     _layout(fig, title or f"{cable.name}: pseudo-damage on the surface", box)
     return fig
-
-
-def _damage_on_rings(damage: DamageMap, arc_length: np.ndarray, angles: np.ndarray) -> np.ndarray:
-    """Damage (N+1, G') at the tube's nodes and ring angles: linear in s, periodic in γ."""
-    along = np.array([np.interp(arc_length, damage.arc_length, col) for col in damage.damage.T]).T
-    a = np.concatenate([damage.angle, [damage.angle[0] + 2 * np.pi]])
-    out = np.empty((len(arc_length), len(angles)))
-    for n in range(len(arc_length)):
-        row = np.concatenate([along[n], along[n, :1]])
-        out[n] = np.interp(np.mod(angles - a[0], 2 * np.pi) + a[0], a, row)
-    return out
 
 
 def _position_at(cable: CableResult, step: int, s: float) -> np.ndarray:
     return np.array([np.interp(s, cable.arc_length, cable.positions[step, :, i]) for i in range(3)])
 
 
-def _frame_at(cable: CableResult, step: int, s: float):
-    from cablelife.report.tube import node_frames
+def volumes_figure(volumes: dict, cables: dict | None = None, title: str | None = None):
+    """Paper Fig. 1: the motion volumes of several runs (label → MotionVolume or TriangleMesh)
+    overlaid as translucent meshes, each with its cable's centre line at the first saved step
+    (``cables``: label → CableResult)."""
+    import plotly.graph_objects as go
+    from plotly.colors import qualitative
 
-    d1, d2 = node_frames(cable.positions[step], cable.quaternions[step])
-    n = int(np.argmin(np.abs(cable.arc_length - s)))
-    return d1[n], d2[n]
+    if not volumes:
+        raise ValueError("volumes: give at least one motion volume")
+    traces, points = [], []
+    for k, (label, volume) in enumerate(volumes.items()):
+        colour = qualitative.Plotly[k % 10]
+        mesh = getattr(volume, "mesh", volume)
+        if len(mesh.faces):
+            v, f = mesh.vertices, mesh.faces
+            traces.append(
+                go.Mesh3d(
+                    x=v[:, 0],
+                    y=v[:, 1],
+                    z=v[:, 2],
+                    i=f[:, 0],
+                    j=f[:, 1],
+                    k=f[:, 2],
+                    color=colour,
+                    opacity=0.3,
+                    name=f"motion volume {label}",
+                    showlegend=True,
+                    hoverinfo="name",
+                )
+            )
+            points.append(v)
+        cable = (cables or {}).get(label)
+        if cable is not None:
+            x = cable.positions[0]
+            points.append(x)
+            traces.append(
+                go.Scatter3d(
+                    x=x[:, 0],
+                    y=x[:, 1],
+                    z=x[:, 2],
+                    mode="lines",
+                    line={"color": colour, "width": 5},
+                    name=f"cable {label} (t = {cable.time[0]:.3g} s)",
+                )
+            )
+    fig = go.Figure(data=traces)
+    p = np.concatenate(points) if points else np.zeros((1, 3))
+    _layout(fig, title or "motion volumes", np.stack([p.min(0), p.max(0)]))
+    return fig
