@@ -273,7 +273,7 @@ def test_interactive_plots_draw_what_the_matplotlib_plots_draw(files):
     fig = to_plotly(plot_bend_radius(runs, 1e3))
     assert fig.layout.yaxis.type == "log"
     rule = [t for t in fig.data if t.mode == "lines" and t.line.dash == "dot" and t.y[0]]
-    assert rule[0].y == (chk.allowed, chk.allowed)
+    assert tuple(rule[0].y) == (chk.allowed, chk.allowed)
     spans = [t for t in fig.data if t.fill == "toself"]
     assert len(spans) == len(chk.violations) > 0
     assert [min(t.x) for t in spans] == pytest.approx([v[0] for v in chk.violations])

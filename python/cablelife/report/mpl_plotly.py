@@ -37,10 +37,11 @@ def _rgba(color, alpha=None) -> str:
     return f"rgba({r * 255:.0f},{g * 255:.0f},{b * 255:.0f},{a:.3g})"
 
 
-def _values(a) -> list:
-    """Floats with NaN/inf (and masked values) as None, for JSON."""
+def _values(a) -> np.ndarray:
+    """Floats with inf and masked values as NaN (plotly writes null: a gap in the line).
+    A numpy array, not a list: plotly validates arrays at once, lists element by element."""
     x = np.ma.filled(np.ma.masked_invalid(np.asarray(a, dtype=float)), np.nan)
-    return [None if not np.isfinite(v) else float(v) for v in np.ravel(x)]
+    return np.ravel(x)
 
 
 def _text(s: str) -> str:
