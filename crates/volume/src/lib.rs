@@ -107,6 +107,76 @@ mod tests {
         }
     }
 
+    /// The capsules of a cable's edges over many saved steps: a few edges along a sloped
+    /// polyline, each moved by a few mm per step pattern, so consecutive capsules nearly
+    /// coincide; some axes reversed, some degenerate, radii 5–6 mm.
+    fn swept_edges(edges: usize, steps: usize, seed: u64) -> (Vec<Vec3>, Vec<Vec3>, Vec<f64>) {
+        let mut g = Lcg(seed);
+        let node = |e: usize, t: f64| -> Vec3 {
+            let u = e as f64 * 0.0125;
+            let w = [
+                (70.0 * t + 3.0 * u).sin(),
+                (110.0 * t + 0.5 + 5.0 * u).sin(),
+                (160.0 * t + 1.0 + 7.0 * u).sin(),
+            ];
+            [
+                u + 0.001 * w[0],
+                0.3 * u + 0.002 * w[1],
+                -0.4 * u + 0.002 * w[2],
+            ]
+        };
+        let (mut s, mut e, mut r) = (vec![], vec![], vec![]);
+        for step in 0..steps {
+            let t = step as f64 * 1e-3;
+            for k in 0..edges {
+                let (a, b) = (node(k, t), node(k + 1, t));
+                let (a, b) = if g.next() < 0.3 { (b, a) } else { (a, b) };
+                let b = if g.next() < 0.02 { a } else { b };
+                s.push(a);
+                e.push(b);
+                r.push(0.005 + 0.001 * g.next());
+            }
+        }
+        (s, e, r)
+    }
+
+    #[test]
+    fn many_nearly_coincident_capsules_equal_brute_force() {
+        // 2000 capsules, hundreds over every brick: the per-voxel hierarchy queries.
+        let (s, e, r) = swept_edges(4, 500, 11);
+        let caps = Capsules::new(&s, &e, &r).unwrap();
+        let h = 0.002;
+        let grid = Grid {
+            origin: [-0.012, -0.012, -0.032],
+            spacing: h,
+            shape: [38, 24, 24],
+        };
+        let band = 3.0 * h;
+        let field = signed_distance(&caps, &grid, band).unwrap();
+        let [nx, ny, nz] = grid.shape;
+        let mut inside_band = 0;
+        for i in 0..nx {
+            for j in 0..ny {
+                for k in 0..nz {
+                    let p = [i, j, k].map(|x| x as f64);
+                    let p = [0, 1, 2].map(|a| grid.origin[a] + h * p[a]);
+                    let exact = brute(&s, &e, &r, p);
+                    let want = exact.clamp(-band, band) as f32;
+                    let got = field[(i * ny + j) * nz + k];
+                    assert_eq!(got, want, "voxel {i},{j},{k}");
+                    inside_band += (exact.abs() < band) as usize;
+                }
+            }
+        }
+        assert!(inside_band > 3000, "{inside_band}");
+        let mut g = Lcg(5);
+        for _ in 0..3000 {
+            let p = g.vec(0.07);
+            let p = [p[0] - 0.01, p[1] - 0.015, p[2] - 0.045];
+            assert!((caps.distance(p) - brute(&s, &e, &r, p)).abs() < 1e-12);
+        }
+    }
+
     #[test]
     fn degenerate_capsule_is_a_ball_and_empty_set_is_far() {
         let caps = Capsules::new(&[[0.0; 3]], &[[0.0; 3]], &[0.5]).unwrap();
