@@ -4,11 +4,11 @@
 //! The Jacobian is the exact derivative of the residual along the Newton update: the symmetric
 //! energy Hessian plus ½[g]× on each rotation's own block (g its energy gradient), which comes
 //! from exp(δ)exp(θ) = exp(δ + θ + ½ δ×θ + …), plus the derivative of dead moments −[Rᵀ M]×.
-use crate::bending::{BendKinematics, Kink};
-use crate::block_tridiag::{BlockTridiag, Singular};
+use crate::bending::{BendKinematics, BendViscous, Kink};
+use crate::block_tridiag::{Block, BlockTridiag, Singular};
 use crate::model::{EdgeKind, NodeKind, Rod, RotRef};
 use crate::rotation::{rotation_matrix, skew, Quat};
-use crate::shear::ShearKinematics;
+use crate::shear::{ShearKinematics, ShearViscous};
 use crate::state::State;
 use crate::statics::SolveError;
 use nalgebra::{Matrix3, Vector3, Vector6};
@@ -133,7 +133,8 @@ impl Workspace {
     /// Elastic terms (shear/extension and bending/torsion) with the rotation-group correction;
     /// with `rates`, Kelvin–Voigt damping too: the section stress is C(Γ−Γ⁰) + τ∘C Γ̇ (and the
     /// same for K), the stored section forces and moments include it, and the Jacobian gets
-    /// `rates.damping_factor` × the damping matrix Jᵀ τ∘C J.
+    /// `rates.damping_factor` × the damping matrix Jᵀ τ∘C J plus the derivative of the viscous
+    /// forces through the strain rates' dependence on the configuration (Jᵀ τ∘C ∂(J v)/∂q).
     pub fn add_elastic(
         &mut self,
         rod: &Rod,
@@ -145,44 +146,59 @@ impl Workspace {
         let strain0 = Vector3::zeros();
         self.dissipation = 0.0;
         for e in 0..rod.n_edges() {
-            let kin =
-                ShearKinematics::new(&st.x[e], &st.x[e + 1], &st.p[e], rod.ds_edge[e], &strain0);
+            let ds = rod.ds_edge[e];
+            let kin = ShearKinematics::new(&st.x[e], &st.x[e + 1], &st.p[e], ds, &strain0);
             let f_el = sec.shear_stiffness.component_mul(&kin.strain);
-            self.elastic_energy += 0.5 * rod.ds_edge[e] * kin.strain.dot(&f_el);
+            self.elastic_energy += 0.5 * ds * kin.strain.dot(&f_el);
             let mut f = f_el;
+            let mut viscous = None;
             if let Some(r) = rates {
-                let (va, vb) = (r.v[e].fixed_rows::<3>(0), r.v[e + 1].fixed_rows::<3>(0));
-                let gd = kin.rate(&va.into(), &vb.into(), &r.v[e].fixed_rows::<3>(3).into());
+                let va: Vector3<f64> = r.v[e].fixed_rows::<3>(0).into();
+                let vb: Vector3<f64> = r.v[e + 1].fixed_rows::<3>(0).into();
+                let omega: Vector3<f64> = r.v[e].fixed_rows::<3>(3).into();
+                let gd = kin.rate(&va, &vb, &omega);
                 let fd = r.shear_damping.component_mul(&gd);
-                self.dissipation += rod.ds_edge[e] * gd.dot(&fd);
+                self.dissipation += ds * gd.dot(&fd);
                 f += fd;
+                viscous = Some(ShearViscous {
+                    coeff: r.shear_damping,
+                    factor: r.damping_factor,
+                    rate_theta: rod.edge_kind[e] == EdgeKind::Free,
+                    va,
+                    vb,
+                    omega,
+                });
             }
             self.edge_force[e] = f;
-            let g = kin.forces(&f);
-            self.node_grad[e] += g[0];
-            self.node_grad[e + 1] += g[1];
-            self.edge_grad[e] += g[2];
+            let rf = kin.r * f;
+            self.node_grad[e] -= rf;
+            self.node_grad[e + 1] += rf;
+            self.edge_grad[e] += ds * f.cross(&kin.u);
             if want_jac {
-                let vars = [node_var(rod, e), node_var(rod, e + 1), edge_var(rod, e)];
-                let mut h = kin.gauss_newton(&sec.shear_stiffness);
-                let geo = kin.geometric(&f);
-                for i in 0..3 {
-                    for j in 0..3 {
-                        h[i][j] += geo[i][j];
-                        self.add(vars[i], vars[j], &h[i][j]);
-                    }
+                let jb = kin.jacobian(&f, &sec.shear_stiffness, viscous.as_ref());
+                let a_free = rod.node_kind[e] == NodeKind::Free;
+                let b_free = rod.node_kind[e + 1] == NodeKind::Free;
+                let edge = !matches!(rod.edge_kind[e], EdgeKind::Prescribed { .. });
+                let jac = &mut self.jac;
+                if a_free {
+                    add_half(&mut jac.diag[e], 0, 0, &-jb.x);
                 }
-                if let Some(r) = rates {
-                    let d = kin.gauss_newton(&r.shear_damping);
-                    let dvars = [
-                        node_var(rod, e),
-                        node_var(rod, e + 1),
-                        rate_var(rod, RotRef::Edge(e)),
-                    ];
-                    for i in 0..3 {
-                        for j in 0..3 {
-                            self.add(vars[i], dvars[j], &(r.damping_factor * d[i][j]));
-                        }
+                if b_free {
+                    add_half(&mut jac.diag[e + 1], 0, 0, &-jb.x);
+                }
+                if a_free && b_free {
+                    add_half(&mut jac.upper[e], 0, 0, &jb.x);
+                    add_half(&mut jac.lower[e + 1], 0, 0, &jb.x);
+                }
+                if edge {
+                    add_half(&mut jac.diag[e], 1, 1, &jb.t);
+                    if a_free {
+                        add_half(&mut jac.diag[e], 0, 1, &-jb.y);
+                        add_half(&mut jac.diag[e], 1, 0, &jb.w);
+                    }
+                    if b_free {
+                        add_half(&mut jac.lower[e + 1], 0, 1, &jb.y);
+                        add_half(&mut jac.upper[e], 1, 0, &-jb.w);
                     }
                 }
             }
@@ -195,11 +211,21 @@ impl Workspace {
             let m_el = sec.bend_stiffness.component_mul(&dk);
             self.elastic_energy += 0.5 * t.weight * dk.dot(&m_el);
             let mut m = m_el;
+            let mut viscous = None;
             if let Some(r) = rates {
-                let kd = kin.rate(&r.omega(t.a), &r.omega(t.b));
+                let (omega_a, omega_b) = (r.omega(t.a), r.omega(t.b));
+                let kd = kin.rate(&omega_a, &omega_b);
                 let md = r.bend_damping.component_mul(&kd);
                 self.dissipation += t.weight * kd.dot(&md);
                 m += md;
+                viscous = Some(BendViscous {
+                    coeff: r.bend_damping,
+                    factor: r.damping_factor,
+                    rate_a: matches!(rate_var(rod, t.a), Var::Full(..)),
+                    rate_b: matches!(rate_var(rod, t.b), Var::Full(..)),
+                    omega_a,
+                    omega_b,
+                });
             }
             self.node_moment[t.node] += m;
             self.node_moment_count[t.node] += 1;
@@ -211,21 +237,25 @@ impl Workspace {
                 }
             }
             if want_jac {
-                let vars = [rot_var(rod, t.a), rot_var(rod, t.b)];
-                let mut h = kin.gauss_newton(&sec.bend_stiffness);
-                let geo = kin.geometric(&m);
-                for i in 0..2 {
-                    for j in 0..2 {
-                        h[i][j] += geo[i][j];
-                        self.add(vars[i], vars[j], &h[i][j]);
+                let h = kin.jacobian(&m, &sec.bend_stiffness, viscous.as_ref());
+                match (t.a, t.b) {
+                    (RotRef::Edge(ea), RotRef::Edge(eb))
+                        if eb == ea + 1
+                            && rod.edge_kind[ea] == EdgeKind::Free
+                            && rod.edge_kind[eb] == EdgeKind::Free =>
+                    {
+                        let jac = &mut self.jac;
+                        add_half(&mut jac.diag[ea], 1, 1, &h[0][0]);
+                        add_half(&mut jac.upper[ea], 1, 1, &h[0][1]);
+                        add_half(&mut jac.lower[eb], 1, 1, &h[1][0]);
+                        add_half(&mut jac.diag[eb], 1, 1, &h[1][1]);
                     }
-                }
-                if let Some(r) = rates {
-                    let d = kin.gauss_newton(&r.bend_damping);
-                    let dvars = [rate_var(rod, t.a), rate_var(rod, t.b)];
-                    for i in 0..2 {
-                        for j in 0..2 {
-                            self.add(vars[i], dvars[j], &(r.damping_factor * d[i][j]));
+                    _ => {
+                        let vars = [rot_var(rod, t.a), rot_var(rod, t.b)];
+                        for i in 0..2 {
+                            for j in 0..2 {
+                                self.add(vars[i], vars[j], &h[i][j]);
+                            }
                         }
                     }
                 }
@@ -242,7 +272,7 @@ impl Workspace {
                     continue; // prescribed, or a single twist axis (whose correction is zero)
                 }
                 let corr = 0.5 * skew(&self.edge_grad[e]);
-                self.jac.add3(e, 1, e, 1, &corr);
+                add_half(&mut self.jac.diag[e], 1, 1, &corr);
             }
         }
         Ok(())
@@ -371,18 +401,18 @@ impl Workspace {
     }
 }
 
+/// Adds a 3×3 matrix to the (hi, hj) half of a 6×6 block.
+#[inline(always)]
+fn add_half(block: &mut Block, hi: usize, hj: usize, m: &Matrix3<f64>) {
+    let mut v = block.fixed_view_mut::<3, 3>(3 * hi, 3 * hj);
+    v += m;
+}
+
 #[inline]
 fn rot(st: &State, r: RotRef) -> Quat {
     match r {
         RotRef::Edge(e) => st.p[e],
         RotRef::Ghost(g) => st.ghost[g],
-    }
-}
-
-fn node_var(rod: &Rod, n: usize) -> Var {
-    match rod.node_kind[n] {
-        NodeKind::Free => Var::Full(n, 0),
-        NodeKind::Prescribed { .. } => Var::None,
     }
 }
 
