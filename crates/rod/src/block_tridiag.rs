@@ -2,6 +2,7 @@
 //! pivot blocks are LU-factored in place with partial pivoting). Storage is allocated once;
 //! factor and solve do not allocate.
 use nalgebra::{Matrix3, Matrix6, Vector6};
+use std::ops::Range;
 
 pub type Block = Matrix6<f64>;
 
@@ -42,13 +43,15 @@ impl BlockTridiag {
     }
 
     pub fn clear(&mut self) {
-        for m in self
-            .diag
-            .iter_mut()
-            .chain(self.lower.iter_mut())
-            .chain(self.upper.iter_mut())
-        {
-            m.fill(0.0);
+        self.clear_range(0..self.n_blocks());
+    }
+
+    /// Zeroes the rows of blocks `r`.
+    pub fn clear_range(&mut self, r: Range<usize>) {
+        for b in r {
+            self.diag[b].fill(0.0);
+            self.lower[b].fill(0.0);
+            self.upper[b].fill(0.0);
         }
     }
 
@@ -88,17 +91,22 @@ impl BlockTridiag {
 
     /// Factors the matrix (forward elimination of the block Thomas algorithm).
     pub fn factor(&mut self) -> Result<(), Singular> {
-        let n = self.n_blocks();
-        for b in 0..n {
+        self.factor_range(0..self.n_blocks())
+    }
+
+    /// Factors the diagonal part of blocks `r` (an independent system: the coupling blocks to
+    /// the blocks outside are zero).
+    pub fn factor_range(&mut self, r: Range<usize>) -> Result<(), Singular> {
+        for b in r.clone() {
             let mut d = self.diag[b];
-            if b > 0 {
+            if b > r.start {
                 d -= self.lower[b] * self.elim[b - 1];
             }
             let (piv, inv_diag) = lu_in_place(&mut d).map_err(|_| Singular { block: b })?;
             let mut inv = Block::identity();
             lu_solve_matrix(&d, &piv, &inv_diag, &mut inv);
             self.inv[b] = inv;
-            if b + 1 < n {
+            if b + 1 < r.end {
                 self.elim[b] = inv * self.upper[b];
             }
         }
@@ -107,17 +115,22 @@ impl BlockTridiag {
 
     /// Solves J x = rhs in place with the current factorisation.
     pub fn solve_factored(&self, rhs: &mut [Vector6<f64>]) {
-        let n = self.n_blocks();
+        self.solve_range(0..self.n_blocks(), rhs);
+    }
+
+    /// Solves the system of blocks `r` (factored by `factor_range`) in place; `rhs` holds all
+    /// blocks, only those in `r` are used and changed.
+    pub fn solve_range(&self, r: Range<usize>, rhs: &mut [Vector6<f64>]) {
         // Forward: y_b = D'_b⁻¹ (r_b − L_b y_{b−1}).
-        for b in 0..n {
-            let mut r = rhs[b];
-            if b > 0 {
-                r -= self.lower[b] * rhs[b - 1];
+        for b in r.clone() {
+            let mut v = rhs[b];
+            if b > r.start {
+                v -= self.lower[b] * rhs[b - 1];
             }
-            rhs[b] = self.inv[b] * r;
+            rhs[b] = self.inv[b] * v;
         }
         // Backward: x_b = y_b − (D'_b⁻¹ U_b) x_{b+1}.
-        for b in (0..n.saturating_sub(1)).rev() {
+        for b in (r.start..r.end.saturating_sub(1)).rev() {
             let next = rhs[b + 1];
             rhs[b] -= self.elim[b] * next;
         }
@@ -235,6 +248,17 @@ mod tests {
         j.mul(&x, &mut rhs);
         j.factor().unwrap();
         j.solve_factored(&mut rhs);
+        for b in 0..n {
+            assert!((rhs[b] - x[b]).norm() < 1e-12);
+        }
+        // Two independent systems: decouple blocks 2 and 3, solve each part on its own.
+        j.upper[2].fill(0.0);
+        j.lower[3].fill(0.0);
+        j.mul(&x, &mut rhs);
+        j.factor_range(0..3).unwrap();
+        j.factor_range(3..n).unwrap();
+        j.solve_range(3..n, &mut rhs);
+        j.solve_range(0..3, &mut rhs);
         for b in 0..n {
             assert!((rhs[b] - x[b]).norm() < 1e-12);
         }
