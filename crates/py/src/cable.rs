@@ -415,6 +415,8 @@ impl Cable {
             rho_inf: spectral_radius,
             tau_shear: vec3(&tau_shear, "tau_shear")?,
             tau_bend: vec3(&tau_bend, "tau_bend")?,
+            // Section outputs and energies only on the recorded steps.
+            outputs_every_step: false,
             ..Default::default()
         };
         let initial = route(&self.rod, poses.first().map(|p| p.as_slice()))
@@ -441,10 +443,14 @@ impl Cable {
                 match dy.advance(rod, &mut st, time_step, &motions[k - 1], &motions[k], 6) {
                     Ok(s) => {
                         if k % every == 0 {
+                            if let Err(e) = dy.update_outputs(rod, &st) {
+                                *state_slot = Some(st);
+                                return (rec, Some(format!("step {k}: {e}")));
+                            }
                             let stats = rod::SolveStats {
                                 iterations: s.iterations,
                                 residual: s.residual,
-                                substeps: s.factorizations,
+                                substeps: s.substeps - 1,
                             };
                             rec.push(rod, &st, &dy.ws, &stats);
                             rec.push_energies(&dy.energies);

@@ -146,12 +146,16 @@ pub struct BendViscous {
     pub rate_b: bool,
     pub omega_a: Vector3<f64>,
     pub omega_b: Vector3<f64>,
+    /// J_r of the rotations' increments in the step (see `ShearViscous::tangent`).
+    pub tangent_a: Option<Matrix3<f64>>,
+    pub tangent_b: Option<Matrix3<f64>>,
 }
 
 impl BendKinematics {
     /// The derivative of the generalised moments w Jᵀ m, m = C(K − K⁰) (+ τ∘C K̇), along the
     /// Newton update (without the rotation-group correction ½[g]×): w Jᵀ P + geometric(m) with
-    /// P = C J + τ∘C (c J + G) on the rate unknowns, G = ∂K̇/∂θ. Blocks [[aa, ab], [ba, bb]].
+    /// P = C J + τ∘C (c J + G) on the rate unknowns, G = ∂K̇/∂θ, the configuration part of each
+    /// column times the tangent J_r of its rotation's step. Blocks [[aa, ab], [ba, bb]].
     pub fn jacobian(
         &self,
         m: &Vector3<f64>,
@@ -160,27 +164,40 @@ impl BendKinematics {
     ) -> [[Matrix3<f64>; 2]; 2] {
         let (a, b) = (self.a(), self.b());
         let inv_w = 1.0 / self.w;
-        let (mut ca, mut cb) = (c * inv_w, c * inv_w);
-        let (mut pa, mut pb) = (Matrix3::zeros(), Matrix3::zeros());
-        if let Some(v) = viscous {
-            let g = self.rate_derivative(&v.omega_a, &v.omega_b);
-            pa = scale_rows(&v.coeff, &g[0]);
-            pb = scale_rows(&v.coeff, &g[1]);
-            if v.rate_a {
-                ca += v.coeff * (v.factor * inv_w);
-            }
-            if v.rate_b {
-                cb += v.coeff * (v.factor * inv_w);
-            }
-        }
-        pa += scale_rows(&ca, &a);
-        pb += scale_rows(&cb, &b);
         let geo = self.geometric(m);
         let (at, bt) = (a.transpose(), b.transpose());
-        [
-            [at * pa + geo[0][0], at * pb + geo[0][1]],
-            [bt * pa + geo[1][0], bt * pb + geo[1][1]],
-        ]
+        let mut pa = scale_rows(&(c * inv_w), &a);
+        let mut pb = scale_rows(&(c * inv_w), &b);
+        let Some(v) = viscous else {
+            return [
+                [at * pa + geo[0][0], at * pb + geo[0][1]],
+                [bt * pa + geo[1][0], bt * pb + geo[1][1]],
+            ];
+        };
+        let g = self.rate_derivative(&v.omega_a, &v.omega_b);
+        pa += scale_rows(&v.coeff, &g[0]);
+        pb += scale_rows(&v.coeff, &g[1]);
+        // Configuration part (× J_r of the rotation's step), then the rate part.
+        let mut col_a = [at * pa + geo[0][0], bt * pa + geo[1][0]];
+        let mut col_b = [at * pb + geo[0][1], bt * pb + geo[1][1]];
+        for (col, jr) in [(&mut col_a, v.tangent_a), (&mut col_b, v.tangent_b)] {
+            if let Some(jr) = jr {
+                col[0] *= jr;
+                col[1] *= jr;
+            }
+        }
+        let rate = v.coeff * (v.factor * inv_w);
+        if v.rate_a {
+            let ra = scale_rows(&rate, &a);
+            col_a[0] += at * ra;
+            col_a[1] += bt * ra;
+        }
+        if v.rate_b {
+            let rb = scale_rows(&rate, &b);
+            col_b[0] += at * rb;
+            col_b[1] += bt * rb;
+        }
+        [[col_a[0], col_b[0]], [col_a[1], col_b[1]]]
     }
 }
 

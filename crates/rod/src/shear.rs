@@ -101,6 +101,9 @@ pub struct ShearViscous {
     pub va: Vector3<f64>,
     pub vb: Vector3<f64>,
     pub omega: Vector3<f64>,
+    /// J_r(hΔθ) of the edge rotation's increment in the step: the Newton update changes the
+    /// increment, so the configuration derivatives along θ are multiplied by it.
+    pub tangent: Option<Matrix3<f64>>,
 }
 
 /// The 3×3 blocks of an element's force Jacobian over (x_a, x_b, θ), which have the pattern
@@ -138,7 +141,8 @@ impl ShearKinematics {
     /// Newton update: the stiffness Δs Jᵀ C J, the geometric part of the section force f, and
     /// with `viscous` the damping matrix (factor × Δs Jᵀ τ∘C J, on the rate unknowns) and the
     /// derivative through the strain rate's dependence on the configuration (Δs Jᵀ τ∘C G,
-    /// G = ∂Γ̇/∂q). The whole element: Δs Jᵀ P + geometric(f) with P = C J + τ∘C (c J + G).
+    /// G = ∂Γ̇/∂q). The whole element: Δs Jᵀ P + geometric(f) with P = C J + τ∘C (c J + G),
+    /// the configuration part of the θ column times the tangent J_r of the step.
     pub fn jacobian(
         &self,
         f: &Vector3<f64>,
@@ -149,27 +153,41 @@ impl ShearKinematics {
         let su = skew(&self.u);
         let inv_ds = 1.0 / self.ds;
         let mut ca = -c * inv_ds;
+        // θ column: configuration part (C J + τ∘C G, × J_r of the step) and rate part.
         let mut pth = scale_rows(c, &su);
+        let mut pth_rate = None;
         let mut pa_extra = Matrix3::zeros();
+        let mut tangent = None;
         if let Some(v) = viscous {
             ca -= v.coeff * (v.factor * inv_ds);
-            let [ga, _, mut gth] = self.rate_derivative(&v.va, &v.vb, &v.omega);
+            let [ga, _, gth] = self.rate_derivative(&v.va, &v.vb, &v.omega);
             pa_extra = scale_rows(&v.coeff, &ga);
-            if v.rate_theta {
-                gth += su * v.factor;
-            }
             pth += scale_rows(&v.coeff, &gth);
+            if v.rate_theta {
+                pth_rate = Some(scale_rows(&(v.coeff * v.factor), &su));
+            }
+            tangent = v.tangent;
         }
         let pa = scale_rows(&ca, &rt) + pa_extra;
         let sf = skew(f);
         let ktt = self.ds
             * (0.5 * (f * self.u.transpose() + self.u * f.transpose())
                 - Matrix3::identity() * f.dot(&self.u));
+        let mut y = pth - sf;
+        let mut t = ktt - self.ds * su * pth;
+        if let Some(jr) = tangent {
+            y *= jr;
+            t *= jr;
+        }
+        if let Some(pr) = pth_rate {
+            y += pr;
+            t -= self.ds * su * pr;
+        }
         ShearBlocks {
             x: self.r * pa,
-            y: self.r * (pth - sf),
+            y: self.r * y,
             w: -self.ds * su * pa - sf * rt,
-            t: ktt - self.ds * su * pth,
+            t,
         }
     }
 }
