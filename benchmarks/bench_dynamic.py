@@ -4,6 +4,8 @@ A 1.2 m cable, four clips, two of them on a bracket excited by a 10–200 Hz ran
 2 mm RMS (vertical), simulated 5 s at 1 ms: wall time, real-time factor, Newton iterations per
 step; then how the cost scales with N = 25 … 400 (1 s each) and with the number of steps.
 Run: python benchmarks/bench_dynamic.py [--quick]
+     python benchmarks/bench_dynamic.py --dump N DURATION FILE   (the scene, clip kinematics and
+     damping as text for `cargo run --release -p cablelife-rod --example replay_dynamic -- FILE`)
 """
 
 from __future__ import annotations
@@ -86,7 +88,55 @@ def run(segments: int, duration: float) -> tuple[float, float, float]:
     return wall, total, float(np.mean(res.solver["iterations"][1:]))
 
 
+def dump(segments: int, duration: float, path: str) -> None:
+    """Writes the inputs of the Rust dynamic run as text (see crates/rod/examples)."""
+    from cablelife.modal import retardation_times
+    from cablelife.simulate import clip_kinematics, clip_poses
+
+    sc = scene_from_dict(scene(segments, duration))
+    cable = sc.cables[0]
+    props = cable.properties()
+    h = sc.simulation.time_step
+    times = np.arange(int(round(duration / h)) + 1) * h
+    tau_shear, tau_bend, _ = retardation_times(sc, cable)
+    kin = clip_kinematics(sc, cable, times)
+    pos0, quat0 = clip_poses(sc, cable, np.array([0.0]), with_motion=False)
+
+    def row(values) -> str:
+        return " ".join(repr(float(v)) for v in values) + "\n"
+
+    with open(path, "w", encoding="utf-8") as f:
+        f.write(f"{cable.length} {cable.n_segments}\n")
+        f.write(
+            row(
+                [*props.shear_stiffness, *props.bend_stiffness, props.mass_per_length]
+                + list(props.rotary_inertia)
+            )
+        )
+        f.write(row([*cable.natural_curvature, *sc.simulation.gravity]))
+        f.write(f"{len(cable.clips)}\n")
+        for j, c in enumerate(cable.clips):
+            f.write(f"{c.s} {c.length} {c.type} " + row([*pos0[0, j], *quat0[0, j]]))
+        f.write(row([*tau_shear, *tau_bend, sc.simulation.spectral_radius, h]))
+        f.write(f"{times.size}\n")
+        keys = (
+            "positions",
+            "quaternions",
+            "velocities",
+            "angular_velocities",
+            "accelerations",
+            "angular_accelerations",
+        )
+        for k in range(times.size):
+            for j in range(len(cable.clips)):
+                f.write(row(np.concatenate([kin[key][k, j] for key in keys])))
+
+
 def main() -> None:
+    if "--dump" in sys.argv:
+        i = sys.argv.index("--dump")
+        dump(int(sys.argv[i + 1]), float(sys.argv[i + 2]), sys.argv[i + 3])
+        return
     quick = "--quick" in sys.argv
     duration = 1.0 if quick else 5.0
     wall, total, its = run(100, duration)
