@@ -182,6 +182,10 @@ pub struct Dynamics {
     increments: Vec<f64>,
     /// Dissipated power of each segment at its last iterate.
     powers: Vec<f64>,
+    /// Segments at rest in equilibrium (skipped while their clips stay at rest).
+    resting: Vec<bool>,
+    /// Per clip: at the same pose as in the last step, with zero rates.
+    clip_still: Vec<bool>,
     pub energies: Energies,
     power_n: f64,
     poses: Vec<Pose>,
@@ -248,6 +252,8 @@ impl Dynamics {
             ],
             increments: vec![0.0; n_seg],
             powers: vec![0.0; n_seg],
+            resting: vec![false; n_seg],
+            clip_still: Vec::with_capacity(clips.len()),
             energies: Energies::default(),
             power_n: 0.0,
             poses: Vec::with_capacity(clips.len()),
@@ -372,6 +378,16 @@ impl Dynamics {
         self.v_n.clone_from(&self.rates.v);
         self.vdot_n.clone_from(&self.vdot);
         self.a_n.clone_from(&self.a);
+        // Clips that stay exactly where they are, at rest.
+        self.clip_still.clear();
+        self.clip_still
+            .extend(clips.iter().zip(&st.clip_pose).map(|(m, old)| {
+                m.pose == *old
+                    && m.velocity == Vector3::zeros()
+                    && m.angular_velocity == Vector3::zeros()
+                    && m.acceleration == Vector3::zeros()
+                    && m.angular_acceleration == Vector3::zeros()
+            }));
         // Prescribed motion at t_{n+1}.
         self.poses.clear();
         self.poses.extend(clips.iter().map(|m| m.pose));
@@ -400,12 +416,34 @@ impl Dynamics {
             ..Default::default()
         };
         for (k, seg) in rod.segments.iter().enumerate() {
+            let clips_still = seg.clips.iter().all(|&c| self.clip_still[c]);
+            if self.resting[k] && clips_still {
+                // A segment in equilibrium with its clips at rest stays so (the loads are
+                // dead): its state is the one of the last step (v = v̇ = a = 0, Δq = 0).
+                self.powers[k] = 0.0;
+                continue;
+            }
             let s = self.solve_segment(rod, st, h, k, seg)?;
+            self.resting[k] &= clips_still;
             stats.iterations = stats.iterations.max(s.iterations);
             stats.factorizations += s.factorizations;
             stats.residual = stats.residual.max(s.residual);
         }
         self.update_accelerations();
+        for (k, seg) in rod.segments.iter().enumerate() {
+            if self.resting[k] {
+                // At rest to round-off: exactly at rest from now on.
+                for b in seg.blocks.clone() {
+                    for i in 0..6 {
+                        if self.inertial[b][i] {
+                            self.vdot[b][i] = 0.0;
+                            self.a[b][i] = 0.0;
+                            self.rates.v[b][i] = 0.0;
+                        }
+                    }
+                }
+            }
+        }
         let power: f64 = self.powers.iter().sum();
         self.energies.dissipated += 0.5 * h * (power + self.power_n);
         self.power_n = power;
@@ -470,6 +508,10 @@ impl Dynamics {
                     .residual_norms_range(seg.blocks.clone(), rod.mean_ds())
                     .1;
                 self.powers[k] = self.ws.dissipation;
+                // Nothing moved and nothing was corrected: at rest (kept while its clips are).
+                self.resting[k] = it == 0
+                    && norm <= self.opts.abs_tolerance
+                    && self.increments[k] <= self.opts.abs_tolerance;
                 return Ok(stats);
             }
             // Slow contraction with a reused matrix: refactor at the next iterate.
@@ -504,6 +546,7 @@ impl Dynamics {
         for f in &mut self.factors {
             f.valid = false;
         }
+        self.resting.iter_mut().for_each(|r| *r = false);
     }
 
     /// Advances by h from the clip kinematics `from` (at t_n) to `to` (at t_n + h); a step whose

@@ -139,6 +139,8 @@ pub struct Segment {
     pub bend_terms: Vec<usize>,
     /// Swivel ghosts whose free twist is in the segment.
     pub ghosts: Vec<usize>,
+    /// The clips whose prescribed nodes, edges or ghosts these elements use.
+    pub clips: Vec<usize>,
 }
 
 /// The discretised cable.
@@ -423,6 +425,7 @@ fn find_segments(
                     edges: vec![],
                     bend_terms: vec![],
                     ghosts: vec![],
+                    clips: vec![],
                 });
             }
             start = b + 1;
@@ -458,6 +461,34 @@ fn find_segments(
                 segments[k].ghosts.push(g);
             }
         }
+    }
+    let node_clip = |n: usize| match node_kind[n] {
+        NodeKind::Prescribed { clip } => Some(clip),
+        NodeKind::Free => None,
+    };
+    let edge_clip = |e: usize| match edge_kind[e] {
+        EdgeKind::Prescribed { clip } | EdgeKind::TwistFree { clip } => Some(clip),
+        EdgeKind::Free => None,
+    };
+    let rot_clip = |r: RotRef| match r {
+        RotRef::Edge(e) => edge_clip(e),
+        RotRef::Ghost(g) => Some(ghosts[g].clip),
+    };
+    for seg in &mut segments {
+        let mut clips: Vec<usize> = seg
+            .edges
+            .iter()
+            .flat_map(|&e| [node_clip(e), node_clip(e + 1), edge_clip(e)])
+            .chain(
+                seg.bend_terms
+                    .iter()
+                    .flat_map(|&i| [rot_clip(bend_terms[i].a), rot_clip(bend_terms[i].b)]),
+            )
+            .flatten()
+            .collect();
+        clips.sort_unstable();
+        clips.dedup();
+        seg.clips = clips;
     }
     segments
 }

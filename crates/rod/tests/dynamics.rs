@@ -446,3 +446,93 @@ fn iteration_matrix_is_the_derivative_of_the_dynamic_residual() {
         }
     }
 }
+
+#[test]
+fn spans_at_rest_stay_in_equilibrium_and_are_skipped() {
+    // Three spans between four fixed clips; only the last clip moves. The first span starts in
+    // static equilibrium and stays there: once nothing moves in it, it is no longer iterated.
+    let mut spec = cantilever(1.2, 60, circle(0.005, 1e8, 0.45, 2200.0));
+    spec.gravity = Vector3::new(0.0, 0.0, -9.81);
+    spec.clips = vec![
+        clip(
+            "a",
+            0.0,
+            0.0,
+            ClipKind::Fixed,
+            pose([0.0; 3], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]),
+        ),
+        clip(
+            "b",
+            0.4,
+            0.0,
+            ClipKind::Fixed,
+            pose([0.36, 0.05, -0.05], [1.0, 0.2, 0.0], [0.0, 0.0, 1.0]),
+        ),
+        clip(
+            "c",
+            0.8,
+            0.0,
+            ClipKind::Fixed,
+            pose([0.7, 0.15, -0.02], [1.0, 0.1, 0.0], [0.0, 0.0, 1.0]),
+        ),
+        clip(
+            "d",
+            1.2,
+            0.0,
+            ClipKind::Fixed,
+            pose([1.0, 0.25, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]),
+        ),
+    ];
+    let rod = Rod::new(spec).unwrap();
+    assert_eq!(rod.segments.len(), 3);
+    let mut st = route(&rod, None).unwrap();
+    Statics::new(&rod, NewtonOptions::default())
+        .solve(&rod, &mut st)
+        .unwrap();
+    let opts = DynamicOptions {
+        tau_shear: Vector3::repeat(0.02),
+        tau_bend: Vector3::repeat(0.02),
+        ..Default::default()
+    };
+    let h = 1e-3;
+    let moving = |t: f64| {
+        let mut clips = clamp(&rod);
+        let (amp, w) = (1e-3, 2.0 * std::f64::consts::PI * 50.0);
+        let m = &mut clips[3];
+        m.pose.position.z += amp * (w * t).sin();
+        m.velocity.z = amp * w * (w * t).cos();
+        m.acceleration.z = -amp * w * w * (w * t).sin();
+        clips
+    };
+    // All clips still: after the start-up every segment comes to rest and the steps cost no
+    // iteration at all; the state no longer changes.
+    let still = clamp(&rod);
+    let mut dy = Dynamics::new(&rod, &st, &still, opts.clone());
+    dy.start(&rod, &st).unwrap();
+    let mut last = 0;
+    for _ in 0..400 {
+        last = dy.step(&rod, &mut st, h, &still).unwrap().iterations;
+    }
+    assert_eq!(
+        last, 0,
+        "a cable at rest with its clips at rest is not iterated"
+    );
+    let frozen = st.clone();
+    dy.step(&rod, &mut st, h, &still).unwrap();
+    assert_eq!(st.x, frozen.x);
+    assert_eq!(st.p, frozen.p);
+    // Shaking the last clip: the first span stays in equilibrium (its rows of the residual
+    // remain at round-off), the others move.
+    for k in 1..=200 {
+        dy.step(&rod, &mut st, h, &moving(k as f64 * h)).unwrap();
+    }
+    let first = rod.segments[0].blocks.clone();
+    let residual = dy.ws.residual_norms_range(first.clone(), rod.mean_ds()).1;
+    let weight = rod.spec.section.mass_per_length * 9.81 * rod.mean_ds();
+    assert!(residual < 1e-9 * weight, "residual {residual:e} N");
+    assert!(first.clone().all(|n| st.x[n] == frozen.x[n]));
+    let moved = (first.end + 1..rod.arc.len() - 1)
+        .map(|n| (st.x[n] - frozen.x[n]).norm())
+        .fold(0.0, f64::max);
+    assert!(moved > 1e-5, "the shaken spans move: {moved}");
+}
