@@ -272,16 +272,17 @@ impl Workspace {
             let fd = r.shear_damping.component_mul(&gd);
             self.dissipation += ds * gd.dot(&fd);
             f += fd;
-            let rate_theta = rod.edge_kind[e] == EdgeKind::Free;
-            viscous = Some(ShearViscous {
-                coeff: r.shear_damping,
-                factor: r.damping_factor,
-                rate_theta,
-                va,
-                vb,
-                omega,
-                tangent: r.tangent_of(RotRef::Edge(e), rod),
-            });
+            if want_jac {
+                viscous = Some(ShearViscous {
+                    coeff: r.shear_damping,
+                    factor: r.damping_factor,
+                    rate_theta: rod.edge_kind[e] == EdgeKind::Free,
+                    va,
+                    vb,
+                    omega,
+                    tangent: r.tangent_of(RotRef::Edge(e), rod),
+                });
+            }
         }
         self.edge_force[e] = f;
         let rf = kin.r * f;
@@ -345,16 +346,18 @@ impl Workspace {
             let md = r.bend_damping.component_mul(&kd);
             self.dissipation += t.weight * kd.dot(&md);
             m += md;
-            viscous = Some(BendViscous {
-                coeff: r.bend_damping,
-                factor: r.damping_factor,
-                rate_a: matches!(rate_var(rod, t.a), Var::Full(..)),
-                rate_b: matches!(rate_var(rod, t.b), Var::Full(..)),
-                omega_a,
-                omega_b,
-                tangent_a: r.tangent_of(t.a, rod),
-                tangent_b: r.tangent_of(t.b, rod),
-            });
+            if want_jac {
+                viscous = Some(BendViscous {
+                    coeff: r.bend_damping,
+                    factor: r.damping_factor,
+                    rate_a: matches!(rate_var(rod, t.a), Var::Full(..)),
+                    rate_b: matches!(rate_var(rod, t.b), Var::Full(..)),
+                    omega_a,
+                    omega_b,
+                    tangent_a: r.tangent_of(t.a, rod),
+                    tangent_b: r.tangent_of(t.b, rod),
+                });
+            }
         }
         if outputs {
             self.node_moment[t.node] += m;

@@ -47,6 +47,7 @@ pub struct ShearKinematics {
 }
 
 impl ShearKinematics {
+    #[inline]
     pub fn new(
         xa: &Vector3<f64>,
         xb: &Vector3<f64>,
@@ -65,6 +66,7 @@ impl ShearKinematics {
     }
 
     /// Γ̇ for the velocities ẋ_a, ẋ_b (global) and ω (body frame): dΓ = Rᵀ(dx_b − dx_a)/Δs + [u]× θ.
+    #[inline]
     pub fn rate(&self, va: &Vector3<f64>, vb: &Vector3<f64>, omega: &Vector3<f64>) -> Vector3<f64> {
         self.r.transpose() * ((vb - va) / self.ds) + self.u.cross(omega)
     }
