@@ -564,9 +564,10 @@ impl Workspace {
     pub fn residual_norms_range(&self, r: std::ops::Range<usize>, length: f64) -> (f64, f64) {
         let mut two = 0.0;
         let mut inf = 0.0f64;
+        let inv_length = 1.0 / length;
         for r in &self.rhs[r] {
             for k in 0..6 {
-                let v = if k < 3 { r[k] } else { r[k] / length };
+                let v = if k < 3 { r[k] } else { r[k] * inv_length };
                 two += v * v;
                 inf = inf.max(v.abs());
             }
