@@ -141,12 +141,35 @@ fn main() {
     let mut history: Vec<f64> = Vec::new();
     for rep in 0..reps {
         let mut st = st0.clone();
-        let mut dy = Dynamics::new(&rod, &st, &motions[0], opts.clone());
+        // BRANCH=k: the first k steps with the default options (a common start, with the same
+        // sub-steps in the start-up transient), the rest with the options from the environment.
+        let branch = env("BRANCH", 0.0) as usize;
+        let mut dy = Dynamics::new(
+            &rod,
+            &st,
+            &motions[0],
+            if branch > 0 {
+                DynamicOptions {
+                    outputs_every_step: false,
+                    ..DynamicOptions {
+                        tolerance: defaults.tolerance,
+                        refactor_rate: defaults.refactor_rate,
+                        max_iterations: defaults.max_iterations,
+                        ..opts.clone()
+                    }
+                }
+            } else {
+                opts.clone()
+            },
+        );
         dy.start(&rod, &st).unwrap();
         let t0 = Instant::now();
         let c0 = cpu_time();
         let (mut it, mut fa) = (0, 0);
         for k in 1..t_count {
+            if branch > 0 && k == branch + 1 {
+                dy.opts = opts.clone();
+            }
             let s = dy
                 .advance(&rod, &mut st, h, &motions[k - 1], &motions[k], 6)
                 .unwrap_or_else(|e| panic!("step {k}: {e}"));
