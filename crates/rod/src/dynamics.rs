@@ -480,6 +480,7 @@ impl Dynamics {
         };
         let mut stats = StepStats::default();
         let mut last_norm = f64::INFINITY;
+        let mut last_fresh_norm = f64::INFINITY;
         for it in 0..self.opts.max_iterations {
             let f = self.factors[k];
             let refactor = !f.valid || f.h != h;
@@ -499,12 +500,21 @@ impl Dynamics {
                 self.factors[k].valid = false;
                 continue;
             }
-            if !norm.is_finite() {
+            // Diverging: not finite, or a correction with a fresh matrix no smaller than the
+            // last one with a fresh matrix (Newton does not contract: give up early, the step
+            // is split).
+            if !norm.is_finite() || (refactor && norm >= last_fresh_norm) {
                 return Err(SolveError::NotConverged {
                     iterations: it + 1,
-                    residual: f64::INFINITY,
+                    residual: self
+                        .ws
+                        .residual_norms_range(seg.blocks.clone(), rod.mean_ds())
+                        .1,
                     load_factor: 1.0,
                 });
+            }
+            if refactor {
+                last_fresh_norm = norm;
             }
             self.increments[k] = self.apply_correction(rod, st, h, c_mass, seg);
             stats.iterations = it + 1;
