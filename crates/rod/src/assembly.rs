@@ -207,7 +207,7 @@ impl Workspace {
         match part {
             Part::All => {
                 for e in 0..rod.n_edges() {
-                    self.shear_term(rod, st, rates, want_jac, e);
+                    self.shear_term(rod, st, rates, want_jac, e, true);
                 }
                 for i in 0..rod.bend_terms.len() {
                     self.bend_term(rod, st, rates, want_jac, i, true)?;
@@ -220,7 +220,7 @@ impl Workspace {
             }
             Part::Segment(seg) => {
                 for &e in &seg.edges {
-                    self.shear_term(rod, st, rates, want_jac, e);
+                    self.shear_term(rod, st, rates, want_jac, e, false);
                 }
                 for &i in &seg.bend_terms {
                     self.bend_term(rod, st, rates, want_jac, i, false)?;
@@ -246,7 +246,8 @@ impl Workspace {
         Ok(())
     }
 
-    /// Shear/extension element of edge e.
+    /// Shear/extension element of edge e (with `outputs`, its energy and section force are
+    /// stored).
     #[inline]
     fn shear_term(
         &mut self,
@@ -255,13 +256,16 @@ impl Workspace {
         rates: Option<&Rates>,
         want_jac: bool,
         e: usize,
+        outputs: bool,
     ) {
         let sec = &rod.spec.section;
         let strain0 = Vector3::zeros();
         let ds = rod.ds_edge[e];
         let kin = ShearKinematics::new(&st.x[e], &st.x[e + 1], &st.p[e], ds, &strain0);
         let f_el = sec.shear_stiffness.component_mul(&kin.strain);
-        self.elastic_energy += 0.5 * ds * kin.strain.dot(&f_el);
+        if outputs {
+            self.elastic_energy += 0.5 * ds * kin.strain.dot(&f_el);
+        }
         let mut f = f_el;
         let mut viscous = None;
         if let Some(r) = rates {
@@ -284,7 +288,9 @@ impl Workspace {
                 });
             }
         }
-        self.edge_force[e] = f;
+        if outputs {
+            self.edge_force[e] = f;
+        }
         let rf = kin.r * f;
         self.node_grad[e] -= rf;
         self.node_grad[e + 1] += rf;
@@ -337,7 +343,9 @@ impl Workspace {
             .map_err(|kink| KinkAt { node: t.node, kink })?;
         let dk = kin.curvature - k0;
         let m_el = sec.bend_stiffness.component_mul(&dk);
-        self.elastic_energy += 0.5 * t.weight * dk.dot(&m_el);
+        if outputs {
+            self.elastic_energy += 0.5 * t.weight * dk.dot(&m_el);
+        }
         let mut m = m_el;
         let mut viscous = None;
         if let Some(r) = rates {

@@ -48,6 +48,8 @@ pub fn curvature(pa: &Quat, pb: &Quat, w: f64) -> Result<Vector3<f64>, Kink> {
 #[derive(Clone, Copy, Debug)]
 pub struct BendKinematics {
     pub w: f64,
+    /// 1/w.
+    pub inv_w: f64,
     /// Gibbs vector g = tan(φ/2)·axis of the relative rotation.
     pub g: Vector3<f64>,
     /// K (not reduced by K⁰).
@@ -65,11 +67,13 @@ impl BendKinematics {
                 cos_half_angle: s / (s * s + nv).sqrt(),
             });
         }
-        let g = q.imag() / s;
+        let g = q.imag() * (1.0 / s);
+        let inv_w = 1.0 / w;
         Ok(BendKinematics {
             w,
+            inv_w,
             g,
-            curvature: g * (2.0 / w),
+            curvature: g * (2.0 * inv_w),
         })
     }
 
@@ -89,14 +93,14 @@ impl BendKinematics {
 
     /// ∂K/∂θ_a, ∂K/∂θ_b.
     pub fn jacobians(&self) -> (Matrix3<f64>, Matrix3<f64>) {
-        (self.a() / self.w, self.b() / self.w)
+        (self.a() * self.inv_w, self.b() * self.inv_w)
     }
 
     /// K̇ for the body angular velocities ω_a, ω_b.
     #[inline]
     pub fn rate(&self, omega_a: &Vector3<f64>, omega_b: &Vector3<f64>) -> Vector3<f64> {
         let d = omega_b - omega_a;
-        (d + self.g.cross(&(omega_a + omega_b)) + self.g * self.g.dot(&d)) / self.w
+        (d + self.g.cross(&(omega_a + omega_b)) + self.g * self.g.dot(&d)) * self.inv_w
     }
 
     /// Generalised moments w Jᵀ m of the section moment m on (θ_a, θ_b).
@@ -131,7 +135,7 @@ impl BendKinematics {
         let d = omega_b - omega_a;
         let g = &self.g;
         let e = (Matrix3::identity() * g.dot(&d) + g * d.transpose() - skew(&(omega_a + omega_b)))
-            * (0.5 / self.w);
+            * (0.5 * self.inv_w);
         [e * self.a(), e * self.b()]
     }
 }
@@ -163,7 +167,7 @@ impl BendKinematics {
         viscous: Option<&BendViscous>,
     ) -> [[Matrix3<f64>; 2]; 2] {
         let (a, b) = (self.a(), self.b());
-        let inv_w = 1.0 / self.w;
+        let inv_w = self.inv_w;
         let geo = self.geometric(m);
         let (at, bt) = (a.transpose(), b.transpose());
         let mut pa = scale_rows(&(c * inv_w), &a);

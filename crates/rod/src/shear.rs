@@ -38,6 +38,8 @@ pub fn shear_strain(
 #[derive(Clone, Copy, Debug)]
 pub struct ShearKinematics {
     pub ds: f64,
+    /// 1/Δs.
+    pub inv_ds: f64,
     /// R(p).
     pub r: Matrix3<f64>,
     /// u = Rᵀ (x_b − x_a)/Δs.
@@ -56,9 +58,11 @@ impl ShearKinematics {
         strain0: &Vector3<f64>,
     ) -> Self {
         let r = rotation_matrix(p);
-        let u = r.transpose() * ((xb - xa) / ds);
+        let inv_ds = 1.0 / ds;
+        let u = r.transpose() * ((xb - xa) * inv_ds);
         ShearKinematics {
             ds,
+            inv_ds,
             r,
             u,
             strain: u - Vector3::z() - strain0,
@@ -68,7 +72,7 @@ impl ShearKinematics {
     /// Γ̇ for the velocities ẋ_a, ẋ_b (global) and ω (body frame): dΓ = Rᵀ(dx_b − dx_a)/Δs + [u]× θ.
     #[inline]
     pub fn rate(&self, va: &Vector3<f64>, vb: &Vector3<f64>, omega: &Vector3<f64>) -> Vector3<f64> {
-        self.r.transpose() * ((vb - va) / self.ds) + self.u.cross(omega)
+        self.r.transpose() * ((vb - va) * self.inv_ds) + self.u.cross(omega)
     }
 
     /// ∂Γ̇/∂(x_a, x_b, θ) at fixed velocities: the strain rate J v depends on the configuration
@@ -80,8 +84,8 @@ impl ShearKinematics {
         omega: &Vector3<f64>,
     ) -> [Matrix3<f64>; 3] {
         let wx = skew(omega);
-        let g = wx * self.r.transpose() / self.ds;
-        let w = self.r.transpose() * ((vb - va) / self.ds);
+        let g = wx * self.r.transpose() * self.inv_ds;
+        let w = self.r.transpose() * ((vb - va) * self.inv_ds);
         [g, -g, skew(&w) - wx * skew(&self.u)]
     }
 
@@ -153,7 +157,7 @@ impl ShearKinematics {
     ) -> ShearBlocks {
         let rt = self.r.transpose();
         let su = skew(&self.u);
-        let inv_ds = 1.0 / self.ds;
+        let inv_ds = self.inv_ds;
         let mut ca = -c * inv_ds;
         // θ column: configuration part (C J + τ∘C G, × J_r of the step) and rate part.
         let mut pth = scale_rows(c, &su);
