@@ -174,8 +174,17 @@ fn main() {
                 .advance(&rod, &mut st, h, &motions[k - 1], &motions[k], 6)
                 .unwrap_or_else(|e| panic!("step {k}: {e}"));
             it += s.iterations;
+            if rep == 0 && k == 20 {
+                println!(
+                    "first 20 steps (start-up transient): {:.2} ms",
+                    t0.elapsed().as_secs_f64() * 1e3
+                );
+            }
             if rep == 0 && s.substeps > 1 {
-                println!("step {k}: {} substeps", s.substeps);
+                println!(
+                    "step {k}: {} substeps, {} iterations, {} factorisations",
+                    s.substeps, s.iterations, s.factorizations
+                );
             }
             fa += s.factorizations;
             if rep == 0
