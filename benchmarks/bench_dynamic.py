@@ -3,19 +3,27 @@
 A 1.2 m cable, four clips, two of them on a bracket excited by a 10–200 Hz random motion of
 2 mm RMS (vertical), simulated 5 s at 1 ms: wall time, real-time factor, Newton iterations per
 step; then how the cost scales with N = 25 … 400 (1 s each) and with the number of steps.
-Run: python benchmarks/bench_dynamic.py [--quick]
+The solver wall time includes the static equilibrium at t = 0 (≈ 5 ms at N = 100) and the
+start-up transient. One core: OpenBLAS is held to one thread (the modal analysis otherwise
+leaves a worker thread spinning on the second core while the solver runs).
+Run: python benchmarks/bench_dynamic.py [--quick] [--repeat K]   (K runs of the headline case,
+     median and spread)
      python benchmarks/bench_dynamic.py --dump N DURATION FILE   (the scene, clip kinematics and
      damping as text for `cargo run --release -p cablelife-rod --example replay_dynamic -- FILE`)
 """
 
 from __future__ import annotations
 
+import os
+import statistics
 import sys
 import time
 
-import numpy as np
-from cablelife.scene import scene_from_dict
-from cablelife.simulate import simulate
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+import numpy as np  # noqa: E402
+from cablelife.scene import scene_from_dict  # noqa: E402
+from cablelife.simulate import simulate  # noqa: E402
 
 RMS = 2e-3
 BAND = (10.0, 200.0)
@@ -138,14 +146,22 @@ def main() -> None:
         dump(int(sys.argv[i + 1]), float(sys.argv[i + 2]), sys.argv[i + 3])
         return
     quick = "--quick" in sys.argv
+    repeat = int(sys.argv[sys.argv.index("--repeat") + 1]) if "--repeat" in sys.argv else 1
     duration = 1.0 if quick else 5.0
-    wall, total, its = run(100, duration)
+    runs = [run(100, duration) for _ in range(repeat)]
+    walls = sorted(r[0] for r in runs)
+    wall, total, its = statistics.median(walls), runs[0][1], runs[0][2]
     print(f"N = 100, {duration:g} s at 1 ms ({int(duration / 1e-3)} steps), 10–200 Hz, 2 mm RMS:")
     print(
         f"  solver wall {wall:.3f} s (with set-up and modal analysis {total:.3f} s), "
         f"real-time factor {wall / duration:.4f} → {duration / wall:.1f}× faster than real time,"
-        f" {its:.2f} Newton iterations per saved step"
+        f" {wall / duration * 1e3:.1f} µs/step, {its:.2f} Newton iterations per saved step"
     )
+    if repeat > 1:
+        print(
+            f"  median of {repeat} runs; min {walls[0]:.3f} s, max {walls[-1]:.3f} s "
+            f"({duration / walls[0]:.1f}× … {duration / walls[-1]:.1f}×)"
+        )
     print(
         f"{'N':>5} {'wall [s] for 1 s':>17} {'per step [µs]':>14} {'× real time':>12} "
         f"{'it/step':>8}"
