@@ -59,6 +59,27 @@ struct Record {
 }
 
 impl Record {
+    /// A record with room for `n` saved steps (no reallocation while recording).
+    fn with_capacity(n: usize, rod: &Rod) -> Record {
+        let (nodes, edges, clips) = (rod.arc.len(), rod.n_edges(), rod.spec.clips.len());
+        Record {
+            steps: 0,
+            positions: Vec::with_capacity(n * 3 * nodes),
+            quaternions: Vec::with_capacity(n * 4 * edges),
+            forces: Vec::with_capacity(n * 3 * edges),
+            moments: Vec::with_capacity(n * 3 * nodes),
+            reaction_force: Vec::with_capacity(n * 3 * clips),
+            reaction_moment: Vec::with_capacity(n * 3 * clips),
+            iterations: Vec::with_capacity(n),
+            substeps: Vec::with_capacity(n),
+            residual: Vec::with_capacity(n),
+            elastic_energy: Vec::with_capacity(n),
+            kinetic_energy: Vec::with_capacity(n),
+            load_potential: Vec::with_capacity(n),
+            dissipated_energy: Vec::with_capacity(n),
+        }
+    }
+
     fn push(&mut self, rod: &Rod, st: &State, ws: &Workspace, stats: &rod::SolveStats) {
         self.steps += 1;
         for x in &st.x {
@@ -415,6 +436,8 @@ impl Cable {
             rho_inf: spectral_radius,
             tau_shear: vec3(&tau_shear, "tau_shear")?,
             tau_bend: vec3(&tau_bend, "tau_bend")?,
+            // Section outputs and energies only on the recorded steps.
+            outputs_every_step: false,
             ..Default::default()
         };
         let initial = route(&self.rod, poses.first().map(|p| p.as_slice()))
@@ -425,7 +448,7 @@ impl Cable {
         let every = output_every.max(1);
         let poll_every = progress_every.max(1);
         let (record, error) = py.detach(move || {
-            let mut rec = Record::default();
+            let mut rec = Record::with_capacity(t.saturating_sub(1) / every + 1, rod);
             let mut st = initial;
             let stats = match solver.solve(rod, &mut st) {
                 Ok(s) => s,
@@ -441,10 +464,14 @@ impl Cable {
                 match dy.advance(rod, &mut st, time_step, &motions[k - 1], &motions[k], 6) {
                     Ok(s) => {
                         if k % every == 0 {
+                            if let Err(e) = dy.update_outputs(rod, &st) {
+                                *state_slot = Some(st);
+                                return (rec, Some(format!("step {k}: {e}")));
+                            }
                             let stats = rod::SolveStats {
                                 iterations: s.iterations,
                                 residual: s.residual,
-                                substeps: s.factorizations,
+                                substeps: s.substeps - 1,
                             };
                             rec.push(rod, &st, &dy.ws, &stats);
                             rec.push_energies(&dy.energies);

@@ -4,11 +4,11 @@
 //! The Jacobian is the exact derivative of the residual along the Newton update: the symmetric
 //! energy Hessian plus ½[g]× on each rotation's own block (g its energy gradient), which comes
 //! from exp(δ)exp(θ) = exp(δ + θ + ½ δ×θ + …), plus the derivative of dead moments −[Rᵀ M]×.
-use crate::bending::{BendKinematics, Kink};
-use crate::block_tridiag::{BlockTridiag, Singular};
-use crate::model::{EdgeKind, NodeKind, Rod, RotRef};
+use crate::bending::{BendKinematics, BendViscous, Kink};
+use crate::block_tridiag::{Block, BlockTridiag, Singular};
+use crate::model::{EdgeKind, NodeKind, Rod, RotRef, Segment};
 use crate::rotation::{rotation_matrix, skew, Quat};
-use crate::shear::ShearKinematics;
+use crate::shear::{ShearKinematics, ShearViscous};
 use crate::state::State;
 use crate::statics::SolveError;
 use nalgebra::{Matrix3, Vector3, Vector6};
@@ -49,9 +49,25 @@ pub struct Rates {
     pub bend_damping: Vector3<f64>,
     /// Factor of the damping matrix in the Jacobian (γ/(βh) in generalized-α).
     pub damping_factor: f64,
+    /// Per edge, J_r(hΔθ) of the rotation's increment in the step (empty: none), by which the
+    /// configuration derivatives along the edge's rotation are multiplied (the Newton update
+    /// changes the increment hΔθ, not the rotation from the right).
+    pub tangent: Vec<Matrix3<f64>>,
 }
 
 impl Rates {
+    /// J_r of a rotation's step (free edges only: the swivel twists and ghosts are moved by
+    /// the Newton update directly).
+    #[inline]
+    fn tangent_of(&self, r: RotRef, rod: &Rod) -> Option<Matrix3<f64>> {
+        match r {
+            RotRef::Edge(e) if !self.tangent.is_empty() && rod.edge_kind[e] == EdgeKind::Free => {
+                Some(self.tangent[e])
+            }
+            _ => None,
+        }
+    }
+
     fn omega(&self, r: RotRef) -> Vector3<f64> {
         match r {
             RotRef::Edge(e) => self.v[e].fixed_rows::<3>(3).into(),
@@ -65,6 +81,14 @@ impl Rates {
 pub struct KinkAt {
     pub node: usize,
     pub kink: Kink,
+}
+
+/// What an assembly covers: the whole cable, or one independent segment (whose residual rows
+/// and Jacobian blocks are then computed alone; reactions and section outputs need `All`).
+#[derive(Clone, Copy, Debug)]
+pub enum Part<'a> {
+    All,
+    Segment(&'a Segment),
 }
 
 /// A variable of an element: where its 3 coordinates go in the block structure.
@@ -97,15 +121,40 @@ impl Workspace {
     }
 
     pub fn clear(&mut self, want_jac: bool) {
-        if want_jac {
-            self.jac.clear();
+        self.clear_part(Part::All, want_jac);
+    }
+
+    /// Zeroes the gradients (and Jacobian rows) of a part and the energy sums.
+    pub fn clear_part(&mut self, part: Part, want_jac: bool) {
+        match part {
+            Part::All => {
+                if want_jac {
+                    self.jac.clear();
+                }
+                self.node_grad.iter_mut().for_each(|v| v.fill(0.0));
+                self.edge_grad.iter_mut().for_each(|v| v.fill(0.0));
+                self.ghost_grad.iter_mut().for_each(|v| v.fill(0.0));
+                self.node_moment.iter_mut().for_each(|v| v.fill(0.0));
+                self.node_moment_count.iter_mut().for_each(|c| *c = 0);
+            }
+            Part::Segment(seg) => {
+                if want_jac {
+                    self.jac.clear_range(seg.blocks.clone());
+                }
+                let n_edges = self.edge_grad.len();
+                for b in seg.blocks.clone() {
+                    self.node_grad[b].fill(0.0);
+                    if b < n_edges {
+                        self.edge_grad[b].fill(0.0);
+                    }
+                }
+                for &g in &seg.ghosts {
+                    self.ghost_grad[g].fill(0.0);
+                }
+            }
         }
-        self.node_grad.iter_mut().for_each(|v| v.fill(0.0));
-        self.edge_grad.iter_mut().for_each(|v| v.fill(0.0));
-        self.ghost_grad.iter_mut().for_each(|v| v.fill(0.0));
-        self.node_moment.iter_mut().for_each(|v| v.fill(0.0));
-        self.node_moment_count.iter_mut().for_each(|c| *c = 0);
         self.elastic_energy = 0.0;
+        self.dissipation = 0.0;
         self.load_potential = 0.0;
     }
 
@@ -133,7 +182,8 @@ impl Workspace {
     /// Elastic terms (shear/extension and bending/torsion) with the rotation-group correction;
     /// with `rates`, Kelvin–Voigt damping too: the section stress is C(Γ−Γ⁰) + τ∘C Γ̇ (and the
     /// same for K), the stored section forces and moments include it, and the Jacobian gets
-    /// `rates.damping_factor` × the damping matrix Jᵀ τ∘C J.
+    /// `rates.damping_factor` × the damping matrix Jᵀ τ∘C J plus the derivative of the viscous
+    /// forces through the strain rates' dependence on the configuration (Jᵀ τ∘C ∂(J v)/∂q).
     pub fn add_elastic(
         &mut self,
         rod: &Rod,
@@ -141,108 +191,215 @@ impl Workspace {
         rates: Option<&Rates>,
         want_jac: bool,
     ) -> Result<(), KinkAt> {
-        let sec = &rod.spec.section;
-        let strain0 = Vector3::zeros();
-        self.dissipation = 0.0;
-        for e in 0..rod.n_edges() {
-            let kin =
-                ShearKinematics::new(&st.x[e], &st.x[e + 1], &st.p[e], rod.ds_edge[e], &strain0);
-            let f_el = sec.shear_stiffness.component_mul(&kin.strain);
-            self.elastic_energy += 0.5 * rod.ds_edge[e] * kin.strain.dot(&f_el);
-            let mut f = f_el;
-            if let Some(r) = rates {
-                let (va, vb) = (r.v[e].fixed_rows::<3>(0), r.v[e + 1].fixed_rows::<3>(0));
-                let gd = kin.rate(&va.into(), &vb.into(), &r.v[e].fixed_rows::<3>(3).into());
-                let fd = r.shear_damping.component_mul(&gd);
-                self.dissipation += rod.ds_edge[e] * gd.dot(&fd);
-                f += fd;
-            }
-            self.edge_force[e] = f;
-            let g = kin.forces(&f);
-            self.node_grad[e] += g[0];
-            self.node_grad[e + 1] += g[1];
-            self.edge_grad[e] += g[2];
-            if want_jac {
-                let vars = [node_var(rod, e), node_var(rod, e + 1), edge_var(rod, e)];
-                let mut h = kin.gauss_newton(&sec.shear_stiffness);
-                let geo = kin.geometric(&f);
-                for i in 0..3 {
-                    for j in 0..3 {
-                        h[i][j] += geo[i][j];
-                        self.add(vars[i], vars[j], &h[i][j]);
-                    }
+        self.add_elastic_part(rod, st, rates, want_jac, Part::All)
+    }
+
+    /// `add_elastic` for a part (section moments are averaged only for `All`).
+    /// With `rates.tangent`, the rotation-group correction is multiplied by it too.
+    pub fn add_elastic_part(
+        &mut self,
+        rod: &Rod,
+        st: &State,
+        rates: Option<&Rates>,
+        want_jac: bool,
+        part: Part,
+    ) -> Result<(), KinkAt> {
+        match part {
+            Part::All => {
+                for e in 0..rod.n_edges() {
+                    self.shear_term(rod, st, rates, want_jac, e, true);
                 }
-                if let Some(r) = rates {
-                    let d = kin.gauss_newton(&r.shear_damping);
-                    let dvars = [
-                        node_var(rod, e),
-                        node_var(rod, e + 1),
-                        rate_var(rod, RotRef::Edge(e)),
-                    ];
-                    for i in 0..3 {
-                        for j in 0..3 {
-                            self.add(vars[i], dvars[j], &(r.damping_factor * d[i][j]));
-                        }
+                for i in 0..rod.bend_terms.len() {
+                    self.bend_term(rod, st, rates, want_jac, i, true)?;
+                }
+                for n in 0..self.node_moment.len() {
+                    if self.node_moment_count[n] > 1 {
+                        self.node_moment[n] /= self.node_moment_count[n] as f64;
                     }
                 }
             }
-        }
-        let k0 = rod.spec.natural_curvature;
-        for t in &rod.bend_terms {
-            let kin = BendKinematics::new(&rot(st, t.a), &rot(st, t.b), t.weight)
-                .map_err(|kink| KinkAt { node: t.node, kink })?;
-            let dk = kin.curvature - k0;
-            let m_el = sec.bend_stiffness.component_mul(&dk);
-            self.elastic_energy += 0.5 * t.weight * dk.dot(&m_el);
-            let mut m = m_el;
-            if let Some(r) = rates {
-                let kd = kin.rate(&r.omega(t.a), &r.omega(t.b));
-                let md = r.bend_damping.component_mul(&kd);
-                self.dissipation += t.weight * kd.dot(&md);
-                m += md;
-            }
-            self.node_moment[t.node] += m;
-            self.node_moment_count[t.node] += 1;
-            let g = kin.forces(&m);
-            for (r, gi) in [(t.a, g[0]), (t.b, g[1])] {
-                match r {
-                    RotRef::Edge(e) => self.edge_grad[e] += gi,
-                    RotRef::Ghost(k) => self.ghost_grad[k] += gi,
+            Part::Segment(seg) => {
+                for &e in &seg.edges {
+                    self.shear_term(rod, st, rates, want_jac, e, false);
                 }
-            }
-            if want_jac {
-                let vars = [rot_var(rod, t.a), rot_var(rod, t.b)];
-                let mut h = kin.gauss_newton(&sec.bend_stiffness);
-                let geo = kin.geometric(&m);
-                for i in 0..2 {
-                    for j in 0..2 {
-                        h[i][j] += geo[i][j];
-                        self.add(vars[i], vars[j], &h[i][j]);
-                    }
+                for &i in &seg.bend_terms {
+                    self.bend_term(rod, st, rates, want_jac, i, false)?;
                 }
-                if let Some(r) = rates {
-                    let d = kin.gauss_newton(&r.bend_damping);
-                    let dvars = [rate_var(rod, t.a), rate_var(rod, t.b)];
-                    for i in 0..2 {
-                        for j in 0..2 {
-                            self.add(vars[i], dvars[j], &(r.damping_factor * d[i][j]));
-                        }
-                    }
-                }
-            }
-        }
-        for n in 0..self.node_moment.len() {
-            if self.node_moment_count[n] > 1 {
-                self.node_moment[n] /= self.node_moment_count[n] as f64;
             }
         }
         if want_jac {
-            for e in 0..rod.n_edges() {
+            let edges = match part {
+                Part::All => 0..rod.n_edges(),
+                Part::Segment(seg) => seg.blocks.start..seg.blocks.end.min(rod.n_edges()),
+            };
+            for e in edges {
                 if rod.edge_kind[e] != EdgeKind::Free {
                     continue; // prescribed, or a single twist axis (whose correction is zero)
                 }
-                let corr = 0.5 * skew(&self.edge_grad[e]);
-                self.jac.add3(e, 1, e, 1, &corr);
+                let mut corr = 0.5 * skew(&self.edge_grad[e]);
+                if let Some(jr) = rates.and_then(|r| r.tangent_of(RotRef::Edge(e), rod)) {
+                    corr *= jr;
+                }
+                add_half(&mut self.jac.diag[e], 1, 1, &corr);
+            }
+        }
+        Ok(())
+    }
+
+    /// Shear/extension element of edge e (with `outputs`, its energy and section force are
+    /// stored).
+    #[inline]
+    fn shear_term(
+        &mut self,
+        rod: &Rod,
+        st: &State,
+        rates: Option<&Rates>,
+        want_jac: bool,
+        e: usize,
+        outputs: bool,
+    ) {
+        let sec = &rod.spec.section;
+        let strain0 = Vector3::zeros();
+        let ds = rod.ds_edge[e];
+        let kin = ShearKinematics::new(&st.x[e], &st.x[e + 1], &st.p[e], ds, &strain0);
+        let f_el = sec.shear_stiffness.component_mul(&kin.strain);
+        if outputs {
+            self.elastic_energy += 0.5 * ds * kin.strain.dot(&f_el);
+        }
+        let mut f = f_el;
+        let mut viscous = None;
+        if let Some(r) = rates {
+            let va: Vector3<f64> = r.v[e].fixed_rows::<3>(0).into();
+            let vb: Vector3<f64> = r.v[e + 1].fixed_rows::<3>(0).into();
+            let omega: Vector3<f64> = r.v[e].fixed_rows::<3>(3).into();
+            let gd = kin.rate(&va, &vb, &omega);
+            let fd = r.shear_damping.component_mul(&gd);
+            self.dissipation += ds * gd.dot(&fd);
+            f += fd;
+            if want_jac {
+                viscous = Some(ShearViscous {
+                    coeff: r.shear_damping,
+                    factor: r.damping_factor,
+                    rate_theta: rod.edge_kind[e] == EdgeKind::Free,
+                    va,
+                    vb,
+                    omega,
+                    tangent: r.tangent_of(RotRef::Edge(e), rod),
+                });
+            }
+        }
+        if outputs {
+            self.edge_force[e] = f;
+        }
+        let rf = kin.r * f;
+        self.node_grad[e] -= rf;
+        self.node_grad[e + 1] += rf;
+        self.edge_grad[e] += ds * f.cross(&kin.u);
+        if want_jac {
+            let jb = kin.jacobian(&f, &sec.shear_stiffness, viscous.as_ref());
+            let a_free = rod.node_kind[e] == NodeKind::Free;
+            let b_free = rod.node_kind[e + 1] == NodeKind::Free;
+            let edge = !matches!(rod.edge_kind[e], EdgeKind::Prescribed { .. });
+            let jac = &mut self.jac;
+            if a_free {
+                add_half(&mut jac.diag[e], 0, 0, &-jb.x);
+            }
+            if b_free {
+                add_half(&mut jac.diag[e + 1], 0, 0, &-jb.x);
+            }
+            if a_free && b_free {
+                add_half(&mut jac.upper[e], 0, 0, &jb.x);
+                add_half(&mut jac.lower[e + 1], 0, 0, &jb.x);
+            }
+            if edge {
+                add_half(&mut jac.diag[e], 1, 1, &jb.t);
+                if a_free {
+                    add_half(&mut jac.diag[e], 0, 1, &-jb.y);
+                    add_half(&mut jac.diag[e], 1, 0, &jb.w);
+                }
+                if b_free {
+                    add_half(&mut jac.lower[e + 1], 0, 1, &jb.y);
+                    add_half(&mut jac.upper[e], 1, 0, &-jb.w);
+                }
+            }
+        }
+    }
+
+    /// Bending/torsion term i (with `outputs`, its section moment is added to the node's).
+    #[inline]
+    fn bend_term(
+        &mut self,
+        rod: &Rod,
+        st: &State,
+        rates: Option<&Rates>,
+        want_jac: bool,
+        i: usize,
+        outputs: bool,
+    ) -> Result<(), KinkAt> {
+        let sec = &rod.spec.section;
+        let k0 = rod.spec.natural_curvature;
+        let t = &rod.bend_terms[i];
+        let kin = BendKinematics::new(&rot(st, t.a), &rot(st, t.b), t.weight)
+            .map_err(|kink| KinkAt { node: t.node, kink })?;
+        let dk = kin.curvature - k0;
+        let m_el = sec.bend_stiffness.component_mul(&dk);
+        if outputs {
+            self.elastic_energy += 0.5 * t.weight * dk.dot(&m_el);
+        }
+        let mut m = m_el;
+        let mut viscous = None;
+        if let Some(r) = rates {
+            let (omega_a, omega_b) = (r.omega(t.a), r.omega(t.b));
+            let kd = kin.rate(&omega_a, &omega_b);
+            let md = r.bend_damping.component_mul(&kd);
+            self.dissipation += t.weight * kd.dot(&md);
+            m += md;
+            if want_jac {
+                viscous = Some(BendViscous {
+                    coeff: r.bend_damping,
+                    factor: r.damping_factor,
+                    rate_a: matches!(rate_var(rod, t.a), Var::Full(..)),
+                    rate_b: matches!(rate_var(rod, t.b), Var::Full(..)),
+                    omega_a,
+                    omega_b,
+                    tangent_a: r.tangent_of(t.a, rod),
+                    tangent_b: r.tangent_of(t.b, rod),
+                });
+            }
+        }
+        if outputs {
+            self.node_moment[t.node] += m;
+            self.node_moment_count[t.node] += 1;
+        }
+        let g = kin.forces(&m);
+        for (r, gi) in [(t.a, g[0]), (t.b, g[1])] {
+            match r {
+                RotRef::Edge(e) => self.edge_grad[e] += gi,
+                RotRef::Ghost(k) => self.ghost_grad[k] += gi,
+            }
+        }
+        if want_jac {
+            let h = kin.jacobian(&m, &sec.bend_stiffness, viscous.as_ref());
+            match (t.a, t.b) {
+                (RotRef::Edge(ea), RotRef::Edge(eb))
+                    if eb == ea + 1
+                        && rod.edge_kind[ea] == EdgeKind::Free
+                        && rod.edge_kind[eb] == EdgeKind::Free =>
+                {
+                    let jac = &mut self.jac;
+                    add_half(&mut jac.diag[ea], 1, 1, &h[0][0]);
+                    add_half(&mut jac.upper[ea], 1, 1, &h[0][1]);
+                    add_half(&mut jac.lower[eb], 1, 1, &h[1][0]);
+                    add_half(&mut jac.diag[eb], 1, 1, &h[1][1]);
+                }
+                _ => {
+                    let vars = [rot_var(rod, t.a), rot_var(rod, t.b)];
+                    for i in 0..2 {
+                        for j in 0..2 {
+                            self.add(vars[i], vars[j], &h[i][j]);
+                        }
+                    }
+                }
             }
         }
         Ok(())
@@ -250,13 +407,31 @@ impl Workspace {
 
     /// Gravity and point loads, scaled by `load_factor`.
     pub fn add_external(&mut self, rod: &Rod, st: &State, load_factor: f64, want_jac: bool) {
+        self.add_external_part(rod, st, load_factor, want_jac, Part::All, None);
+    }
+
+    /// `add_external` for the nodes and edges of a part (the load potential only for `All`);
+    /// the dead-moment derivative times `rates.tangent` if given.
+    pub fn add_external_part(
+        &mut self,
+        rod: &Rod,
+        st: &State,
+        load_factor: f64,
+        want_jac: bool,
+        part: Part,
+        rates: Option<&Rates>,
+    ) {
         let g = rod.spec.gravity;
-        for n in 0..st.x.len() {
+        let blocks = part_blocks(rod, part);
+        let potential = matches!(part, Part::All);
+        for n in blocks.clone() {
             let f = load_factor * (rod.node_mass[n] * g + rod.node_force[n]);
             self.node_grad[n] -= f;
-            self.load_potential -= f.dot(&st.x[n]);
+            if potential {
+                self.load_potential -= f.dot(&st.x[n]);
+            }
         }
-        for e in 0..rod.n_edges() {
+        for e in blocks.start..blocks.end.min(rod.n_edges()) {
             let m = rod.edge_moment[e];
             if m == Vector3::zeros() {
                 continue;
@@ -264,15 +439,25 @@ impl Workspace {
             let mb = rotation_matrix(&st.p[e]).transpose() * (load_factor * m);
             self.edge_grad[e] -= mb;
             if want_jac {
-                self.jac.add3(e, 1, e, 1, &(-skew(&mb)));
+                let mut d = -skew(&mb);
+                if let Some(jr) = rates.and_then(|r| r.tangent_of(RotRef::Edge(e), rod)) {
+                    d *= jr;
+                }
+                self.jac.add3(e, 1, e, 1, &d);
             }
         }
     }
 
     /// Gathers the gradients into the block residual and eliminates inactive slots.
     pub fn finalize(&mut self, rod: &Rod, want_jac: bool) {
+        self.finalize_part(rod, want_jac, Part::All);
+    }
+
+    /// `finalize` for the blocks of a part.
+    pub fn finalize_part(&mut self, rod: &Rod, want_jac: bool, part: Part) {
         let n_edges = rod.n_edges();
-        for n in 0..=n_edges {
+        let blocks = part_blocks(rod, part);
+        for n in blocks.clone() {
             let mut r = Vector6::zeros();
             r.fixed_rows_mut::<3>(0).copy_from(&self.node_grad[n]);
             if n < n_edges {
@@ -281,11 +466,14 @@ impl Workspace {
             self.rhs[n] = r;
         }
         for (k, g) in rod.ghosts.iter().enumerate() {
-            if g.twist_free {
+            if g.twist_free && blocks.contains(&g.node) {
                 self.rhs[g.node][0] = self.ghost_grad[k].z;
             }
         }
-        for n in 0..=n_edges {
+        for n in blocks {
+            if rod.mask[n] == [true; 6] {
+                continue;
+            }
             for k in 0..6 {
                 if !rod.mask[n][k] {
                     self.rhs[n][k] = 0.0;
@@ -341,15 +529,34 @@ impl Workspace {
             })
     }
 
+    /// Factors the Jacobian rows of a segment (see `factor`).
+    pub fn factor_segment(&mut self, rod: &Rod, seg: &Segment) -> Result<(), SolveError> {
+        self.jac
+            .factor_range(seg.blocks.clone())
+            .map_err(|Singular { block }| SolveError::Singular {
+                node: block,
+                s: rod.arc[block.min(rod.arc.len() - 1)],
+            })
+    }
+
     /// The Newton correction Δ = −J⁻¹ r with the current factorisation, and its largest
     /// position and rotation components (|Δx|, |θ|).
     pub fn newton_correction(&self, delta: &mut [Vector6<f64>]) -> (f64, f64) {
-        for (d, r) in delta.iter_mut().zip(&self.rhs) {
-            *d = -r;
+        self.newton_correction_range(0..delta.len(), delta)
+    }
+
+    /// `newton_correction` for the blocks `r` of an independent segment (its factorisation).
+    pub fn newton_correction_range(
+        &self,
+        r: std::ops::Range<usize>,
+        delta: &mut [Vector6<f64>],
+    ) -> (f64, f64) {
+        for b in r.clone() {
+            delta[b] = -self.rhs[b];
         }
-        self.jac.solve_factored(delta);
+        self.jac.solve_range(r.clone(), delta);
         let (mut dx, mut dth) = (0.0f64, 0.0f64);
-        for d in delta.iter() {
+        for d in &delta[r] {
             dx = dx.max(d.fixed_rows::<3>(0).amax());
             dth = dth.max(d.fixed_rows::<3>(3).amax());
         }
@@ -358,11 +565,17 @@ impl Workspace {
 
     /// Scaled residual norms (max over blocks): forces in N, moments divided by `length`.
     pub fn residual_norms(&self, length: f64) -> (f64, f64) {
+        self.residual_norms_range(0..self.rhs.len(), length)
+    }
+
+    /// `residual_norms` over the blocks `r`.
+    pub fn residual_norms_range(&self, r: std::ops::Range<usize>, length: f64) -> (f64, f64) {
         let mut two = 0.0;
         let mut inf = 0.0f64;
-        for r in &self.rhs {
+        let inv_length = 1.0 / length;
+        for r in &self.rhs[r] {
             for k in 0..6 {
-                let v = if k < 3 { r[k] } else { r[k] / length };
+                let v = if k < 3 { r[k] } else { r[k] * inv_length };
                 two += v * v;
                 inf = inf.max(v.abs());
             }
@@ -371,18 +584,27 @@ impl Workspace {
     }
 }
 
+/// The blocks of a part.
+#[inline]
+fn part_blocks(rod: &Rod, part: Part) -> std::ops::Range<usize> {
+    match part {
+        Part::All => 0..rod.arc.len(),
+        Part::Segment(seg) => seg.blocks.clone(),
+    }
+}
+
+/// Adds a 3×3 matrix to the (hi, hj) half of a 6×6 block.
+#[inline(always)]
+fn add_half(block: &mut Block, hi: usize, hj: usize, m: &Matrix3<f64>) {
+    let mut v = block.fixed_view_mut::<3, 3>(3 * hi, 3 * hj);
+    v += m;
+}
+
 #[inline]
 fn rot(st: &State, r: RotRef) -> Quat {
     match r {
         RotRef::Edge(e) => st.p[e],
         RotRef::Ghost(g) => st.ghost[g],
-    }
-}
-
-fn node_var(rod: &Rod, n: usize) -> Var {
-    match rod.node_kind[n] {
-        NodeKind::Free => Var::Full(n, 0),
-        NodeKind::Prescribed { .. } => Var::None,
     }
 }
 

@@ -4,8 +4,9 @@
 //! K is the relative rotation's axis times (2/δs) tan(φ/2); the axis has the same components
 //! in the frames of a and b, so K and M are "the" material-frame values at the node.
 //! Derivatives in θ_a, θ_b with p ← p ⊗ exp(θ/2) at θ = 0 (exact, symmetric Hessian).
-use crate::rotation::Quat;
-use nalgebra::{Matrix3, Matrix3x4, Matrix4, Matrix4x3, Quaternion, Vector3, Vector4};
+use crate::rotation::{skew, Quat};
+use crate::shear::scale_rows;
+use nalgebra::{Matrix3, Vector3};
 
 /// Value, gradient and Hessian of one bending element.
 #[derive(Clone, Debug, Default)]
@@ -29,13 +30,6 @@ pub struct Kink {
 /// Smallest |cos(φ/2)| accepted, φ the rotation between neighbouring edges (φ < 179.9°).
 pub const MIN_COS_HALF: f64 = 1e-3;
 
-#[inline]
-fn pure(i: usize) -> Quat {
-    let mut v = Vector3::zeros();
-    v[i] = 1.0;
-    Quaternion::from_imag(v)
-}
-
 /// Curvature of two rotations over the cell length `w`.
 #[inline]
 pub fn curvature(pa: &Quat, pb: &Quat, w: f64) -> Result<Vector3<f64>, Kink> {
@@ -48,112 +42,166 @@ pub fn curvature(pa: &Quat, pb: &Quat, w: f64) -> Result<Vector3<f64>, Kink> {
     Ok(q.imag() * (2.0 / (w * q.w)))
 }
 
-/// Curvature K of a bending cell and its derivatives with respect to θ_a, θ_b.
+/// Curvature K of a bending cell and its derivatives with respect to θ_a, θ_b, in closed form
+/// through the Gibbs vector g = Im(q)/Re(q) of q = p̄_a p_b (K = (2/w) g):
+/// ∂K/∂θ_a = A/w, ∂K/∂θ_b = B/w with A = −I + [g]× − g gᵀ and B = −Aᵀ = I + [g]× + g gᵀ.
 #[derive(Clone, Copy, Debug)]
 pub struct BendKinematics {
     pub w: f64,
-    /// q = p̄_a p_b.
-    q: Quat,
+    /// 1/w.
+    pub inv_w: f64,
+    /// Gibbs vector g = tan(φ/2)·axis of the relative rotation.
+    pub g: Vector3<f64>,
     /// K (not reduced by K⁰).
     pub curvature: Vector3<f64>,
-    dkdq: Matrix3x4<f64>,
-    qa: Matrix4x3<f64>,
-    qb: Matrix4x3<f64>,
-    /// ∂K/∂θ_a, ∂K/∂θ_b.
-    pub ja: Matrix3<f64>,
-    pub jb: Matrix3<f64>,
 }
 
 impl BendKinematics {
+    #[inline]
     pub fn new(pa: &Quat, pb: &Quat, w: f64) -> Result<Self, Kink> {
         let q = pa.conjugate() * pb;
         let s = q.w;
-        if s.abs() < MIN_COS_HALF * q.norm() {
+        let nv = q.imag().norm_squared();
+        if s * s < MIN_COS_HALF * MIN_COS_HALF * (s * s + nv) {
             return Err(Kink {
-                cos_half_angle: s / q.norm(),
+                cos_half_angle: s / (s * s + nv).sqrt(),
             });
         }
-        let v = q.imag();
-        let c2 = 2.0 / w;
-        // ∂K/∂q, columns (s, v1, v2, v3).
-        let mut dkdq = Matrix3x4::zeros();
-        dkdq.set_column(0, &(-v * (c2 / (s * s))));
-        for i in 0..3 {
-            dkdq[(i, i + 1)] = c2 / s;
-        }
-        // ∂q/∂θ_a = −½ ε_j ⊗ q, ∂q/∂θ_b = ½ q ⊗ ε_j (columns j).
-        let mut qa = Matrix4x3::zeros();
-        let mut qb = Matrix4x3::zeros();
-        for j in 0..3 {
-            let a = pure(j) * q * -0.5;
-            let b = q * pure(j) * 0.5;
-            qa.set_column(j, &Vector4::new(a.w, a.i, a.j, a.k));
-            qb.set_column(j, &Vector4::new(b.w, b.i, b.j, b.k));
-        }
+        let g = q.imag() * (1.0 / s);
+        let inv_w = 1.0 / w;
         Ok(BendKinematics {
             w,
-            q,
-            curvature: v * (c2 / s),
-            dkdq,
-            qa,
-            qb,
-            ja: dkdq * qa,
-            jb: dkdq * qb,
+            inv_w,
+            g,
+            curvature: g * (2.0 * inv_w),
         })
     }
 
+    /// A = w ∂K/∂θ_a.
+    #[inline]
+    pub fn a(&self) -> Matrix3<f64> {
+        let g = &self.g;
+        skew(g) - Matrix3::identity() - g * g.transpose()
+    }
+
+    /// B = w ∂K/∂θ_b = −Aᵀ.
+    #[inline]
+    pub fn b(&self) -> Matrix3<f64> {
+        let g = &self.g;
+        skew(g) + Matrix3::identity() + g * g.transpose()
+    }
+
+    /// ∂K/∂θ_a, ∂K/∂θ_b.
+    pub fn jacobians(&self) -> (Matrix3<f64>, Matrix3<f64>) {
+        (self.a() * self.inv_w, self.b() * self.inv_w)
+    }
+
     /// K̇ for the body angular velocities ω_a, ω_b.
+    #[inline]
     pub fn rate(&self, omega_a: &Vector3<f64>, omega_b: &Vector3<f64>) -> Vector3<f64> {
-        self.ja * omega_a + self.jb * omega_b
+        let d = omega_b - omega_a;
+        (d + self.g.cross(&(omega_a + omega_b)) + self.g * self.g.dot(&d)) * self.inv_w
     }
 
     /// Generalised moments w Jᵀ m of the section moment m on (θ_a, θ_b).
+    #[inline]
     pub fn forces(&self, m: &Vector3<f64>) -> [Vector3<f64>; 2] {
-        [
-            self.w * self.ja.transpose() * m,
-            self.w * self.jb.transpose() * m,
-        ]
+        let gm = self.g.cross(m);
+        let proj = self.g * self.g.dot(m);
+        [-m - gm - proj, m - gm + proj]
     }
 
-    /// w Jᵀ C J for a diagonal C (stiffness or viscous damping).
-    pub fn gauss_newton(&self, c: &Vector3<f64>) -> [[Matrix3<f64>; 2]; 2] {
-        let c = Matrix3::from_diagonal(c);
-        let (ja, jb) = (self.ja, self.jb);
-        let ab = self.w * ja.transpose() * c * jb;
-        [
-            [self.w * ja.transpose() * c * ja, ab],
-            [ab.transpose(), self.w * jb.transpose() * c * jb],
-        ]
-    }
-
-    /// Σ_k m_k w ∇²K_k: the geometric stiffness of the section moment m.
+    /// Σ_k m_k w ∇²K_k: the geometric stiffness of the section moment m (the symmetric
+    /// second derivative in θ_a, θ_b, from the composition of Gibbs vectors).
     pub fn geometric(&self, m: &Vector3<f64>) -> [[Matrix3<f64>; 2]; 2] {
-        let (s, v) = (self.q.w, self.q.imag());
-        let c2 = 2.0 / self.w;
-        // Σ_k m_k ∂²K_k/∂q² (K = (2/w) v/s: only the s-s and s-v entries are non-zero).
-        let mut sqq = Matrix4::zeros();
-        sqq[(0, 0)] = c2 * 2.0 * m.dot(&v) / (s * s * s);
-        for j in 0..3 {
-            sqq[(0, j + 1)] = -c2 * m[j] / (s * s);
-            sqq[(j + 1, 0)] = sqq[(0, j + 1)];
-        }
-        // λ = (∂K/∂q)ᵀ m with the second derivatives of q: aa and bb are −q/4 δij, which
-        // contract with λ to zero (K is homogeneous of degree 0 in q); ab is −¼ ε_i ⊗ q ⊗ ε_j.
-        let lambda = self.dkdq.transpose() * m;
-        let mut tab = Matrix3::zeros();
-        for i in 0..3 {
-            let left = pure(i) * self.q;
-            for j in 0..3 {
-                let d = left * pure(j);
-                tab[(i, j)] = -0.25 * lambda.dot(&Vector4::new(d.w, d.i, d.j, d.k));
+        let g = &self.g;
+        let mg = m.dot(g);
+        let ggt = g * g.transpose();
+        let sym = |x: Matrix3<f64>| 0.5 * (x + x.transpose());
+        let haa = sym((m + g.cross(m)) * g.transpose()) + mg * ggt;
+        let hbb = sym((m + m.cross(g)) * g.transpose()) + mg * ggt;
+        let xab = (g * m.transpose() - skew(m) + Matrix3::identity() * mg) * self.b();
+        let ab = -0.5 * xab;
+        [[haa, ab], [ab.transpose(), hbb]]
+    }
+
+    /// ∂K̇/∂θ_a, ∂K̇/∂θ_b at fixed angular velocities (K̇ depends on the configuration
+    /// through g).
+    pub fn rate_derivative(
+        &self,
+        omega_a: &Vector3<f64>,
+        omega_b: &Vector3<f64>,
+    ) -> [Matrix3<f64>; 2] {
+        let d = omega_b - omega_a;
+        let g = &self.g;
+        let e = (Matrix3::identity() * g.dot(&d) + g * d.transpose() - skew(&(omega_a + omega_b)))
+            * (0.5 * self.inv_w);
+        [e * self.a(), e * self.b()]
+    }
+}
+
+/// Kelvin–Voigt damping of a bending cell in a dynamic Jacobian (see `ShearViscous`).
+#[derive(Clone, Copy, Debug)]
+pub struct BendViscous {
+    pub coeff: Vector3<f64>,
+    pub factor: f64,
+    /// Whether rotation a (b) has a tracked rate (a free edge).
+    pub rate_a: bool,
+    pub rate_b: bool,
+    pub omega_a: Vector3<f64>,
+    pub omega_b: Vector3<f64>,
+    /// J_r of the rotations' increments in the step (see `ShearViscous::tangent`).
+    pub tangent_a: Option<Matrix3<f64>>,
+    pub tangent_b: Option<Matrix3<f64>>,
+}
+
+impl BendKinematics {
+    /// The derivative of the generalised moments w Jᵀ m, m = C(K − K⁰) (+ τ∘C K̇), along the
+    /// Newton update (without the rotation-group correction ½[g]×): w Jᵀ P + geometric(m) with
+    /// P = C J + τ∘C (c J + G) on the rate unknowns, G = ∂K̇/∂θ, the configuration part of each
+    /// column times the tangent J_r of its rotation's step. Blocks [[aa, ab], [ba, bb]].
+    pub fn jacobian(
+        &self,
+        m: &Vector3<f64>,
+        c: &Vector3<f64>,
+        viscous: Option<&BendViscous>,
+    ) -> [[Matrix3<f64>; 2]; 2] {
+        let (a, b) = (self.a(), self.b());
+        let inv_w = self.inv_w;
+        let geo = self.geometric(m);
+        let (at, bt) = (a.transpose(), b.transpose());
+        let mut pa = scale_rows(&(c * inv_w), &a);
+        let mut pb = scale_rows(&(c * inv_w), &b);
+        let Some(v) = viscous else {
+            return [
+                [at * pa + geo[0][0], at * pb + geo[0][1]],
+                [bt * pa + geo[1][0], bt * pb + geo[1][1]],
+            ];
+        };
+        let g = self.rate_derivative(&v.omega_a, &v.omega_b);
+        pa += scale_rows(&v.coeff, &g[0]);
+        pb += scale_rows(&v.coeff, &g[1]);
+        // Configuration part (× J_r of the rotation's step), then the rate part.
+        let mut col_a = [at * pa + geo[0][0], bt * pa + geo[1][0]];
+        let mut col_b = [at * pb + geo[0][1], bt * pb + geo[1][1]];
+        for (col, jr) in [(&mut col_a, v.tangent_a), (&mut col_b, v.tangent_b)] {
+            if let Some(jr) = jr {
+                col[0] *= jr;
+                col[1] *= jr;
             }
         }
-        let (qa, qb, w) = (self.qa, self.qb, self.w);
-        let ab = w * (qa.transpose() * sqq * qb + tab);
-        [
-            [w * qa.transpose() * sqq * qa, ab],
-            [ab.transpose(), w * qb.transpose() * sqq * qb],
-        ]
+        let rate = v.coeff * (v.factor * inv_w);
+        if v.rate_a {
+            let ra = scale_rows(&rate, &a);
+            col_a[0] += at * ra;
+            col_a[1] += bt * ra;
+        }
+        if v.rate_b {
+            let rb = scale_rows(&rate, &b);
+            col_b[0] += at * rb;
+            col_b[1] += bt * rb;
+        }
+        [[col_a[0], col_b[0]], [col_a[1], col_b[1]]]
     }
 }
 
@@ -176,13 +224,7 @@ pub fn bend_element(
     out.moment = m;
     out.grad = kin.forces(&m);
     if want_hess {
-        let gn = kin.gauss_newton(stiffness);
-        let geo = kin.geometric(&m);
-        for i in 0..2 {
-            for j in 0..2 {
-                out.hess[i][j] = gn[i][j] + geo[i][j];
-            }
-        }
+        out.hess = kin.jacobian(&m, stiffness, None);
     }
     Ok(())
 }
@@ -218,6 +260,53 @@ mod tests {
             |i| e.grad[i / 3][i % 3],
             |i, j| e.hess[i / 3][j / 3][(i % 3, j % 3)],
         );
+    }
+
+    #[test]
+    fn curvature_rate_and_its_configuration_derivative_match_finite_differences() {
+        let base_a = exp_half(&Vector3::new(0.3, 0.2, -0.5));
+        let base_b = exp_half(&Vector3::new(0.45, 0.1, -0.3));
+        let (wa, wb) = (Vector3::new(0.7, -1.1, 0.4), Vector3::new(-0.2, 0.9, 1.3));
+        let w = 0.05;
+        let kin_at = |z: &[f64; 6]| {
+            let pa = rotate_body(&base_a, &Vector3::new(z[0], z[1], z[2]));
+            let pb = rotate_body(&base_b, &Vector3::new(z[3], z[4], z[5]));
+            BendKinematics::new(&pa, &pb, w).unwrap()
+        };
+        let kin = kin_at(&[0.0; 6]);
+        let (ja, jb) = kin.jacobians();
+        let g = kin.rate_derivative(&wa, &wb);
+        let h = 1e-6;
+        let scale_j = ja.amax().max(jb.amax());
+        let scale_g = g[0].amax().max(g[1].amax());
+        for i in 0..6 {
+            let mut zp = [0.0; 6];
+            let mut zm = [0.0; 6];
+            zp[i] = h;
+            zm[i] = -h;
+            let (kp, km) = (kin_at(&zp), kin_at(&zm));
+            // K along the coordinate: the columns of ∂K/∂θ.
+            let dk = (kp.curvature - km.curvature) / (2.0 * h);
+            let an_j = if i < 3 {
+                ja.column(i)
+            } else {
+                jb.column(i - 3)
+            };
+            assert!((dk - an_j).amax() < 1e-6 * scale_j, "∂K/∂θ col {i}");
+            // K̇ at fixed ω along the coordinate.
+            let dr = (kp.rate(&wa, &wb) - km.rate(&wa, &wb)) / (2.0 * h);
+            let an = if i < 3 {
+                g[0].column(i)
+            } else {
+                g[1].column(i - 3)
+            };
+            assert!(
+                (dr - an).amax() < 1e-6 * scale_g,
+                "∂K̇/∂θ col {i}: fd {dr} analytic {an}"
+            );
+        }
+        // K̇ is ∂K/∂θ ω.
+        assert!((kin.rate(&wa, &wb) - (ja * wa + jb * wb)).amax() < 1e-12 * scale_j);
     }
 
     #[test]

@@ -1,6 +1,8 @@
-//! Block-tridiagonal matrices with 6×6 blocks and their O(N) solve (block Thomas algorithm with
-//! LU-inverted pivot blocks, so that substitutions are matrix–vector products). Storage is allocated once; factor and solve do not allocate.
-use nalgebra::{Matrix3, Matrix6, Vector6, LU};
+//! Block-tridiagonal matrices with 6×6 blocks and their O(N) solve (block Thomas algorithm; the
+//! pivot blocks are LU-factored in place with partial pivoting). Storage is allocated once;
+//! factor and solve do not allocate.
+use nalgebra::{Matrix3, Matrix6, Vector6};
+use std::ops::Range;
 
 pub type Block = Matrix6<f64>;
 
@@ -12,7 +14,8 @@ pub struct BlockTridiag {
     pub lower: Vec<Block>,
     /// J[n][n+1] (last entry unused).
     pub upper: Vec<Block>,
-    /// D'_n⁻¹, the inverted pivot blocks (substitution is then matrix–vector products only).
+    /// D'_n⁻¹, the inverted pivot blocks D'_n = D_n − L_n D'_{n−1}⁻¹ U_{n−1} (substitution
+    /// is then matrix–vector products only).
     inv: Vec<Block>,
     /// D'_n⁻¹ U_n of the forward elimination.
     elim: Vec<Block>,
@@ -40,13 +43,15 @@ impl BlockTridiag {
     }
 
     pub fn clear(&mut self) {
-        for m in self
-            .diag
-            .iter_mut()
-            .chain(self.lower.iter_mut())
-            .chain(self.upper.iter_mut())
-        {
-            m.fill(0.0);
+        self.clear_range(0..self.n_blocks());
+    }
+
+    /// Zeroes the rows of blocks `r`.
+    pub fn clear_range(&mut self, r: Range<usize>) {
+        for b in r {
+            self.diag[b].fill(0.0);
+            self.lower[b].fill(0.0);
+            self.upper[b].fill(0.0);
         }
     }
 
@@ -86,25 +91,23 @@ impl BlockTridiag {
 
     /// Factors the matrix (forward elimination of the block Thomas algorithm).
     pub fn factor(&mut self) -> Result<(), Singular> {
-        let n = self.n_blocks();
-        for b in 0..n {
+        self.factor_range(0..self.n_blocks())
+    }
+
+    /// Factors the diagonal part of blocks `r` (an independent system: the coupling blocks to
+    /// the blocks outside are zero).
+    pub fn factor_range(&mut self, r: Range<usize>) -> Result<(), Singular> {
+        for b in r.clone() {
             let mut d = self.diag[b];
-            if b > 0 {
+            if b > r.start {
                 d -= self.lower[b] * self.elim[b - 1];
             }
-            let lu = LU::new(d);
-            let u = lu.u();
-            let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
-            for k in 0..6 {
-                lo = lo.min(u[(k, k)].abs());
-                hi = hi.max(u[(k, k)].abs());
-            }
-            if lo.is_nan() || lo <= 1e-14 * hi || !hi.is_finite() {
-                return Err(Singular { block: b });
-            }
-            self.inv[b] = lu.try_inverse().ok_or(Singular { block: b })?;
-            if b + 1 < n {
-                self.elim[b] = self.inv[b] * self.upper[b];
+            let (piv, inv_diag) = lu_in_place(&mut d).map_err(|_| Singular { block: b })?;
+            let mut inv = Block::identity();
+            lu_solve_matrix(&d, &piv, &inv_diag, &mut inv);
+            self.inv[b] = inv;
+            if b + 1 < r.end {
+                self.elim[b] = inv * self.upper[b];
             }
         }
         Ok(())
@@ -112,17 +115,22 @@ impl BlockTridiag {
 
     /// Solves J x = rhs in place with the current factorisation.
     pub fn solve_factored(&self, rhs: &mut [Vector6<f64>]) {
-        let n = self.n_blocks();
+        self.solve_range(0..self.n_blocks(), rhs);
+    }
+
+    /// Solves the system of blocks `r` (factored by `factor_range`) in place; `rhs` holds all
+    /// blocks, only those in `r` are used and changed.
+    pub fn solve_range(&self, r: Range<usize>, rhs: &mut [Vector6<f64>]) {
         // Forward: y_b = D'_b⁻¹ (r_b − L_b y_{b−1}).
-        for b in 0..n {
-            let mut r = rhs[b];
-            if b > 0 {
-                r -= self.lower[b] * rhs[b - 1];
+        for b in r.clone() {
+            let mut v = rhs[b];
+            if b > r.start {
+                v -= self.lower[b] * rhs[b - 1];
             }
-            rhs[b] = self.inv[b] * r;
+            rhs[b] = self.inv[b] * v;
         }
         // Backward: x_b = y_b − (D'_b⁻¹ U_b) x_{b+1}.
-        for b in (0..n.saturating_sub(1)).rev() {
+        for b in (r.start..r.end.saturating_sub(1)).rev() {
             let next = rhs[b + 1];
             rhs[b] -= self.elim[b] * next;
         }
@@ -140,6 +148,77 @@ impl BlockTridiag {
                 v += self.upper[b] * x[b + 1];
             }
             y[b] = v;
+        }
+    }
+}
+
+/// LU factorisation of a 6×6 block in place (partial pivoting): returns the row interchanges and
+/// the reciprocals of U's diagonal; a pivot below 1e-14 of the largest (or not finite) is an
+/// error.
+#[inline]
+fn lu_in_place(a: &mut Block) -> Result<([u8; 6], [f64; 6]), ()> {
+    let mut piv = [0u8; 6];
+    let mut inv = [0.0; 6];
+    let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
+    for k in 0..6 {
+        let mut p = k;
+        let mut max = a[(k, k)].abs();
+        for i in k + 1..6 {
+            let v = a[(i, k)].abs();
+            if v > max {
+                max = v;
+                p = i;
+            }
+        }
+        piv[k] = p as u8;
+        if p != k {
+            a.swap_rows(k, p);
+        }
+        let d = a[(k, k)];
+        lo = lo.min(d.abs());
+        hi = hi.max(d.abs());
+        if d == 0.0 || !d.is_finite() {
+            return Err(());
+        }
+        let r = 1.0 / d;
+        inv[k] = r;
+        for i in k + 1..6 {
+            a[(i, k)] *= r;
+        }
+        for j in k + 1..6 {
+            let akj = a[(k, j)];
+            for i in k + 1..6 {
+                a[(i, j)] -= a[(i, k)] * akj;
+            }
+        }
+    }
+    if lo.is_nan() || lo <= 1e-14 * hi || !hi.is_finite() {
+        return Err(());
+    }
+    Ok((piv, inv))
+}
+
+/// X ← A⁻¹ X (6 columns) with the factors of `lu_in_place`.
+#[inline]
+fn lu_solve_matrix(lu: &Block, piv: &[u8; 6], inv: &[f64; 6], x: &mut Block) {
+    for (k, &p) in piv.iter().enumerate() {
+        if p as usize != k {
+            x.swap_rows(k, p as usize);
+        }
+    }
+    for j in 0..6 {
+        for k in 0..6 {
+            let xk = x[(k, j)];
+            for i in k + 1..6 {
+                x[(i, j)] -= lu[(i, k)] * xk;
+            }
+        }
+        for k in (0..6).rev() {
+            let xk = x[(k, j)] * inv[k];
+            x[(k, j)] = xk;
+            for i in 0..k {
+                x[(i, j)] -= lu[(i, k)] * xk;
+            }
         }
     }
 }
@@ -169,6 +248,17 @@ mod tests {
         j.mul(&x, &mut rhs);
         j.factor().unwrap();
         j.solve_factored(&mut rhs);
+        for b in 0..n {
+            assert!((rhs[b] - x[b]).norm() < 1e-12);
+        }
+        // Two independent systems: decouple blocks 2 and 3, solve each part on its own.
+        j.upper[2].fill(0.0);
+        j.lower[3].fill(0.0);
+        j.mul(&x, &mut rhs);
+        j.factor_range(0..3).unwrap();
+        j.factor_range(3..n).unwrap();
+        j.solve_range(3..n, &mut rhs);
+        j.solve_range(0..3, &mut rhs);
         for b in 0..n {
             assert!((rhs[b] - x[b]).norm() < 1e-12);
         }

@@ -128,6 +128,21 @@ pub struct Ghost {
     pub twist_free: bool,
 }
 
+/// A set of consecutive blocks whose unknowns are coupled to no others: the cable splits into
+/// independent systems at fixed clips (their prescribed position and orientation decouple the
+/// two sides), so each segment can be solved on its own.
+#[derive(Clone, Debug)]
+pub struct Segment {
+    pub blocks: std::ops::Range<usize>,
+    /// Shear elements (edges) and bending terms acting on the segment's unknowns.
+    pub edges: Vec<usize>,
+    pub bend_terms: Vec<usize>,
+    /// Swivel ghosts whose free twist is in the segment.
+    pub ghosts: Vec<usize>,
+    /// The clips whose prescribed nodes, edges or ghosts these elements use.
+    pub clips: Vec<usize>,
+}
+
 /// The discretised cable.
 #[derive(Clone, Debug)]
 pub struct Rod {
@@ -155,6 +170,8 @@ pub struct Rod {
     /// Nodes and edges held by each clip.
     pub clip_nodes: Vec<Vec<usize>>,
     pub clip_edges: Vec<Vec<usize>>,
+    /// The independent parts of the system (segments without unknowns are left out).
+    pub segments: Vec<Segment>,
 }
 
 fn fmt_clip(c: &ClipSpec) -> String {
@@ -333,6 +350,7 @@ impl Rod {
                 }
             }
         }
+        let segments = find_segments(&mask, &node_kind, &edge_kind, &ghosts, &bend_terms);
         Ok(Rod {
             spec,
             arc,
@@ -349,6 +367,7 @@ impl Rod {
             mask,
             clip_nodes,
             clip_edges,
+            segments,
         })
     }
 
@@ -366,6 +385,112 @@ impl Rod {
     pub fn mean_ds(&self) -> f64 {
         self.spec.length / self.n_edges() as f64
     }
+}
+
+/// The segments of the system: blocks b and b+1 are coupled when an element acts on active
+/// unknowns of both (a shear element through x_{b+1}, a bending term between two edges or
+/// through a swivel ghost's twist in slot 0 of a block).
+fn find_segments(
+    mask: &[[bool; 6]],
+    node_kind: &[NodeKind],
+    edge_kind: &[EdgeKind],
+    ghosts: &[Ghost],
+    bend_terms: &[BendTerm],
+) -> Vec<Segment> {
+    let n_blocks = mask.len();
+    let n_edges = edge_kind.len();
+    let node_free = |n: usize| node_kind[n] == NodeKind::Free;
+    let edge_active = |e: usize| !matches!(edge_kind[e], EdgeKind::Prescribed { .. });
+    // The block holding an element variable, if it is an unknown.
+    let rot_block = |r: RotRef| match r {
+        RotRef::Edge(e) => edge_active(e).then_some(e),
+        RotRef::Ghost(g) => ghosts[g].twist_free.then_some(ghosts[g].node),
+    };
+    // coupled[b]: blocks b and b+1.
+    let mut coupled: Vec<bool> = (0..n_blocks)
+        .map(|e| e < n_edges && node_free(e + 1) && (node_free(e) || edge_active(e)))
+        .collect();
+    for t in bend_terms {
+        if let (Some(a), Some(b)) = (rot_block(t.a), rot_block(t.b)) {
+            coupled[a.min(b)..a.max(b)].fill(true);
+        }
+    }
+    let mut segments: Vec<Segment> = Vec::new();
+    let mut start = 0;
+    for b in 0..n_blocks {
+        if b + 1 == n_blocks || !coupled[b] {
+            if mask[start..=b].iter().any(|m| m.iter().any(|&x| x)) {
+                segments.push(Segment {
+                    blocks: start..b + 1,
+                    edges: vec![],
+                    bend_terms: vec![],
+                    ghosts: vec![],
+                    clips: vec![],
+                });
+            }
+            start = b + 1;
+        }
+    }
+    let mut block_segment = vec![None; n_blocks];
+    for (k, s) in segments.iter().enumerate() {
+        for b in s.blocks.clone() {
+            block_segment[b] = Some(k);
+        }
+    }
+    let segment_of = |b: usize| block_segment[b];
+    for e in 0..n_edges {
+        let block = if node_free(e) || edge_active(e) {
+            Some(e)
+        } else if node_free(e + 1) {
+            Some(e + 1)
+        } else {
+            None
+        };
+        if let Some(k) = block.and_then(segment_of) {
+            segments[k].edges.push(e);
+        }
+    }
+    for (i, t) in bend_terms.iter().enumerate() {
+        if let Some(k) = rot_block(t.a).or(rot_block(t.b)).and_then(segment_of) {
+            segments[k].bend_terms.push(i);
+        }
+    }
+    for (g, ghost) in ghosts.iter().enumerate() {
+        if ghost.twist_free {
+            if let Some(k) = segment_of(ghost.node) {
+                segments[k].ghosts.push(g);
+            }
+        }
+    }
+    let node_clip = |n: usize| match node_kind[n] {
+        NodeKind::Prescribed { clip } => Some(clip),
+        NodeKind::Free => None,
+    };
+    let edge_clip = |e: usize| match edge_kind[e] {
+        EdgeKind::Prescribed { clip } | EdgeKind::TwistFree { clip } => Some(clip),
+        EdgeKind::Free => None,
+    };
+    let rot_clip = |r: RotRef| match r {
+        RotRef::Edge(e) => edge_clip(e),
+        RotRef::Ghost(g) => Some(ghosts[g].clip),
+    };
+    for seg in &mut segments {
+        let mut clips: Vec<usize> = seg
+            .edges
+            .iter()
+            .flat_map(|&e| [node_clip(e), node_clip(e + 1), edge_clip(e)])
+            .chain(
+                seg.bend_terms
+                    .iter()
+                    .flat_map(|&i| [rot_clip(bend_terms[i].a), rot_clip(bend_terms[i].b)]),
+            )
+            .flatten()
+            .collect();
+        clips.sort_unstable();
+        clips.dedup();
+        seg.clips = clips;
+    }
+    segments
 }
 
 /// Distributes `segments` edges over the intervals between breakpoints, each at least one edge,
@@ -472,6 +597,44 @@ mod tests {
         let total: f64 = rod.ds_node.iter().sum();
         assert!((total - 1.0).abs() < 1e-14);
         assert_eq!(rod.ghosts.len(), 2);
+    }
+
+    #[test]
+    fn the_system_splits_at_fixed_clips_only() {
+        let rod = Rod::new(spec(vec![
+            clip("a", 0.0, 0.0, ClipKind::Fixed),
+            clip("b", 0.3, 0.0, ClipKind::Fixed),
+            clip("c", 0.5, 0.1, ClipKind::Fixed),
+            clip("d", 0.8, 0.0, ClipKind::Swivel),
+            clip("e", 0.9, 0.0, ClipKind::Ball),
+        ]))
+        .unwrap();
+        let at = |s: f64| rod.arc.iter().position(|a| (a - s).abs() < 1e-12).unwrap();
+        let starts: Vec<usize> = rod.segments.iter().map(|g| g.blocks.start).collect();
+        // Splits at the point clip b and at both ends of the held length of c; not at the swivel
+        // (its free twist couples both sides) nor at the ball clip.
+        assert_eq!(starts, vec![0, at(0.3), at(0.55)]);
+        assert_eq!(rod.segments.last().unwrap().blocks.end, rod.arc.len());
+        // Every active slot is in exactly one segment, every element acting on one too.
+        for (b, m) in rod.mask.iter().enumerate() {
+            let n = rod
+                .segments
+                .iter()
+                .filter(|g| g.blocks.contains(&b))
+                .count();
+            assert_eq!(n, usize::from(m.iter().any(|&x| x)), "block {b}");
+        }
+        let edges: usize = rod.segments.iter().map(|g| g.edges.len()).sum();
+        let held = rod
+            .edge_kind
+            .iter()
+            .filter(|k| matches!(k, EdgeKind::Prescribed { .. }))
+            .count();
+        assert_eq!(edges, rod.n_edges() - held);
+        assert_eq!(
+            rod.segments.iter().map(|g| g.ghosts.len()).sum::<usize>(),
+            1
+        );
     }
 
     #[test]

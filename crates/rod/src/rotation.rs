@@ -13,15 +13,22 @@ pub fn skew(v: &Vector3<f64>) -> Matrix3<f64> {
 }
 
 /// exp(θ/2) as a unit quaternion: the rotation by |θ| about θ/|θ|.
-#[inline]
+#[inline(always)]
 pub fn exp_half(theta: &Vector3<f64>) -> Quat {
-    let angle = theta.norm();
-    if angle < 1e-8 {
-        // Taylor expansion; exact to round-off for such small angles.
-        let w = 1.0 - angle * angle / 8.0;
-        let s = 0.5 - angle * angle / 48.0;
+    let a2 = theta.norm_squared();
+    if a2 < 1e-2 {
+        // Series in t² = |θ|²/4 for cos t and sin t/(2t), exact to round-off for |θ| < 0.1
+        // (the next terms are below 1e-19).
+        let t2 = 0.25 * a2;
+        const C: [f64; 5] = [1.0, -1.0 / 2.0, 1.0 / 24.0, -1.0 / 720.0, 1.0 / 40320.0];
+        const S: [f64; 5] = [0.5, -0.5 / 6.0, 0.5 / 120.0, -0.5 / 5040.0, 0.5 / 362880.0];
+        // Estrin's scheme: short dependency chains.
+        let t4 = t2 * t2;
+        let w = (C[0] + C[1] * t2) + t4 * ((C[2] + C[3] * t2) + t4 * C[4]);
+        let s = (S[0] + S[1] * t2) + t4 * ((S[2] + S[3] * t2) + t4 * S[4]);
         Quaternion::new(w, s * theta.x, s * theta.y, s * theta.z)
     } else {
+        let angle = a2.sqrt();
         let (s, c) = (0.5 * angle).sin_cos();
         let k = s / angle;
         Quaternion::new(c, k * theta.x, k * theta.y, k * theta.z)
@@ -29,10 +36,34 @@ pub fn exp_half(theta: &Vector3<f64>) -> Quat {
 }
 
 /// p ⊗ exp(θ/2), renormalised so that |p| = 1 holds to round-off.
-#[inline]
+#[inline(always)]
 pub fn rotate_body(p: &Quat, theta: &Vector3<f64>) -> Quat {
     let q = p * exp_half(theta);
-    q / q.norm()
+    let n2 = q.norm_squared();
+    // |q|² = 1 + ε: 1/√(1 + ε) = 1 − ε/2 + O(ε²), exact to round-off for |ε| < 1e-8.
+    let k = if (n2 - 1.0).abs() < 1e-8 {
+        1.5 - 0.5 * n2
+    } else {
+        1.0 / n2.sqrt()
+    };
+    q * k
+}
+
+/// The right Jacobian of the exponential map, exp(θ + δ) = exp(θ) exp(J_r(θ) δ + O(δ²)):
+/// J_r(θ) = I − (1 − cos t)/t² [θ]× + (t − sin t)/t³ [θ]×², t = |θ|.
+pub fn right_jacobian(theta: &Vector3<f64>) -> Matrix3<f64> {
+    let t2 = theta.norm_squared();
+    let (a, b) = if t2 < 1e-4 {
+        (
+            0.5 - t2 / 24.0 + t2 * t2 / 720.0,
+            1.0 / 6.0 - t2 / 120.0 + t2 * t2 / 5040.0,
+        )
+    } else {
+        let t = t2.sqrt();
+        ((1.0 - t.cos()) / t2, (t - t.sin()) / (t2 * t))
+    };
+    let s = skew(theta);
+    Matrix3::identity() - a * s + b * (s * s)
 }
 
 /// Rotation vector (axis · angle, angle in [0, π]) of a unit quaternion.
@@ -174,6 +205,44 @@ mod tests {
         assert!((e * theta - theta).norm() < 1e-15);
         assert!(((e.trace() - 1.0) / 2.0 - theta.norm().cos()).abs() < 1e-14);
         assert!((log_vec(&exp_half(&theta)) - theta).norm() < 1e-14);
+    }
+
+    #[test]
+    fn right_jacobian_of_the_exponential() {
+        for theta in [
+            Vector3::new(0.3, -0.8, 0.5),
+            Vector3::new(1e-3, 2e-3, -4e-3),
+        ] {
+            let jr = right_jacobian(&theta);
+            let r0 = rotation_matrix(&exp_half(&theta));
+            let h = 1e-6;
+            for j in 0..3 {
+                let mut d = Vector3::zeros();
+                d[j] = h;
+                // exp(θ + δ) = exp(θ) exp(J_r δ): the body rotation vector of the difference.
+                let rp = rotation_matrix(&exp_half(&(theta + d)));
+                let rm = rotation_matrix(&exp_half(&(theta - d)));
+                let w = (r0.transpose() * (rp - rm)) / (2.0 * h);
+                let fd = Vector3::new(w[(2, 1)], w[(0, 2)], w[(1, 0)]);
+                assert!((fd - jr.column(j)).amax() < 1e-8, "{theta} col {j}");
+            }
+        }
+    }
+
+    #[test]
+    fn exp_half_series_matches_the_closed_form() {
+        for k in 0..200 {
+            let a = 0.1 * (k as f64 / 200.0);
+            let theta = Vector3::new(0.3, -0.8, 0.52).normalize() * a;
+            let q = exp_half(&theta);
+            let (s, c) = (0.5 * a).sin_cos();
+            assert!((q.w - c).abs() < 2e-16, "{a}");
+            assert!(
+                (q.imag() - theta.normalize() * s).amax() < 2e-16 || a == 0.0,
+                "{a}"
+            );
+            assert!((q.norm() - 1.0).abs() < 3e-16);
+        }
     }
 
     #[test]

@@ -38,6 +38,8 @@ pub fn shear_strain(
 #[derive(Clone, Copy, Debug)]
 pub struct ShearKinematics {
     pub ds: f64,
+    /// 1/Δs.
+    pub inv_ds: f64,
     /// R(p).
     pub r: Matrix3<f64>,
     /// u = Rᵀ (x_b − x_a)/Δs.
@@ -47,6 +49,7 @@ pub struct ShearKinematics {
 }
 
 impl ShearKinematics {
+    #[inline]
     pub fn new(
         xa: &Vector3<f64>,
         xb: &Vector3<f64>,
@@ -55,9 +58,11 @@ impl ShearKinematics {
         strain0: &Vector3<f64>,
     ) -> Self {
         let r = rotation_matrix(p);
-        let u = r.transpose() * ((xb - xa) / ds);
+        let inv_ds = 1.0 / ds;
+        let u = r.transpose() * ((xb - xa) * inv_ds);
         ShearKinematics {
             ds,
+            inv_ds,
             r,
             u,
             strain: u - Vector3::z() - strain0,
@@ -65,8 +70,23 @@ impl ShearKinematics {
     }
 
     /// Γ̇ for the velocities ẋ_a, ẋ_b (global) and ω (body frame): dΓ = Rᵀ(dx_b − dx_a)/Δs + [u]× θ.
+    #[inline]
     pub fn rate(&self, va: &Vector3<f64>, vb: &Vector3<f64>, omega: &Vector3<f64>) -> Vector3<f64> {
-        self.r.transpose() * ((vb - va) / self.ds) + self.u.cross(omega)
+        self.r.transpose() * ((vb - va) * self.inv_ds) + self.u.cross(omega)
+    }
+
+    /// ∂Γ̇/∂(x_a, x_b, θ) at fixed velocities: the strain rate J v depends on the configuration
+    /// through R and u (Γ̇ = Rᵀ(v_b − v_a)/Δs + u × ω).
+    pub fn rate_derivative(
+        &self,
+        va: &Vector3<f64>,
+        vb: &Vector3<f64>,
+        omega: &Vector3<f64>,
+    ) -> [Matrix3<f64>; 3] {
+        let wx = skew(omega);
+        let g = wx * self.r.transpose() * self.inv_ds;
+        let w = self.r.transpose() * ((vb - va) * self.inv_ds);
+        [g, -g, skew(&w) - wx * skew(&self.u)]
     }
 
     /// Generalised forces Δs Jᵀ f of the section force f (material frame) on (x_a, x_b, θ).
@@ -74,33 +94,107 @@ impl ShearKinematics {
         let rf = self.r * f;
         [-rf, rf, self.ds * f.cross(&self.u)]
     }
+}
 
-    /// Δs Jᵀ C J for a diagonal C: the stiffness (C = C^Γ) or viscous damping (C = τC^Γ) blocks.
-    pub fn gauss_newton(&self, c: &Vector3<f64>) -> [[Matrix3<f64>; 3]; 3] {
-        let c = Matrix3::from_diagonal(c);
-        let su = skew(&self.u);
-        let kxx = self.r * c * self.r.transpose() / self.ds;
-        let kxt = self.r * c * su;
-        let ktt = -self.ds * su * c * su;
-        [
-            [kxx, -kxx, -kxt],
-            [-kxx, kxx, kxt],
-            [-kxt.transpose(), kxt.transpose(), ktt],
-        ]
+/// Kelvin–Voigt damping of an element in a dynamic Jacobian: the viscous coefficients τ∘C,
+/// the factor of the velocity derivative (γ/(βh) in generalized-α) and the velocities.
+#[derive(Clone, Copy, Debug)]
+pub struct ShearViscous {
+    pub coeff: Vector3<f64>,
+    pub factor: f64,
+    /// Whether the edge rotation has a tracked rate (a free edge; not a swivel's twist).
+    pub rate_theta: bool,
+    pub va: Vector3<f64>,
+    pub vb: Vector3<f64>,
+    pub omega: Vector3<f64>,
+    /// J_r(hΔθ) of the edge rotation's increment in the step: the Newton update changes the
+    /// increment, so the configuration derivatives along θ are multiplied by it.
+    pub tangent: Option<Matrix3<f64>>,
+}
+
+/// The 3×3 blocks of an element's force Jacobian over (x_a, x_b, θ), which have the pattern
+/// [[−X, X, −Y], [X, −X, Y], [W, −W, T]].
+#[derive(Clone, Copy, Debug)]
+pub struct ShearBlocks {
+    pub x: Matrix3<f64>,
+    pub y: Matrix3<f64>,
+    pub w: Matrix3<f64>,
+    pub t: Matrix3<f64>,
+}
+
+impl ShearBlocks {
+    pub fn block(&self, i: usize, j: usize) -> Matrix3<f64> {
+        match (i, j) {
+            (0, 0) | (1, 1) => -self.x,
+            (0, 1) | (1, 0) => self.x,
+            (0, 2) => -self.y,
+            (1, 2) => self.y,
+            (2, 0) => self.w,
+            (2, 1) => -self.w,
+            _ => self.t,
+        }
     }
+}
 
-    /// Σ_k f_k Δs ∇²Γ_k: the geometric stiffness of the section force f.
-    pub fn geometric(&self, f: &Vector3<f64>) -> [[Matrix3<f64>; 3]; 3] {
-        let z = Matrix3::zeros();
-        let kxt = -self.r * skew(f);
+/// diag(c) m.
+#[inline]
+pub(crate) fn scale_rows(c: &Vector3<f64>, m: &Matrix3<f64>) -> Matrix3<f64> {
+    Matrix3::from_fn(|i, j| c[i] * m[(i, j)])
+}
+
+impl ShearKinematics {
+    /// The derivative of the generalised forces Δs Jᵀ f, f = C(Γ − Γ⁰) (+ τ∘C Γ̇), along the
+    /// Newton update: the stiffness Δs Jᵀ C J, the geometric part of the section force f, and
+    /// with `viscous` the damping matrix (factor × Δs Jᵀ τ∘C J, on the rate unknowns) and the
+    /// derivative through the strain rate's dependence on the configuration (Δs Jᵀ τ∘C G,
+    /// G = ∂Γ̇/∂q). The whole element: Δs Jᵀ P + geometric(f) with P = C J + τ∘C (c J + G),
+    /// the configuration part of the θ column times the tangent J_r of the step.
+    pub fn jacobian(
+        &self,
+        f: &Vector3<f64>,
+        c: &Vector3<f64>,
+        viscous: Option<&ShearViscous>,
+    ) -> ShearBlocks {
+        let rt = self.r.transpose();
+        let su = skew(&self.u);
+        let inv_ds = self.inv_ds;
+        let mut ca = -c * inv_ds;
+        // θ column: configuration part (C J + τ∘C G, × J_r of the step) and rate part.
+        let mut pth = scale_rows(c, &su);
+        let mut pth_rate = None;
+        let mut pa_extra = Matrix3::zeros();
+        let mut tangent = None;
+        if let Some(v) = viscous {
+            ca -= v.coeff * (v.factor * inv_ds);
+            let [ga, _, gth] = self.rate_derivative(&v.va, &v.vb, &v.omega);
+            pa_extra = scale_rows(&v.coeff, &ga);
+            pth += scale_rows(&v.coeff, &gth);
+            if v.rate_theta {
+                pth_rate = Some(scale_rows(&(v.coeff * v.factor), &su));
+            }
+            tangent = v.tangent;
+        }
+        let pa = scale_rows(&ca, &rt) + pa_extra;
+        let sf = skew(f);
         let ktt = self.ds
             * (0.5 * (f * self.u.transpose() + self.u * f.transpose())
                 - Matrix3::identity() * f.dot(&self.u));
-        [
-            [z, z, -kxt],
-            [z, z, kxt],
-            [-kxt.transpose(), kxt.transpose(), ktt],
-        ]
+        let mut y = pth - sf;
+        let mut t = ktt - self.ds * su * pth;
+        if let Some(jr) = tangent {
+            y *= jr;
+            t *= jr;
+        }
+        if let Some(pr) = pth_rate {
+            y += pr;
+            t -= self.ds * su * pr;
+        }
+        ShearBlocks {
+            x: self.r * pa,
+            y: self.r * y,
+            w: -self.ds * su * pa - sf * rt,
+            t,
+        }
     }
 }
 
@@ -123,11 +217,10 @@ pub fn shear_element(
     out.force = f;
     out.grad = kin.forces(&f);
     if want_hess {
-        let gn = kin.gauss_newton(stiffness);
-        let geo = kin.geometric(&f);
+        let jac = kin.jacobian(&f, stiffness, None);
         for i in 0..3 {
             for j in 0..3 {
-                out.hess[i][j] = gn[i][j] + geo[i][j];
+                out.hess[i][j] = jac.block(i, j);
             }
         }
     }
@@ -163,5 +256,40 @@ mod tests {
             |i| e.grad[i / 3][i % 3],
             |i, j| e.hess[i / 3][j / 3][(i % 3, j % 3)],
         );
+    }
+
+    #[test]
+    fn strain_rate_and_its_configuration_derivative_match_finite_differences() {
+        let (va, vb, omega) = (
+            Vector3::new(0.3, -0.8, 0.2),
+            Vector3::new(-0.5, 0.1, 0.9),
+            Vector3::new(1.2, -0.4, 0.7),
+        );
+        let kin_at = |z: &[f64; 9]| {
+            let xa = Vector3::new(0.1, -0.2, 0.05) + Vector3::new(z[0], z[1], z[2]);
+            let xb = Vector3::new(0.13, -0.17, 0.14) + Vector3::new(z[3], z[4], z[5]);
+            let p = rotate_body(
+                &exp_half(&Vector3::new(0.4, -0.3, 0.9)),
+                &Vector3::new(z[6], z[7], z[8]),
+            );
+            ShearKinematics::new(&xa, &xb, &p, 0.1, &Vector3::new(0.01, 0.0, -0.02))
+        };
+        let kin = kin_at(&[0.0; 9]);
+        let g = kin.rate_derivative(&va, &vb, &omega);
+        let scale = g.iter().map(|m| m.amax()).fold(0.0, f64::max);
+        let h = 1e-6;
+        for i in 0..9 {
+            let mut zp = [0.0; 9];
+            let mut zm = [0.0; 9];
+            zp[i] = h;
+            zm[i] = -h;
+            let fd = (kin_at(&zp).rate(&va, &vb, &omega) - kin_at(&zm).rate(&va, &vb, &omega))
+                / (2.0 * h);
+            let an = g[i / 3].column(i % 3);
+            assert!(
+                (fd - an).amax() < 1e-6 * scale,
+                "∂Γ̇/∂q col {i}: fd {fd} analytic {an}"
+            );
+        }
     }
 }

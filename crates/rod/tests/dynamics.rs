@@ -4,8 +4,11 @@
 mod common;
 use common::*;
 use nalgebra::Vector3;
+use rod::rotation::exp_half;
 use rod::routing::route;
-use rod::{ClipMotion, DynamicOptions, Dynamics, NewtonOptions, PointLoad, Rod, State, Statics};
+use rod::{
+    ClipKind, ClipMotion, DynamicOptions, Dynamics, NewtonOptions, PointLoad, Rod, State, Statics,
+};
 
 const BETA1: f64 = 1.875104;
 
@@ -310,4 +313,226 @@ fn stiff_heavy_cable_is_stable_at_one_millisecond() {
     assert!(peak.is_finite() && peak > 0.0);
     assert!(st.x.iter().all(|x| x.iter().all(|v| v.is_finite())));
     assert!(st.max_unit_error() < 1e-12);
+}
+
+/// Clip "a" moving: z = A sin Ωt and a rotation φ sin Ωt about the global x axis.
+fn shaken(rod: &Rod, t: f64) -> Vec<ClipMotion> {
+    let (amp, phi, big_omega) = (2e-3, 0.05, 2.0 * std::f64::consts::PI * 30.0);
+    let (s, c) = (big_omega * t).sin_cos();
+    let mut clips = clamp(rod);
+    let m = &mut clips[0];
+    m.pose.position.z += amp * s;
+    m.pose.orientation = exp_half(&Vector3::new(phi * s, 0.0, 0.0)) * m.pose.orientation;
+    m.velocity.z = amp * big_omega * c;
+    m.acceleration.z = -amp * big_omega * big_omega * s;
+    m.angular_velocity.x = phi * big_omega * c;
+    m.angular_acceleration.x = -phi * big_omega * big_omega * s;
+    clips
+}
+
+#[test]
+fn iteration_matrix_is_the_derivative_of_the_dynamic_residual() {
+    // Every clip type, gravity, dead loads, natural curvature and Kelvin–Voigt damping, with
+    // a clip moving and rotating: the assembled iteration matrix (stiffness, damping and its
+    // configuration derivative, inertia, tangent of the rotation steps) against central
+    // differences of the residual along the Newton update.
+    let mut spec = cantilever(1.0, 16, circle(0.005, 5e7, 0.45, 1500.0));
+    spec.gravity = Vector3::new(0.0, 0.0, -9.81);
+    spec.natural_curvature = Vector3::new(0.5, -0.2, 0.3);
+    spec.loads.push(PointLoad {
+        s: 0.7,
+        force: Vector3::new(0.1, 0.2, -0.3),
+        moment: Vector3::new(0.01, -0.02, 0.005),
+    });
+    spec.clips = vec![
+        clip(
+            "a",
+            0.0,
+            0.0,
+            ClipKind::Fixed,
+            pose([0.0; 3], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]),
+        ),
+        clip(
+            "b",
+            0.3,
+            0.06,
+            ClipKind::Swivel,
+            pose([0.28, 0.0, 0.02], [1.0, 0.1, 0.0], [0.0, 0.0, 1.0]),
+        ),
+        clip(
+            "c",
+            0.5,
+            0.0,
+            ClipKind::Ball,
+            pose([0.45, 0.05, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]),
+        ),
+        clip(
+            "d",
+            0.62,
+            0.0,
+            ClipKind::Fixed,
+            pose([0.56, 0.08, 0.0], [1.0, 0.3, 0.0], [0.0, 0.0, 1.0]),
+        ),
+        clip(
+            "e",
+            0.8,
+            0.0,
+            ClipKind::Swivel,
+            pose([0.7, 0.1, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]),
+        ),
+    ];
+    let rod = Rod::new(spec).unwrap();
+    assert!(
+        rod.segments.len() >= 2,
+        "the fixed clip d splits the system"
+    );
+    let mut st = route(&rod, None).unwrap();
+    Statics::new(&rod, NewtonOptions::default())
+        .solve(&rod, &mut st)
+        .unwrap();
+    let opts = DynamicOptions {
+        tau_shear: Vector3::new(2e-3, 2e-3, 1e-3),
+        tau_bend: Vector3::new(3e-3, 3e-3, 2e-3),
+        tolerance: 1e-9,
+        ..Default::default()
+    };
+    let h = 1e-3;
+    let mut dy = Dynamics::new(&rod, &st, &shaken(&rod, 0.0), opts);
+    dy.start(&rod, &st).unwrap();
+    for k in 1..=12 {
+        dy.step(&rod, &mut st, h, &shaken(&rod, k as f64 * h))
+            .unwrap();
+    }
+    let (an, fd) = dy.iteration_matrix_fd(&rod, &mut st, h, 1e-7).unwrap();
+    // Per kind of entry (x/θ rows and columns), relative to its largest value.
+    let mut worst = [0.0f64; 4];
+    let mut scale = [0.0f64; 4];
+    let n = an.n_blocks();
+    for b in 0..n {
+        for (a, f) in [
+            (&an.diag[b], &fd.diag[b]),
+            (&an.lower[b], &fd.lower[b]),
+            (&an.upper[b], &fd.upper[b]),
+        ] {
+            for i in 0..6 {
+                for j in 0..6 {
+                    let kind = 2 * (i / 3) + j / 3;
+                    worst[kind] = worst[kind].max((a[(i, j)] - f[(i, j)]).abs());
+                    scale[kind] = scale[kind].max(f[(i, j)].abs());
+                }
+            }
+        }
+    }
+    for kind in 0..4 {
+        assert!(
+            worst[kind] < 1e-6 * scale[kind],
+            "entries {kind}: {:e} of {:e}",
+            worst[kind],
+            scale[kind]
+        );
+    }
+    // The segments are independent: no coupling between consecutive blocks of different ones.
+    let segment_of = |b: usize| rod.segments.iter().position(|s| s.blocks.contains(&b));
+    for b in 0..n - 1 {
+        if segment_of(b) != segment_of(b + 1) {
+            for m in [
+                &an.upper[b],
+                &an.lower[b + 1],
+                &fd.upper[b],
+                &fd.lower[b + 1],
+            ] {
+                assert_eq!(m.amax(), 0.0, "coupling of blocks {b} and {}", b + 1);
+            }
+        }
+    }
+}
+
+#[test]
+fn spans_at_rest_stay_in_equilibrium_and_are_skipped() {
+    // Three spans between four fixed clips; only the last clip moves. The first span starts in
+    // static equilibrium and stays there: once nothing moves in it, it is no longer iterated.
+    let mut spec = cantilever(1.2, 60, circle(0.005, 1e8, 0.45, 2200.0));
+    spec.gravity = Vector3::new(0.0, 0.0, -9.81);
+    spec.clips = vec![
+        clip(
+            "a",
+            0.0,
+            0.0,
+            ClipKind::Fixed,
+            pose([0.0; 3], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]),
+        ),
+        clip(
+            "b",
+            0.4,
+            0.0,
+            ClipKind::Fixed,
+            pose([0.36, 0.05, -0.05], [1.0, 0.2, 0.0], [0.0, 0.0, 1.0]),
+        ),
+        clip(
+            "c",
+            0.8,
+            0.0,
+            ClipKind::Fixed,
+            pose([0.7, 0.15, -0.02], [1.0, 0.1, 0.0], [0.0, 0.0, 1.0]),
+        ),
+        clip(
+            "d",
+            1.2,
+            0.0,
+            ClipKind::Fixed,
+            pose([1.0, 0.25, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]),
+        ),
+    ];
+    let rod = Rod::new(spec).unwrap();
+    assert_eq!(rod.segments.len(), 3);
+    let mut st = route(&rod, None).unwrap();
+    Statics::new(&rod, NewtonOptions::default())
+        .solve(&rod, &mut st)
+        .unwrap();
+    let opts = DynamicOptions {
+        tau_shear: Vector3::repeat(0.02),
+        tau_bend: Vector3::repeat(0.02),
+        ..Default::default()
+    };
+    let h = 1e-3;
+    let moving = |t: f64| {
+        let mut clips = clamp(&rod);
+        let (amp, w) = (1e-3, 2.0 * std::f64::consts::PI * 50.0);
+        let m = &mut clips[3];
+        m.pose.position.z += amp * (w * t).sin();
+        m.velocity.z = amp * w * (w * t).cos();
+        m.acceleration.z = -amp * w * w * (w * t).sin();
+        clips
+    };
+    // All clips still: after the start-up every segment comes to rest and the steps cost no
+    // iteration at all; the state no longer changes.
+    let still = clamp(&rod);
+    let mut dy = Dynamics::new(&rod, &st, &still, opts.clone());
+    dy.start(&rod, &st).unwrap();
+    let mut last = 0;
+    for _ in 0..400 {
+        last = dy.step(&rod, &mut st, h, &still).unwrap().iterations;
+    }
+    assert_eq!(
+        last, 0,
+        "a cable at rest with its clips at rest is not iterated"
+    );
+    let frozen = st.clone();
+    dy.step(&rod, &mut st, h, &still).unwrap();
+    assert_eq!(st.x, frozen.x);
+    assert_eq!(st.p, frozen.p);
+    // Shaking the last clip: the first span stays in equilibrium (its rows of the residual
+    // remain at round-off), the others move.
+    for k in 1..=200 {
+        dy.step(&rod, &mut st, h, &moving(k as f64 * h)).unwrap();
+    }
+    let first = rod.segments[0].blocks.clone();
+    let residual = dy.ws.residual_norms_range(first.clone(), rod.mean_ds()).1;
+    let weight = rod.spec.section.mass_per_length * 9.81 * rod.mean_ds();
+    assert!(residual < 1e-9 * weight, "residual {residual:e} N");
+    assert!(first.clone().all(|n| st.x[n] == frozen.x[n]));
+    let moved = (first.end + 1..rod.arc.len() - 1)
+        .map(|n| (st.x[n] - frozen.x[n]).norm())
+        .fold(0.0, f64::max);
+    assert!(moved > 1e-5, "the shaken spans move: {moved}");
 }
