@@ -56,6 +56,12 @@ def polydata_xml(
     n = len(points)
     conn = np.column_stack([np.arange(n - 1), np.arange(1, n)]).ravel()
     offsets = 2 * np.arange(1, n)
+    cells = f"<Lines>{_ints('connectivity', conn)}{_ints('offsets', offsets)}</Lines>\n"
+    return _polydata(points, n - 1, 0, cells, point_data, cell_data, field_data)
+
+
+def _polydata(points, n_lines, n_polys, cells, point_data, cell_data, field_data) -> str:
+    """The PolyData document around the cell block ``cells`` (Lines or Polys)."""
     pd = "".join(_array(k, v) for k, v in point_data.items())
     cd = "".join(_array(k, v) for k, v in cell_data.items())
     fd = "".join(
@@ -68,11 +74,11 @@ def polydata_xml(
         '<VTKFile type="PolyData" version="1.0" byte_order="LittleEndian" '
         'header_type="UInt64">\n<PolyData>\n'
         f"<FieldData>{fd}</FieldData>\n"
-        f'<Piece NumberOfPoints="{n}" NumberOfVerts="0" NumberOfLines="{n - 1}" '
-        'NumberOfStrips="0" NumberOfPolys="0">\n'
+        f'<Piece NumberOfPoints="{len(points)}" NumberOfVerts="0" NumberOfLines="{n_lines}" '
+        f'NumberOfStrips="0" NumberOfPolys="{n_polys}">\n'
         f"<PointData>{pd}</PointData>\n<CellData>{cd}</CellData>\n"
         f"<Points>{_array('Points', points)}</Points>\n"
-        f"<Lines>{_ints('connectivity', conn)}{_ints('offsets', offsets)}</Lines>\n"
+        f"{cells}"
         "</Piece>\n</PolyData>\n</VTKFile>\n"
     )
 
@@ -85,26 +91,11 @@ def surface_xml(
     field_data: dict[str, float],
 ) -> str:
     """A VTK XML PolyData document of a triangle surface."""
-    pd = "".join(_array(k, v) for k, v in point_data.items())
-    cd = "".join(_array(k, v) for k, v in cell_data.items())
-    fd = "".join(
-        f'<DataArray type="Float64" Name={quoteattr(k)} NumberOfTuples="1" format="ascii">'
-        f"{float(v)!r}</DataArray>"
-        for k, v in field_data.items()
-    )
-    return (
-        '<?xml version="1.0"?>\n'
-        '<VTKFile type="PolyData" version="1.0" byte_order="LittleEndian" '
-        'header_type="UInt64">\n<PolyData>\n'
-        f"<FieldData>{fd}</FieldData>\n"
-        f'<Piece NumberOfPoints="{len(points)}" NumberOfVerts="0" NumberOfLines="0" '
-        f'NumberOfStrips="0" NumberOfPolys="{len(faces)}">\n'
-        f"<PointData>{pd}</PointData>\n<CellData>{cd}</CellData>\n"
-        f"<Points>{_array('Points', points)}</Points>\n"
+    cells = (
         f"<Polys>{_ints('connectivity', np.ravel(faces))}"
         f"{_ints('offsets', 3 * np.arange(1, len(faces) + 1))}</Polys>\n"
-        "</Piece>\n</PolyData>\n</VTKFile>\n"
     )
+    return _polydata(points, 0, len(faces), cells, point_data, cell_data, field_data)
 
 
 def pvd_xml(entries: list[tuple]) -> str:

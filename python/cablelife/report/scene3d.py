@@ -181,6 +181,26 @@ def _body_traces(cable: CableResult, k: int, bodies: list[BodyPose], length: flo
     return traces
 
 
+def volume_trace(mesh, name: str, color: str, opacity: float):
+    """A translucent plotly mesh of a motion volume's triangle mesh."""
+    v, f = mesh.vertices, mesh.faces
+    import plotly.graph_objects as go
+
+    return go.Mesh3d(
+        x=v[:, 0],
+        y=v[:, 1],
+        z=v[:, 2],
+        i=f[:, 0],
+        j=f[:, 1],
+        k=f[:, 2],
+        color=color,
+        opacity=opacity,
+        name=name,
+        hoverinfo="name",
+        showlegend=True,
+    )
+
+
 def cable_figure(
     cable: CableResult,
     color_by: str = "bending",
@@ -245,22 +265,8 @@ def cable_figure(
     if volume is not None:
         mesh = getattr(volume, "mesh", volume)
         if len(mesh.faces):
-            vv, ff = mesh.vertices, mesh.faces
-            traces.append(
-                go.Mesh3d(
-                    x=vv[:, 0],
-                    y=vv[:, 1],
-                    z=vv[:, 2],
-                    i=ff[:, 0],
-                    j=ff[:, 1],
-                    k=ff[:, 2],
-                    color="lightsteelblue",
-                    opacity=0.25,
-                    name="motion volume",
-                    hoverinfo="name",
-                    showlegend=True,
-                )
-            )
+            vv = mesh.vertices
+            traces.append(volume_trace(mesh, "motion volume", "lightsteelblue", 0.25))
             box = np.stack([np.minimum(box[0], vv.min(0)), np.maximum(box[1], vv.max(0))])
     fig = go.Figure(data=traces)
     fig.frames = [
@@ -416,22 +422,8 @@ def volumes_figure(volumes: dict, cables: dict | None = None, title: str | None 
         colour = qualitative.Plotly[k % 10]
         mesh = getattr(volume, "mesh", volume)
         if len(mesh.faces):
-            v, f = mesh.vertices, mesh.faces
-            traces.append(
-                go.Mesh3d(
-                    x=v[:, 0],
-                    y=v[:, 1],
-                    z=v[:, 2],
-                    i=f[:, 0],
-                    j=f[:, 1],
-                    k=f[:, 2],
-                    color=colour,
-                    opacity=0.3,
-                    name=f"motion volume {label}",
-                    showlegend=True,
-                    hoverinfo="name",
-                )
-            )
+            v = mesh.vertices
+            traces.append(volume_trace(mesh, f"motion volume {label}", colour, 0.3))
             points.append(v)
         cable = (cables or {}).get(label)
         if cable is not None:
