@@ -35,6 +35,7 @@ def scene(segments: int, duration: float) -> dict:
         "type": "psd",
         "quantity": "displacement",
         "seed": 7,
+        "fade_in": 0.1,  # start at rest, as dynamic runs should (no start-up transient)
         "breakpoints": [[BAND[0], level], [BAND[1], level]],
     }
     return {
