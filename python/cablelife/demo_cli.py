@@ -68,7 +68,7 @@ def demo_command(
             state["report"] = "ok" if report else "skipped"
             live.update(view())
     except (StudyError, FileNotFoundError, RuntimeError) as e:
-        Console(stderr=True).print(f"[bold red]error:[/] {e}", highlight=False)
+        Console(stderr=True).print(f"[bold red]error:[/] {e}", highlight=False, soft_wrap=True)
         raise typer.Exit(2) from None
     cmp = outcome.comparison
     console.print("\n[bold]Ranking by maximum pseudo-damage (dynamic runs):[/]")
@@ -92,7 +92,7 @@ def demo_command(
         )
     for name, row in outcome.rows.items():
         for w in row.get("warnings", []):
-            console.print(f"[yellow]warning[/] ({name}): {w}", highlight=False)
+            console.print(f"[yellow]warning[/] ({name}): {w}", highlight=False, soft_wrap=True)
     t = outcome.stage_times
     console.print(
         "Wall time: " + ", ".join(f"{k} {v:.2f} s" for k, v in t.items() if ":" not in k),

@@ -51,7 +51,7 @@ def paraview_command(
                 write_paraview(res.cables[name], out, damage=dm, steps=slice(None, None, every))
             )
     except (ValueError, FileNotFoundError) as e:
-        err.print(f"[bold red]error:[/] {e}", highlight=False)
+        err.print(f"[bold red]error:[/] {e}", highlight=False, soft_wrap=True)
         raise typer.Exit(2) from None
     for p in written:
         Console().print(f"ParaView time series written to {p}")

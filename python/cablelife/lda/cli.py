@@ -74,10 +74,10 @@ def lda_command(
                 result, threads=threads, progress=progress, **settings.analyse_kwargs()
             )
         for w in caught:
-            console.print(f"[yellow]warning:[/] {w.message}")
+            console.print(f"[yellow]warning:[/] {w.message}", soft_wrap=True)
         path = analysis.save(output or default_damage_path(result))
     except (ValueError, FileNotFoundError) as e:
-        console.print(f"[red]error:[/] {e}")
+        console.print(f"[red]error:[/] {e}", soft_wrap=True)
         raise typer.Exit(1) from e
     console.print(analysis.summary(hot_spots), soft_wrap=True, highlight=False)
     console.print(f"damage file: {path}")
@@ -101,7 +101,7 @@ def compare_command(
         names = None if labels is None else [s.strip() for s in labels.split(",")]
         cmp = compare(files, names, check_settings=not force, n_hot_spots=hot_spots)
     except (ValueError, FileNotFoundError, TypeError) as e:
-        console.print(f"[red]error:[/] {e}")
+        console.print(f"[red]error:[/] {e}", soft_wrap=True)
         raise typer.Exit(1) from e
     console.print(cmp.table(hot_spots), soft_wrap=True, highlight=False)
     console.print(f"best: {cmp.best.label}")

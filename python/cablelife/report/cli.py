@@ -113,7 +113,7 @@ def report_command(
             output, runs, color_by=color_by, frames=frames, voxel=h, bend_factor=bend_factor
         )
     except (ValueError, FileNotFoundError) as e:
-        err.print(f"[bold red]error:[/] {e}", highlight=False)
+        err.print(f"[bold red]error:[/] {e}", highlight=False, soft_wrap=True)
         raise typer.Exit(2) from None
     size = path.stat().st_size / 1e6
     Console().print(f"report written to {path} ({size:.1f} MB)")

@@ -55,10 +55,12 @@ def signal_command(
 
                 plot_signals(plot_path, time, series)
     except (SignalError, OSError) as error:
-        err.print(f"[red]error:[/red] {escape(str(error))}", highlight=False)
+        err.print(f"[red]error:[/red] {escape(str(error))}", highlight=False, soft_wrap=True)
         raise typer.Exit(code=1) from None
     for w in caught:
-        err.print(f"[yellow]warning:[/yellow] {escape(str(w.message))}", highlight=False)
+        err.print(
+            f"[yellow]warning:[/yellow] {escape(str(w.message))}", highlight=False, soft_wrap=True
+        )
 
     table = Table(title=f"{spec.name}: {time.size} samples, step {settings.signal.time_step:g} s")
     for column in ("channel", "frame", "type", "quantity", "RMS", "target RMS", "unit"):

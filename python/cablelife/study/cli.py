@@ -62,7 +62,7 @@ def study_command(
                 study, output, scheduler=scheduler, workers=workers, progress=progress
             )
     except (StudyError, ConnectionError, FileNotFoundError) as e:
-        err.print(f"[bold red]error:[/] {e}", highlight=False)
+        err.print(f"[bold red]error:[/] {e}", highlight=False, soft_wrap=True)
         raise typer.Exit(2) from None
     frame = outcome.table
     t = Table(title=f"study {outcome.out_dir}", title_justify="left")

@@ -70,7 +70,7 @@ def volume_command(
         a.save(output, unit=unit)
         b = motion_volume(source(compare), h) if compare is not None else None
     except (ValueError, FileNotFoundError) as e:
-        err.print(f"[bold red]error:[/] {e}", highlight=False)
+        err.print(f"[bold red]error:[/] {e}", highlight=False, soft_wrap=True)
         raise typer.Exit(2) from None
     t = Table(title=f"motion volume at {h * 1e3:g} mm voxels", title_justify="left")
     t.add_column("run")
