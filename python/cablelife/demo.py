@@ -69,8 +69,11 @@ def demo_runs(
 ) -> list[Variant]:
     """The runs of the demo: every variant of ``variants.toml`` dynamically and (optionally)
     quasistatically, labelled ``<variant>-<mode>``."""
-    folder = example or example_dir()
-    study, study_dir = load_study(folder / "variants.toml")
+    study, study_dir = load_study((example or example_dir()) / "variants.toml")
+    return _runs(study, study_dir, seed, duration, quasistatic)
+
+
+def _runs(study, study_dir: Path, seed, duration, quasistatic) -> list[Variant]:
     runs = []
     for v in expand(study, study_dir):
         for mode in MODES if quasistatic else MODES[:1]:
@@ -98,9 +101,8 @@ def run_demo(
     each), the comparison, and the report. ``on_stage(run, stage)`` follows the progress."""
     from cablelife.lda.compare import compare
 
-    folder = example or example_dir()
-    study, _ = load_study(folder / "variants.toml")
-    runs = demo_runs(folder, seed=seed, duration=duration, quasistatic=quasistatic)
+    study, study_dir = load_study((example or example_dir()) / "variants.toml")
+    runs = _runs(study, study_dir, seed, duration, quasistatic)
     out = Path(out_dir)
     times: dict[str, float] = {}
     t0 = time.perf_counter()

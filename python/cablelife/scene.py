@@ -7,7 +7,6 @@ built in Python. Validation errors name the key path, the bad value and what is 
 from __future__ import annotations
 
 import math
-import tomllib
 from pathlib import Path
 from typing import Annotated, Literal
 
@@ -26,6 +25,7 @@ from pydantic import (
 
 from cablelife.sections import SectionProperties, from_material, from_measured
 from cablelife.signals.spec import ChannelMotion, TableSignal
+from cablelife.tomlfile import read_toml
 
 Vec3 = tuple[float, float, float]
 
@@ -397,12 +397,7 @@ def scene_from_dict(data: dict, base_dir: Path | None = None, source: str = "") 
 def load_scene(path: str | Path) -> Scene:
     """Reads and validates a scene TOML file."""
     path = Path(path)
-    if not path.is_file():
-        raise SceneError(f"scene file {str(path)!r} does not exist")
-    try:
-        data = tomllib.loads(path.read_text())
-    except tomllib.TOMLDecodeError as err:
-        raise SceneError(f"scene file {str(path)!r} is not valid TOML: {err}") from None
+    data = read_toml(path, "scene file", SceneError)
     return scene_from_dict(data, base_dir=path.parent.resolve(), source=f"{str(path)!r}")
 
 

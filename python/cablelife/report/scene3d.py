@@ -96,16 +96,23 @@ def _clip_nodes(cable: CableResult) -> dict[str, int]:
     return {n: int(np.argmin(np.abs(cable.arc_length - c.s))) for n, c in cable.clips.items()}
 
 
-def _clip_trace(cable: CableResult, k: int, bodies: dict[str, str]):
+def _scatter3d(points, **kw):
+    """A plotly Scatter3d through ``points``: an (n, 3) array or (x, y, z) lists."""
     import plotly.graph_objects as go
+
+    if isinstance(points, np.ndarray):
+        points = (points[:, 0], points[:, 1], points[:, 2])
+    x, y, z = points
+    return go.Scatter3d(x=x, y=y, z=z, **kw)
+
+
+def _clip_trace(cable: CableResult, k: int, bodies: dict[str, str]):
 
     nodes = _clip_nodes(cable)
     p = cable.positions[k, list(nodes.values())] if nodes else np.zeros((0, 3))
     text = [f"{n} ({bodies.get(n, 'world')})" for n in nodes]
-    return go.Scatter3d(
-        x=p[:, 0],
-        y=p[:, 1],
-        z=p[:, 2],
+    return _scatter3d(
+        p,
         mode="markers+text",
         text=text,
         name="clips",
@@ -129,17 +136,14 @@ def _segments(pairs) -> list[np.ndarray]:
 def _body_traces(cable: CableResult, k: int, bodies: list[BodyPose], length: float) -> list:
     """Body origins (labelled with their clips), their x/y/z axes (red, green, blue) and dotted
     links from each origin to the clips it carries, at saved step ``k``."""
-    import plotly.graph_objects as go
 
     if not bodies:
         return []
     o = np.array([b.origin[k] for b in bodies])
     labels = [f"body {b.name}" + (f" → {', '.join(b.clips)}" if b.clips else "") for b in bodies]
     traces = [
-        go.Scatter3d(
-            x=o[:, 0],
-            y=o[:, 1],
-            z=o[:, 2],
+        _scatter3d(
+            o,
             mode="markers+text",
             text=labels,
             name="bodies",
@@ -150,10 +154,8 @@ def _body_traces(cable: CableResult, k: int, bodies: list[BodyPose], length: flo
     for i, colour in enumerate(AXIS_COLOURS):
         x, y, z = _segments((b.origin[k], b.origin[k] + length * b.axes[k][:, i]) for b in bodies)
         traces.append(
-            go.Scatter3d(
-                x=x,
-                y=y,
-                z=z,
+            _scatter3d(
+                (x, y, z),
                 mode="lines",
                 line={"color": colour, "width": 5},
                 name="body axes x, y, z (red, green, blue)",
@@ -168,10 +170,8 @@ def _body_traces(cable: CableResult, k: int, bodies: list[BodyPose], length: flo
     ]
     x, y, z = _segments(links) if links else ([], [], [])
     traces.append(
-        go.Scatter3d(
-            x=x,
-            y=y,
-            z=z,
+        _scatter3d(
+            (x, y, z),
             mode="lines",
             line={"color": "purple", "width": 2, "dash": "dot"},
             name="body → clip",
@@ -385,10 +385,8 @@ def damage_figure(
             )
         p = np.array(pts)
         traces.append(
-            go.Scatter3d(
-                x=p[:, 0],
-                y=p[:, 1],
-                z=p[:, 2],
+            _scatter3d(
+                p,
                 mode="markers+text",
                 text=text,
                 name="hot spots",
@@ -430,10 +428,8 @@ def volumes_figure(volumes: dict, cables: dict | None = None, title: str | None 
             x = cable.positions[0]
             points.append(x)
             traces.append(
-                go.Scatter3d(
-                    x=x[:, 0],
-                    y=x[:, 1],
-                    z=x[:, 2],
+                _scatter3d(
+                    x,
                     mode="lines",
                     line={"color": colour, "width": 5},
                     name=f"cable {label} (t = {cable.time[0]:.3g} s)",

@@ -15,7 +15,6 @@ A spec file::
 
 from __future__ import annotations
 
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -26,6 +25,7 @@ from cablelife.signals.errors import SignalError
 from cablelife.signals.generate import kinematics, quantity_series
 from cablelife.signals.kinematics import Kinematics, time_grid
 from cablelife.signals.spec import NamedChannel, PsdSignal, SignalFile
+from cablelife.tomlfile import read_toml
 
 
 @dataclass
@@ -52,12 +52,7 @@ def format_validation_error(err: ValidationError, source: str) -> str:
 def load_spec(path: Path) -> SignalFile:
     """Read and validate a spec file; a SignalError with every problem otherwise."""
     path = Path(path)
-    try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise SignalError(f"spec file {str(path)!r} does not exist") from None
-    except tomllib.TOMLDecodeError as err:
-        raise SignalError(f"spec file {str(path)!r} is not valid TOML: {err}") from None
+    data = read_toml(path, "spec file", SignalError)
     try:
         return SignalFile.model_validate(data)
     except ValidationError as err:

@@ -66,10 +66,7 @@ def _client(scheduler: str | None, workers: int | None):
 
 
 def _failed_row(variant: Variant, error: BaseException) -> dict:
-    return {
-        "variant": variant.name,
-        **variant.values,
-        "mode": variant.mode,
+    return variant.row() | {
         "status": "failed",
         "stage": "worker",
         "error": f"{type(error).__name__}: {error}",

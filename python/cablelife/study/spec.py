@@ -3,7 +3,6 @@ the fatigue-analysis settings (TOML, validated with pydantic)."""
 
 from __future__ import annotations
 
-import tomllib
 from pathlib import Path
 from typing import Annotated, Literal
 
@@ -11,6 +10,7 @@ from pydantic import BaseModel, ConfigDict, Field, PositiveFloat, ValidationErro
 
 from cablelife.lda.settings import LdaSettings
 from cablelife.scene import Vec3, format_validation_errors
+from cablelife.tomlfile import read_toml
 
 ParameterName = Annotated[str, Field(min_length=1, pattern=r"^[A-Za-z_][A-Za-z0-9_\-]*$")]
 
@@ -141,12 +141,7 @@ class StudyFile(_Model):
 def load_study(path: str | Path) -> tuple[StudyFile, Path]:
     """Reads and validates a study file; returns it with its directory (for relative paths)."""
     path = Path(path)
-    if not path.is_file():
-        raise StudyError(f"study file {str(path)!r} does not exist")
-    try:
-        data = tomllib.loads(path.read_text())
-    except tomllib.TOMLDecodeError as err:
-        raise StudyError(f"study file {str(path)!r} is not valid TOML: {err}") from None
+    data = read_toml(path, "study file", StudyError)
     try:
         study = StudyFile.model_validate(data)
     except ValidationError as err:

@@ -93,7 +93,7 @@ def run_variant(
     folder = variant_dir(out_dir, variant.name)
     folder.mkdir(parents=True, exist_ok=True)
     (folder / ERROR).unlink(missing_ok=True)
-    row: dict = {"variant": variant.name, **variant.values, "mode": variant.mode}
+    row = variant.row()
     times: dict[str, float] = {}
     stage = "scene"
 

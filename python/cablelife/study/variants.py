@@ -8,13 +8,13 @@ import hashlib
 import itertools
 import json
 import re
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
 from cablelife.scene import Scene, SceneError, scene_from_dict
 from cablelife.study.parameters import apply_parameter
 from cablelife.study.spec import StudyError, StudyFile
+from cablelife.tomlfile import read_toml
 
 
 @dataclass(frozen=True)
@@ -26,6 +26,10 @@ class Variant:
     scene: dict
     base_dir: Path
     mode: str
+
+    def row(self) -> dict:
+        """The first columns of its summary row: name, parameter values, mode."""
+        return {"variant": self.name, **self.values, "mode": self.mode}
 
     def validated(self) -> Scene:
         return scene_from_dict(self.scene, self.base_dir, f"of variant {self.name!r}")
@@ -50,12 +54,7 @@ def _grid_name(values: dict[str, float]) -> str:
 def base_scene(study: StudyFile, study_dir: Path) -> tuple[dict, Path]:
     """The base scene dict with the study's mode/duration overrides, and its directory."""
     path = study.study.scene if study.study.scene.is_absolute() else study_dir / study.study.scene
-    if not path.is_file():
-        raise StudyError(f"study.scene = {str(study.study.scene)!r}: {str(path)!r} does not exist")
-    try:
-        data = tomllib.loads(path.read_text())
-    except tomllib.TOMLDecodeError as err:
-        raise StudyError(f"scene {str(path)!r} is not valid TOML: {err}") from None
+    data = read_toml(path, "study.scene: scene file", StudyError)
     sim = data.setdefault("simulation", {})
     if study.study.mode is not None:
         sim["mode"] = study.study.mode
