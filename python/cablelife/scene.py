@@ -317,6 +317,9 @@ class Simulation(_Model):
     output_step: PositiveFloat | None = None  # s (default: every step)
     max_iterations: PositiveInt = 40
     spectral_radius: Annotated[float, Field(ge=0.0, le=1.0)] = 0.9  # ρ∞ of generalized-α
+    # Dynamic Newton iteration: converged when the correction is below this fraction of the
+    # step's increment (docs/dynamics.md: the error it leaves vs the time-step error).
+    newton_tolerance: Annotated[float, Field(gt=0.0, lt=1.0)] = 5e-3
 
 
 class Scene(_Model):

@@ -225,12 +225,14 @@ def _run_cable(scene: Scene, cable: Cable, times: np.ndarray, mode: str, progres
                 tau_shear,
                 tau_bend,
                 scene.simulation.spectral_radius,
+                scene.simulation.newton_tolerance,
                 callback,
                 max(1, times.size // 200),
             )
             saved = times[::every]
             solver.update(
                 spectral_radius=scene.simulation.spectral_radius,
+                newton_tolerance=scene.simulation.newton_tolerance,
                 time_step=scene.simulation.time_step,
                 tau_shear=np.array(tau_shear),
                 tau_bend=np.array(tau_bend),

@@ -144,6 +144,7 @@ fn main() {
         // BRANCH=k: the first k steps with the default options (a common start, with the same
         // sub-steps in the start-up transient), the rest with the options from the environment.
         let branch = env("BRANCH", 0.0) as usize;
+        let split = env("SPLIT", 1.0) as usize;
         let mut dy = Dynamics::new(
             &rod,
             &st,
@@ -170,9 +171,26 @@ fn main() {
             if branch > 0 && k == branch + 1 {
                 dy.opts = opts.clone();
             }
-            let s = dy
-                .advance(&rod, &mut st, h, &motions[k - 1], &motions[k], 6)
-                .unwrap_or_else(|e| panic!("step {k}: {e}"));
+            let s = if split > 1 {
+                // SPLIT sub-steps per signal step on the quintic Hermite interpolant of the
+                // clip kinematics (the time-discretisation error on the same input).
+                let mut sum = rod::StepStats::default();
+                let mut from = motions[k - 1].clone();
+                for j in 1..=split {
+                    let to = interpolate(&motions[k - 1], &motions[k], h, j as f64 / split as f64);
+                    let s = dy
+                        .advance(&rod, &mut st, h / split as f64, &from, &to, 6)
+                        .unwrap_or_else(|e| panic!("step {k}: {e}"));
+                    sum.iterations += s.iterations;
+                    sum.factorizations += s.factorizations;
+                    sum.substeps += s.substeps;
+                    from = to;
+                }
+                sum
+            } else {
+                dy.advance(&rod, &mut st, h, &motions[k - 1], &motions[k], 6)
+                    .unwrap_or_else(|e| panic!("step {k}: {e}"))
+            };
             it += s.iterations;
             if rep == 0 && k == 20 {
                 println!(
@@ -326,4 +344,63 @@ fn report(a: &rod::block_tridiag::BlockTridiag, f: &rod::block_tridiag::BlockTri
             );
         }
     }
+}
+
+/// The clip kinematics at t_0 + λh on the quintic Hermite interpolant of position, velocity and
+/// acceleration between two samples (angular motion: slerp and linear; consistent derivatives
+/// for the translation).
+fn interpolate(a: &[ClipMotion], b: &[ClipMotion], h: f64, l: f64) -> Vec<ClipMotion> {
+    a.iter()
+        .zip(b)
+        .map(|(a, b)| {
+            let (p0, v0, a0) = (a.pose.position, a.velocity * h, a.acceleration * h * h);
+            let (p1, v1, a1) = (b.pose.position, b.velocity * h, b.acceleration * h * h);
+            // Quintic Hermite basis in λ and its first two derivatives.
+            let (t, t2, t3, t4, t5) = (l, l * l, l.powi(3), l.powi(4), l.powi(5));
+            let h0 = [
+                1.0 - 10.0 * t3 + 15.0 * t4 - 6.0 * t5,
+                -30.0 * t2 + 60.0 * t3 - 30.0 * t4,
+                -60.0 * t + 180.0 * t2 - 120.0 * t3,
+            ];
+            let h1 = [
+                t - 6.0 * t3 + 8.0 * t4 - 3.0 * t5,
+                1.0 - 18.0 * t2 + 32.0 * t3 - 15.0 * t4,
+                -36.0 * t + 96.0 * t2 - 60.0 * t3,
+            ];
+            let h2 = [
+                0.5 * t2 - 1.5 * t3 + 1.5 * t4 - 0.5 * t5,
+                t - 4.5 * t2 + 6.0 * t3 - 2.5 * t4,
+                1.0 - 9.0 * t + 18.0 * t2 - 10.0 * t3,
+            ];
+            let h5 = [
+                10.0 * t3 - 15.0 * t4 + 6.0 * t5,
+                30.0 * t2 - 60.0 * t3 + 30.0 * t4,
+                60.0 * t - 180.0 * t2 + 120.0 * t3,
+            ];
+            let h4 = [
+                -4.0 * t3 + 7.0 * t4 - 3.0 * t5,
+                -12.0 * t2 + 28.0 * t3 - 15.0 * t4,
+                -24.0 * t + 84.0 * t2 - 60.0 * t3,
+            ];
+            let h3 = [
+                0.5 * t3 - t4 + 0.5 * t5,
+                1.5 * t2 - 4.0 * t3 + 2.5 * t4,
+                3.0 * t - 12.0 * t2 + 10.0 * t3,
+            ];
+            let at = |d: usize| {
+                p0 * h0[d] + v0 * h1[d] + a0 * h2[d] + a1 * h3[d] + v1 * h4[d] + p1 * h5[d]
+            };
+            ClipMotion {
+                pose: Pose {
+                    position: at(0),
+                    orientation: rod::rotation::slerp(&a.pose.orientation, &b.pose.orientation, l),
+                },
+                velocity: at(1) / h,
+                acceleration: at(2) / (h * h),
+                angular_velocity: a.angular_velocity * (1.0 - l) + b.angular_velocity * l,
+                angular_acceleration: a.angular_acceleration * (1.0 - l)
+                    + b.angular_acceleration * l,
+            }
+        })
+        .collect()
 }
