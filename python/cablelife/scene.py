@@ -23,6 +23,7 @@ from pydantic import (
     model_validator,
 )
 
+from cablelife import _core
 from cablelife.sections import SectionProperties, from_material, from_measured
 from cablelife.signals.spec import ChannelMotion, TableSignal
 from cablelife.tomlfile import read_toml
@@ -319,7 +320,7 @@ class Simulation(_Model):
     spectral_radius: Annotated[float, Field(ge=0.0, le=1.0)] = 0.9  # ρ∞ of generalized-α
     # Dynamic Newton iteration: converged when the correction is below this fraction of the
     # step's increment (docs/dynamics.md: the error it leaves vs the time-step error).
-    newton_tolerance: Annotated[float, Field(gt=0.0, lt=1.0)] = 5e-3
+    newton_tolerance: Annotated[float, Field(gt=0.0, lt=1.0)] = _core.DEFAULT_NEWTON_TOLERANCE
 
 
 class Scene(_Model):

@@ -45,6 +45,17 @@ pub fn damage(series: &[f64], curve: &Wohler, options: &CountOptions) -> Result<
     )
 }
 
+fn check_n_samples(n_samples: usize) -> Result<(), FatigueError> {
+    if n_samples == 0 {
+        return Err(FatigueError::param(
+            "n_samples",
+            0,
+            "every series needs at least one sample",
+        ));
+    }
+    Ok(())
+}
+
 /// Damage of `n_series = series.len() / n_samples` series stored row-major (one series per
 /// row of `n_samples` samples), in parallel on the current rayon pool.
 pub fn damage_many(
@@ -53,13 +64,7 @@ pub fn damage_many(
     curve: &Wohler,
     options: &CountOptions,
 ) -> Result<Vec<f64>, FatigueError> {
-    if n_samples == 0 {
-        return Err(FatigueError::param(
-            "n_samples",
-            0,
-            "every series needs at least one sample",
-        ));
-    }
+    check_n_samples(n_samples)?;
     if !series.len().is_multiple_of(n_samples) {
         return Err(FatigueError::Shape {
             name: "series",
@@ -95,13 +100,7 @@ pub fn damage_combined(
     curve: &Wohler,
     options: &CountOptions,
 ) -> Result<Vec<f64>, FatigueError> {
-    if n_samples == 0 {
-        return Err(FatigueError::param(
-            "n_samples",
-            0,
-            "every series needs at least one sample",
-        ));
-    }
+    check_n_samples(n_samples)?;
     if n_groups == 0 || n_series == 0 {
         return Ok(Vec::new());
     }

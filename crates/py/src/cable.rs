@@ -368,7 +368,7 @@ impl Cable {
     /// (EI₁, EI₂, GJ). Returns the recorded arrays, energies and `error` as `run_sequence`.
     #[pyo3(signature = (time_step, positions, quaternions, velocities, angular_velocities,
         accelerations, angular_accelerations, output_every, tau_shear, tau_bend,
-        spectral_radius=0.9, newton_tolerance=None, progress=None, progress_every=100))]
+        spectral_radius=0.9, newton_tolerance=DynamicOptions::default().tolerance, progress=None, progress_every=100))]
     #[allow(clippy::too_many_arguments)]
     fn run_dynamic<'py>(
         &mut self,
@@ -384,15 +384,13 @@ impl Cable {
         tau_shear: Vec<f64>,
         tau_bend: Vec<f64>,
         spectral_radius: f64,
-        newton_tolerance: Option<f64>,
+        newton_tolerance: f64,
         progress: Option<Py<PyAny>>,
         progress_every: usize,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let defaults = DynamicOptions::default();
-        let tolerance = newton_tolerance.unwrap_or(defaults.tolerance);
-        if !(tolerance.is_finite() && tolerance > 0.0 && tolerance < 1.0) {
+        if !(newton_tolerance > 0.0 && newton_tolerance < 1.0) {
             return Err(PyValueError::new_err(format!(
-                "newton_tolerance = {tolerance}: allowed is 0 < tolerance < 1"
+                "newton_tolerance = {newton_tolerance}: allowed is 0 < tolerance < 1"
             )));
         }
         if !(time_step.is_finite() && time_step > 0.0) {
@@ -444,10 +442,10 @@ impl Cable {
             rho_inf: spectral_radius,
             tau_shear: vec3(&tau_shear, "tau_shear")?,
             tau_bend: vec3(&tau_bend, "tau_bend")?,
-            tolerance,
+            tolerance: newton_tolerance,
             // Section outputs and energies only on the recorded steps.
             outputs_every_step: false,
-            ..defaults
+            ..Default::default()
         };
         let initial = route(&self.rod, poses.first().map(|p| p.as_slice()))
             .map_err(|e| PyValueError::new_err(e.0))?;
@@ -579,5 +577,9 @@ impl Cable {
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Cable>()?;
+    m.add(
+        "DEFAULT_NEWTON_TOLERANCE",
+        DynamicOptions::default().tolerance,
+    )?;
     Ok(())
 }

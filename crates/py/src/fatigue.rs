@@ -5,9 +5,13 @@ use ::fatigue::{
     count_cycles, damage_combined, damage_many, run_with_threads, turning_points, CountOptions,
     FatigueError, KneeKind, Residue, Wohler,
 };
-use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3};
+use numpy::ndarray::Dimension;
+use numpy::{
+    PyArray1, PyArrayMethods, PyReadonlyArray, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3,
+};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
+use std::borrow::Cow;
 
 fn err(e: FatigueError) -> PyErr {
     PyValueError::new_err(e.to_string())
@@ -95,16 +99,9 @@ fn fatigue_damage_many<'py>(
     let w = curve(k, alpha, knee_range, knee_kind)?;
     let o = options(residue, hysteresis)?;
     let n_samples = series.as_array().ncols();
-    let owned;
-    let data: &[f64] = match series.as_slice() {
-        Ok(s) => s,
-        Err(_) => {
-            owned = series.as_array().iter().copied().collect::<Vec<f64>>();
-            &owned
-        }
-    };
+    let data = row_major(&series);
     let d = py
-        .detach(|| run_with_threads(threads, || damage_many(data, n_samples, &w, &o)))
+        .detach(|| run_with_threads(threads, || damage_many(&data, n_samples, &w, &o)))
         .map_err(err)?
         .map_err(err)?;
     Ok(PyArray1::from_vec(py, d))
@@ -139,19 +136,11 @@ fn fatigue_damage_combined<'py>(
             "weights has {w_channels} columns but signals has {n_channels} channels: they must match"
         )));
     }
-    let sig_owned;
-    let sig: &[f64] = match signals.as_slice() {
-        Ok(s) => s,
-        Err(_) => {
-            sig_owned = signals.as_array().iter().copied().collect::<Vec<f64>>();
-            &sig_owned
-        }
-    };
-    let wts = weights.as_array().iter().copied().collect::<Vec<f64>>();
+    let (sig, wts) = (row_major(&signals), row_major(&weights));
     let d = py
         .detach(|| {
             run_with_threads(threads, || {
-                damage_combined(sig, n_groups, n_samples, &wts, n_series, &w, &o)
+                damage_combined(&sig, n_groups, n_samples, &wts, n_series, &w, &o)
             })
         })
         .map_err(err)?
@@ -159,6 +148,14 @@ fn fatigue_damage_combined<'py>(
     Ok(PyArray1::from_vec(py, d)
         .reshape([n_groups, n_series])?
         .into_any())
+}
+
+/// The array's values in row-major order: borrowed when it is C-contiguous, else copied.
+fn row_major<'a, D: Dimension>(a: &'a PyReadonlyArray<'_, f64, D>) -> Cow<'a, [f64]> {
+    match a.as_slice() {
+        Ok(s) => Cow::Borrowed(s),
+        Err(_) => Cow::Owned(a.as_array().iter().copied().collect()),
+    }
 }
 
 /// Add the fatigue functions to the `_core` module.

@@ -181,9 +181,7 @@ fn main() {
                     let s = dy
                         .advance(&rod, &mut st, h / split as f64, &from, &to, 6)
                         .unwrap_or_else(|e| panic!("step {k}: {e}"));
-                    sum.iterations += s.iterations;
-                    sum.factorizations += s.factorizations;
-                    sum.substeps += s.substeps;
+                    sum = sum.then(s);
                     from = to;
                 }
                 sum

@@ -128,6 +128,18 @@ pub struct StepStats {
     pub substeps: usize,
 }
 
+impl StepStats {
+    /// The stats of this step followed by `next` (sub-steps of one step).
+    pub fn then(self, next: StepStats) -> StepStats {
+        StepStats {
+            iterations: self.iterations + next.iterations,
+            factorizations: self.factorizations + next.factorizations,
+            residual: next.residual,
+            substeps: self.substeps + next.substeps,
+        }
+    }
+}
+
 /// Energies after a step, J.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Energies {
@@ -588,12 +600,7 @@ impl Dynamics {
                     from.iter().zip(to).map(|(a, b)| a.midpoint(b)).collect();
                 let s1 = self.advance(rod, st, 0.5 * h, from, &mid, max_depth - 1)?;
                 let s2 = self.advance(rod, st, 0.5 * h, &mid, to, max_depth - 1)?;
-                Ok(StepStats {
-                    iterations: s1.iterations + s2.iterations,
-                    factorizations: s1.factorizations + s2.factorizations,
-                    residual: s2.residual,
-                    substeps: s1.substeps + s2.substeps,
-                })
+                Ok(s1.then(s2))
             }
         }
     }
