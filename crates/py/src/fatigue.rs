@@ -150,11 +150,12 @@ fn fatigue_damage_combined<'py>(
         .into_any())
 }
 
-/// The array's values in row-major order: borrowed when it is C-contiguous, else copied.
+/// The array's values in row-major order: borrowed when it is C-contiguous, else copied
+/// (`as_slice` alone also accepts Fortran order, whose memory is column-major).
 fn row_major<'a, D: Dimension>(a: &'a PyReadonlyArray<'_, f64, D>) -> Cow<'a, [f64]> {
     match a.as_slice() {
-        Ok(s) => Cow::Borrowed(s),
-        Err(_) => Cow::Owned(a.as_array().iter().copied().collect()),
+        Ok(s) if a.as_array().is_standard_layout() => Cow::Borrowed(s),
+        _ => Cow::Owned(a.as_array().iter().copied().collect()),
     }
 }
 
