@@ -11,6 +11,7 @@ from rich.console import Console
 from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 from rich.table import Table
 
+from cablelife.interrupt import interrupted
 from cablelife.results import Result
 from cablelife.scene import SceneError, json_schema, load_scene
 from cablelife.signals.errors import SignalError
@@ -114,9 +115,16 @@ def run(
     except (SceneError, SignalError) as err:
         raise fail(str(err)) from None
     except SimulationError as err:
+        what = "interruption" if err.interrupted else "failure"
         if output is not None:
             err.result.save(output)
-            err_console.print(f"partial result (steps before the failure) saved to {output}")
+            err_console.print(
+                f"partial result (steps before the {what}) saved to {output}", highlight=False
+            )
+        if err.interrupted:
+            raise interrupted(
+                "the run stopped early" + ("" if output else " (nothing saved)")
+            ) from None
         raise fail(str(err), code=1) from None
     print_summary(result)
     if output is not None:
@@ -194,7 +202,7 @@ _register_optional()
 
 
 def main() -> None:  # pragma: no cover
-    app()
+    app(prog_name="cablelife")
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -15,7 +15,7 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from cablelife import _core
+from cablelife import _core, interrupt
 from cablelife.results import CableResult, ClipReaction, Result
 from cablelife.scene import Cable, Scene, SceneError
 from cablelife.signals import body_motion, time_grid
@@ -24,11 +24,17 @@ Progress = Callable[[str, int, int], None]
 
 
 class SimulationError(RuntimeError):
-    """A run that stopped early; ``result`` holds every step computed before the stop."""
+    """A run that stopped early; ``result`` holds every step computed before the stop
+    (``result.complete`` is False, ``result.message`` says why: "interrupted" after Ctrl-C)."""
 
     def __init__(self, message: str, result: Result):
         super().__init__(message)
         self.result = result
+
+    @property
+    def interrupted(self) -> bool:
+        """The run was stopped on request (Ctrl-C), not by a solver failure."""
+        return self.result.message == interrupt.INTERRUPTED
 
 
 def frame_matrix(direction, normal=None) -> np.ndarray:
@@ -199,7 +205,14 @@ def _warn_moving_start(cable: Cable, kin: dict[str, np.ndarray]) -> None:
                 return
 
 
-def _run_cable(scene: Scene, cable: Cable, times: np.ndarray, mode: str, progress: Progress | None):
+def _run_cable(
+    scene: Scene,
+    cable: Cable,
+    times: np.ndarray,
+    mode: str,
+    progress: Progress | None,
+    stop: _core.StopFlag | None = None,
+):
     core = build_cable(scene, cable)
     callback = (lambda k, n: progress(cable.name, k, n)) if progress else None
     solver: dict = {}
@@ -228,6 +241,7 @@ def _run_cable(scene: Scene, cable: Cable, times: np.ndarray, mode: str, progres
                 scene.simulation.newton_tolerance,
                 callback,
                 max(1, times.size // 200),
+                stop=stop,
             )
             saved = times[::every]
             solver.update(
@@ -242,7 +256,7 @@ def _run_cable(scene: Scene, cable: Cable, times: np.ndarray, mode: str, progres
             )
         else:
             pos, quat = clip_poses(scene, cable, times)
-            out = core.run_sequence(pos, quat, callback, max(1, times.size // 100))
+            out = core.run_sequence(pos, quat, callback, max(1, times.size // 100), stop=stop)
             saved = times
     except ValueError as err:
         raise SceneError(f"cable '{cable.name}': {err}") from None
@@ -292,7 +306,8 @@ def simulate(scene: Scene, mode: str | None = None, progress: Progress | None = 
     """Runs the scene (``mode`` overrides ``scene.simulation.mode``).
 
     Raises :class:`SimulationError` with the partial result if a cable's solve fails or the run
-    is interrupted; :class:`SceneError` for an unusable scene.
+    is interrupted (Ctrl-C, or :func:`cablelife.interrupt.request_stop` from another thread: the
+    solver threads stop after their current step); :class:`SceneError` for an unusable scene.
     """
     mode = mode or scene.simulation.mode
     if mode not in ("static", "quasistatic", "dynamic"):
@@ -301,8 +316,11 @@ def simulate(scene: Scene, mode: str | None = None, progress: Progress | None = 
         )
     times = output_times(scene, mode)
     workers = max(1, min(len(scene.cables), os.cpu_count() or 1))
-    with ThreadPoolExecutor(max_workers=workers) as pool:
-        futures = [pool.submit(_run_cable, scene, c, times, mode, progress) for c in scene.cables]
+    with interrupt.stop_flag() as stop, ThreadPoolExecutor(max_workers=workers) as pool:
+        futures = [
+            pool.submit(_run_cable, scene, c, times, mode, progress, stop) for c in scene.cables
+        ]
+        interrupt.wait_stopping(futures, stop.set)  # Ctrl-C: the runs end after their step
         outcomes = [f.result() for f in futures]
     cables = {res.name: res for res, _ in outcomes}
     errors = [f"cable '{res.name}': {err}" for res, err in outcomes if err]
@@ -311,7 +329,7 @@ def simulate(scene: Scene, mode: str | None = None, progress: Progress | None = 
         cables=cables,
         scene_toml=scene.to_toml(),
         complete=not errors,
-        message="; ".join(errors),
+        message=interrupt.INTERRUPTED if errors and stop.is_set else "; ".join(errors),
     )
     if errors:
         raise SimulationError(result.message, result)

@@ -1,5 +1,6 @@
 //! Bindings of the rod solver: a `Cable` built from plain numbers and arrays; runs release the
 //! GIL, poll Ctrl-C and report progress through an optional Python callable.
+use crate::stop::{Poller, StopFlag};
 use nalgebra::{Quaternion, Vector3};
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray3};
 use pyo3::exceptions::PyValueError;
@@ -173,21 +174,6 @@ fn read_poses(
     Ok(poses)
 }
 
-/// Calls the progress callback and checks for Ctrl-C; returns why to stop, if so.
-fn poll(progress: &Option<Py<PyAny>>, done: usize, total: usize) -> Option<String> {
-    Python::attach(|py| {
-        if let Err(e) = py.check_signals() {
-            return Some(format!("interrupted: {e}"));
-        }
-        if let Some(cb) = progress {
-            if let Err(e) = cb.call1(py, (done, total)) {
-                return Some(format!("progress callback failed: {e}"));
-            }
-        }
-        None
-    })
-}
-
 /// One cable: mesh, state and solver.
 #[pyclass(module = "cablelife._core")]
 pub struct Cable {
@@ -296,8 +282,9 @@ impl Cable {
     /// `quaternions` (T, C, 4). Step 0 is a static solve from the routed shape (with load
     /// continuation if needed); later steps are warm-started and sub-stepped on failure.
     /// Returns a dict of arrays for the completed steps and `error` (None, or why it stopped:
-    /// the results up to there are kept).
-    #[pyo3(signature = (positions, quaternions, progress=None, progress_every=50))]
+    /// the results up to there are kept). `stop`: a `StopFlag` read after every step (the
+    /// run ends with error "interrupted" when it is set).
+    #[pyo3(signature = (positions, quaternions, progress=None, progress_every=50, stop=None))]
     fn run_sequence<'py>(
         &mut self,
         py: Python<'py>,
@@ -305,6 +292,7 @@ impl Cable {
         quaternions: PyReadonlyArray3<'py, f64>,
         progress: Option<Py<PyAny>>,
         progress_every: usize,
+        stop: Option<Bound<'py, StopFlag>>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let pos = positions.as_array();
         let qs = quaternions.as_array();
@@ -321,7 +309,7 @@ impl Cable {
         let rod = &self.rod;
         let solver = &mut self.solver;
         let state_slot = &mut self.state;
-        let every = progress_every.max(1);
+        let mut poller = Poller::new(stop.as_ref(), progress, progress_every, poses.len());
         // Routing problems (a cable too short between two clips) are input errors.
         let initial = route(rod, poses.first().map(|p| p.as_slice()))
             .map_err(|e| PyValueError::new_err(e.0))?;
@@ -346,11 +334,9 @@ impl Cable {
                         return (rec, Some(format!("step {k}: {e}")));
                     }
                 }
-                if (k + 1) % every == 0 || k + 1 == poses.len() {
-                    if let Some(stop) = poll(&progress, k + 1, poses.len()) {
-                        *state_slot = Some(st);
-                        return (rec, Some(stop));
-                    }
+                if let Some(why) = poller.poll(k + 1) {
+                    *state_slot = Some(st);
+                    return (rec, Some(why));
                 }
             }
             *state_slot = Some(st);
@@ -365,10 +351,12 @@ impl Cable {
     /// of `time_step` through the clip kinematics (T, C, ·): positions, quaternions, velocities,
     /// angular velocities, accelerations, angular accelerations (global). Every
     /// `output_every`-th step is recorded (and step 0). τ: retardation times (GA₁, GA₂, EA),
-    /// (EI₁, EI₂, GJ). Returns the recorded arrays, energies and `error` as `run_sequence`.
+    /// (EI₁, EI₂, GJ). Returns the recorded arrays, energies and `error` as `run_sequence`;
+    /// `stop` as there.
     #[pyo3(signature = (time_step, positions, quaternions, velocities, angular_velocities,
         accelerations, angular_accelerations, output_every, tau_shear, tau_bend,
-        spectral_radius=0.9, newton_tolerance=DynamicOptions::default().tolerance, progress=None, progress_every=100))]
+        spectral_radius=0.9, newton_tolerance=DynamicOptions::default().tolerance, progress=None,
+        progress_every=100, stop=None))]
     #[allow(clippy::too_many_arguments)]
     fn run_dynamic<'py>(
         &mut self,
@@ -387,6 +375,7 @@ impl Cable {
         newton_tolerance: f64,
         progress: Option<Py<PyAny>>,
         progress_every: usize,
+        stop: Option<Bound<'py, StopFlag>>,
     ) -> PyResult<Bound<'py, PyDict>> {
         if !(newton_tolerance > 0.0 && newton_tolerance < 1.0) {
             return Err(PyValueError::new_err(format!(
@@ -453,7 +442,7 @@ impl Cable {
         let solver = &mut self.solver;
         let state_slot = &mut self.state;
         let every = output_every.max(1);
-        let poll_every = progress_every.max(1);
+        let mut poller = Poller::new(stop.as_ref(), progress, progress_every, t);
         let (record, error) = py.detach(move || {
             let mut rec = Record::with_capacity(t.saturating_sub(1) / every + 1, rod);
             let mut st = initial;
@@ -492,11 +481,9 @@ impl Cable {
                         );
                     }
                 }
-                if k % poll_every == 0 || k + 1 == t {
-                    if let Some(stop) = poll(&progress, k + 1, t) {
-                        *state_slot = Some(st);
-                        return (rec, Some(stop));
-                    }
+                if let Some(why) = poller.poll(k + 1) {
+                    *state_slot = Some(st);
+                    return (rec, Some(why));
                 }
             }
             *state_slot = Some(st);
