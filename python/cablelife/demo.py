@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import cablelife
+from cablelife import interrupt
 from cablelife.study.spec import StudyError, load_study
 from cablelife.study.task import run_variant, variant_dir
 from cablelife.study.variants import Variant, expand
@@ -116,7 +117,17 @@ def run_demo(
         return row
 
     with ThreadPoolExecutor(max_workers=n) as pool:
-        rows = dict(zip([v.name for v in runs], pool.map(one, runs), strict=True))
+        futures = [pool.submit(one, v) for v in runs]
+
+        def stop() -> None:  # Ctrl-C: the runs keep what they computed (partial result.h5)
+            interrupt.request_stop()
+            for f in futures:
+                f.cancel()
+
+        if interrupt.wait_stopping(futures, stop, stop_on_error=False):
+            interrupt.reset()  # every run has ended
+            raise KeyboardInterrupt
+        rows = {v.name: f.result() for v, f in zip(runs, futures, strict=True)}
     times["simulate + LDA + volume (all runs)"] = time.perf_counter() - t0
     for name, row in rows.items():
         for key in ("simulation_s", "lda_s", "volume_s"):

@@ -67,6 +67,12 @@ def demo_command(
                 )
             state["report"] = "ok" if report else "skipped"
             live.update(view())
+    except KeyboardInterrupt:
+        from cablelife.interrupt import interrupted
+
+        raise interrupted(
+            f"runs finished so far (and partial results) are kept in {output / 'variants'}"
+        ) from None
     except (StudyError, FileNotFoundError, RuntimeError) as e:
         Console(stderr=True).print(f"[bold red]error:[/] {e}", highlight=False, soft_wrap=True)
         raise typer.Exit(2) from None

@@ -28,6 +28,7 @@ def paraview_command(
     from cablelife.results import load_result
 
     err = Console(stderr=True)
+    written = []
     try:
         if every < 1:
             raise ValueError(f"every = {every}: must be >= 1")
@@ -39,7 +40,6 @@ def paraview_command(
                 f"damage file {str(damage)!r} has the cables {', '.join(maps)}; the result "
                 f"{str(result)!r} has {', '.join(res.cables)}"
             )
-        written = []
         for name in names:
             if name not in res.cables:
                 raise ValueError(f"cable = {name!r}: {str(result)!r} has {', '.join(res.cables)}")
@@ -50,6 +50,11 @@ def paraview_command(
             written.append(
                 write_paraview(res.cables[name], out, damage=dm, steps=slice(None, None, every))
             )
+    except KeyboardInterrupt:
+        from cablelife.interrupt import interrupted
+
+        done = ", ".join(map(str, written)) or "none"
+        raise interrupted(f"complete time series: {done}; frame files of the others kept") from None
     except (ValueError, FileNotFoundError) as e:
         err.print(f"[bold red]error:[/] {e}", highlight=False, soft_wrap=True)
         raise typer.Exit(2) from None

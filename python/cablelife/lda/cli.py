@@ -76,6 +76,10 @@ def lda_command(
         for w in caught:
             console.print(f"[yellow]warning:[/] {w.message}", soft_wrap=True)
         path = analysis.save(output or default_damage_path(result))
+    except KeyboardInterrupt:
+        from cablelife.interrupt import interrupted
+
+        raise interrupted("no damage file written") from None
     except (ValueError, FileNotFoundError) as e:
         console.print(f"[red]error:[/] {e}", soft_wrap=True)
         raise typer.Exit(1) from e

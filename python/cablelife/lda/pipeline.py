@@ -17,6 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
+from cablelife import interrupt
 from cablelife.lda.damage import damage_combined, equivalent_range_from_damage
 from cablelife.lda.planes import DEFAULT_PLANE_STEP_DEG, plane_angles, plane_weights
 from cablelife.lda.rainflow import RainflowMatrix, check_residue, rainflow_cycles
@@ -230,6 +231,7 @@ def analyse_cable(
     out = np.empty((n_sec, weights.shape[0]))
     chunk = _chunk_sections(weights.shape[0], n_steps)
     for start in range(0, n_sec, chunk):
+        interrupt.check()  # Ctrl-C seen by another thread (cablelife demo)
         stop = min(n_sec, start + chunk)
         out[start:stop] = damage_combined(
             loads[start:stop],

@@ -112,6 +112,10 @@ def report_command(
         path = write_report(
             output, runs, color_by=color_by, frames=frames, voxel=h, bend_factor=bend_factor
         )
+    except KeyboardInterrupt:
+        from cablelife.interrupt import interrupted
+
+        raise interrupted("no report written") from None
     except (ValueError, FileNotFoundError) as e:
         err.print(f"[bold red]error:[/] {e}", highlight=False, soft_wrap=True)
         raise typer.Exit(2) from None

@@ -15,6 +15,34 @@ def _fmt(x, spec: str = ".4g") -> str:
         return "" if x is None else str(x)
 
 
+def tls_security(scheduler: str | None, ca_file, cert, key):
+    """A ``distributed.security.Security`` for a ``tls://`` scheduler from the TLS options
+    (None without them: Dask's configuration applies, e.g. DASK_DISTRIBUTED__COMM__TLS__…)."""
+    from cablelife.study.spec import StudyError
+
+    given = {"--tls-ca-file": ca_file, "--tls-cert": cert, "--tls-key": key}
+    if all(v is None for v in given.values()):
+        return None
+    if scheduler is None or not scheduler.startswith("tls://"):
+        raise StudyError(
+            f"{', '.join(k for k, v in given.items() if v is not None)} need a tls:// scheduler "
+            f"address; --scheduler is {scheduler!r}"
+        )
+    for option, path in given.items():
+        if path is not None and not Path(path).is_file():
+            raise StudyError(f"{option} {str(path)!r}: no such file")
+    if cert is None:
+        raise StudyError("--tls-cert is required with TLS options (the client's certificate)")
+    from distributed.security import Security
+
+    return Security(
+        tls_ca_file=str(ca_file) if ca_file else None,
+        tls_client_cert=str(cert),
+        tls_client_key=str(key) if key else None,
+        require_encryption=True,
+    )
+
+
 def study_command(
     study: Annotated[Path, typer.Argument(help="Study file (TOML): base scene + parameters.")],
     output: Annotated[
@@ -26,6 +54,16 @@ def study_command(
     ] = None,
     workers: Annotated[
         int | None, typer.Option(help="Worker processes of the local cluster [one per core].")
+    ] = None,
+    tls_ca_file: Annotated[
+        Path | None,
+        typer.Option(help="TLS: CA certificate of the cluster (with a tls:// --scheduler)."),
+    ] = None,
+    tls_cert: Annotated[
+        Path | None, typer.Option(help="TLS: this client's certificate (PEM).")
+    ] = None,
+    tls_key: Annotated[
+        Path | None, typer.Option(help="TLS: this client's private key (PEM) [in --tls-cert].")
     ] = None,
 ) -> None:
     """Run a variant study on Dask: simulate, LDA and summary per variant, ranked by damage.
@@ -59,8 +97,19 @@ def study_command(
                 bar.update(task, completed=done, total=total, description=last)
 
             outcome = run_study(
-                study, output, scheduler=scheduler, workers=workers, progress=progress
+                study,
+                output,
+                scheduler=scheduler,
+                workers=workers,
+                progress=progress,
+                security=tls_security(scheduler, tls_ca_file, tls_cert, tls_key),
             )
+    except KeyboardInterrupt:
+        from cablelife.interrupt import interrupted
+
+        raise interrupted(
+            "finished variants are kept; the same command computes the others"
+        ) from None
     except (StudyError, ConnectionError, FileNotFoundError) as e:
         err.print(f"[bold red]error:[/] {e}", highlight=False, soft_wrap=True)
         raise typer.Exit(2) from None

@@ -6,7 +6,6 @@ on the remaining workers."""
 from __future__ import annotations
 
 import os
-import shutil
 import uuid
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -14,6 +13,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from cablelife.atomic import write_atomic
 from cablelife.study.spec import StudyFile, load_study
 from cablelife.study.table import plot_damage_over_parameters, save_tables, summary_frame
 from cablelife.study.task import finished_row, run_variant, task_settings
@@ -42,27 +42,41 @@ def default_out_dir(study_path: str | Path, study: StudyFile) -> Path:
     return Path("out") / (study.study.name or Path(study_path).stem)
 
 
-def _client(scheduler: str | None, workers: int | None):
+def _client(scheduler: str | None, workers: int | None, security=None):
     import dask
     from distributed import Client, LocalCluster
 
     dask.config.set({"distributed.scheduler.allowed-failures": ALLOWED_FAILURES})
     if scheduler is not None:
         try:
-            return Client(scheduler, timeout="20s"), None
+            return Client(scheduler, timeout="20s", security=security), None
         except OSError as err:
             raise ConnectionError(
                 f"--scheduler {scheduler!r}: no Dask scheduler answers there ({err})"
             ) from None
     n = workers or os.cpu_count() or 1
+    # No HTTP server anywhere (Dask starts unauthenticated ones even without a dashboard: the
+    # scheduler's on port 8787, each worker's on a random port): no routes, and stopped.
+    dask.config.set({"distributed.scheduler.http.routes": [], "distributed.worker.http.routes": []})
     cluster = LocalCluster(
         n_workers=n,
         threads_per_worker=1,
         processes=True,
+        host="127.0.0.1",
         dashboard_address=None,
+        worker_dashboard_address=None,
+        scheduler_kwargs={"dashboard": False, "dashboard_address": "127.0.0.1:0"},
+        preload=["cablelife.study.worker_setup"],
         silence_logs=40,
     )
+    cluster.sync(_stop_http_server, cluster.scheduler)
     return Client(cluster), cluster
+
+
+async def _stop_http_server(node) -> None:
+    server = getattr(node, "http_server", None)
+    if server is not None:
+        server.stop()
 
 
 def _failed_row(variant: Variant, error: BaseException) -> dict:
@@ -80,16 +94,18 @@ def run_study(
     scheduler: str | None = None,
     workers: int | None = None,
     progress: Callable[[int, int, dict], None] | None = None,
+    security=None,
 ) -> StudyOutcome:
     """Runs every unfinished variant of the study and writes the summary table and plot.
 
     ``progress(done, total, row)`` is called after each variant (finished ones count at once).
+    ``security``: a ``distributed.security.Security`` for a ``tls://`` scheduler address.
     """
     study, study_dir = load_study(study_path)
     variants = expand(study, study_dir)
     out = Path(out_dir) if out_dir is not None else default_out_dir(study_path, study)
     out.mkdir(parents=True, exist_ok=True)
-    shutil.copyfile(study_path, out / "study.toml")
+    write_atomic(out / "study.toml", lambda f: f.write(Path(study_path).read_bytes()))
     settings = task_settings(study.lda, study.volume, study.study.threads)
     rows: dict[str, dict] = {}
     skipped = []
@@ -103,14 +119,14 @@ def run_study(
     if progress is not None:
         progress(len(rows), total, {})
     if pending:
-        _run_pending(pending, out, study, rows, total, scheduler, workers, progress)
+        client, cluster = _client(scheduler, workers, security)
+        _run_pending(client, cluster, pending, out, study, rows, total, progress)
     return _finish(study, variants, rows, out, skipped)
 
 
-def _run_pending(pending, out, study, rows, total, scheduler, workers, progress) -> None:
+def _run_pending(client, cluster, pending, out, study, rows, total, progress) -> None:
     from distributed import as_completed
 
-    client, cluster = _client(scheduler, workers)
     futures = {}
     try:
         for v in pending:
@@ -134,7 +150,9 @@ def _run_pending(pending, out, study, rows, total, scheduler, workers, progress)
             rows[v.name] = row
             if progress is not None:
                 progress(len(rows), total, row)
-    except BaseException:
+    except BaseException as err:
+        if isinstance(err, KeyboardInterrupt):
+            _quiet_shutdown()
         for fut in futures:
             fut.cancel()
         raise
@@ -142,6 +160,15 @@ def _run_pending(pending, out, study, rows, total, scheduler, workers, progress)
         client.close()
         if cluster is not None:
             cluster.close()
+
+
+def _quiet_shutdown() -> None:
+    """Ctrl-C: the cluster is closed under running variants, and Dask logs the closed
+    connections (CommClosedError, …) of that on purpose; nothing of it is news to the user."""
+    import logging
+
+    for name in ("distributed", "tornado", "asyncio"):
+        logging.getLogger(name).setLevel(logging.CRITICAL + 1)
 
 
 def _finish(study: StudyFile, variants: list[Variant], rows, out: Path, skipped) -> StudyOutcome:

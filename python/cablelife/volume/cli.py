@@ -64,11 +64,18 @@ def volume_command(
             )
         return res.cables[cable]
 
+    a_saved = False
     try:
         h = parse_length(voxel)
         a = motion_volume(source(result), h)
         a.save(output, unit=unit)
+        a_saved = True
         b = motion_volume(source(compare), h) if compare is not None else None
+    except KeyboardInterrupt:
+        from cablelife.interrupt import interrupted
+
+        kept = f"the mesh was saved to {output}" if a_saved else "no mesh written"
+        raise interrupted(kept) from None
     except (ValueError, FileNotFoundError) as e:
         err.print(f"[bold red]error:[/] {e}", highlight=False, soft_wrap=True)
         raise typer.Exit(2) from None

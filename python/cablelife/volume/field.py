@@ -6,10 +6,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from cablelife import _core
+from cablelife import _core, interrupt
 
 #: Largest grid built without complaint (about 1.2 GB of float32).
 MAX_VOXELS = 300_000_000
+#: Voxels per call of the distance kernel (a fraction of a second).
+SLAB_VOXELS = 2_000_000
 
 
 @dataclass(frozen=True)
@@ -108,13 +110,21 @@ def signed_distance(
     voxel = check_voxel(voxel)
     band = 3.0 * voxel if band is None else float(band)
     origin = np.asarray(origin, dtype=np.float64)
-    values = _core.capsule_signed_distance(
-        capsules.starts,
-        capsules.ends,
-        capsules.radius,
-        [float(x) for x in origin],
-        voxel,
-        [int(s) for s in shape],
-        band,
-    )
+    nx, ny, nz = (int(s) for s in shape)
+    # Slabs of about SLAB_VOXELS per kernel call, so that Ctrl-C is seen between them.
+    rows = max(1, SLAB_VOXELS // max(1, ny * nz))
+    values = None
+    for i0 in range(0, nx, rows):
+        interrupt.check()  # Ctrl-C seen by another thread (cablelife demo)
+        corner = [float(origin[0] + voxel * i0), float(origin[1]), float(origin[2])]
+        n = min(rows, nx - i0)
+        part = _core.capsule_signed_distance(
+            capsules.starts, capsules.ends, capsules.radius, corner, voxel, [n, ny, nz], band
+        )
+        if n == nx:
+            values = part
+        else:
+            if values is None:
+                values = np.empty((nx, ny, nz), dtype=part.dtype)
+            values[i0 : i0 + n] = part
     return VoxelField(values=values, origin=origin, spacing=voxel, band=band)
