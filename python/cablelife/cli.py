@@ -166,7 +166,9 @@ def schema(
     if output is None:
         console.print_json(text)
     else:
-        output.write_text(text + "\n")
+        from cablelife.atomic import write_text_atomic
+
+        write_text_atomic(output, text + "\n")
 
 
 def _register_optional() -> None:
