@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import signal
+import socket
 import subprocess
 import sys
 import time
@@ -16,6 +18,8 @@ import pytest
 from cablelife.study import StudyError, expand, load_study, run_study
 
 ROOT = Path(__file__).resolve().parents[1]
+# After Ctrl-C the study cancels its variants and closes the local cluster (a hang detector).
+STOP_BOUND = 30.0  # s
 SCENE = ROOT / "examples" / "clip-variants" / "scene.toml"
 
 # A short, coarse study: 0.3 s of the demo scene, a coarse LDA and motion volume.
@@ -266,25 +270,48 @@ def _wait_for(predicate, timeout: float, what: str, procs=()):
 
 
 def test_rerun_after_an_interruption_computes_only_the_missing_variants(tmp_path):
+    """The interruption comes at a known point: Ctrl-C (KeyboardInterrupt) raised by the
+    progress callback when the first variant has finished; the worker busy with the second is
+    shut down with the cluster."""
+    out = tmp_path / "out"
+    study = write_study(tmp_path, "[0.0, 0.02, 0.04]", "[1.25, 1.26]")
+
+    def ctrl_c_after_the_first(done: int, total: int, row: dict) -> None:
+        if row:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        run_study(study, out, workers=1, progress=ctrl_c_after_the_first)
+    assert not (out / "summary.csv").exists()
+    finished = sorted(_rows(out))
+    assert len(finished) == 1, finished
+    outcome = run_study(study, out, workers=2)
+    assert outcome.skipped == finished
+    assert sorted(outcome.computed) == sorted(set(outcome.table["variant"]) - set(finished))
+    assert len(outcome.computed) == 5
+    assert len(outcome.table) == 6 and (outcome.table["status"] == "ok").all()
+
+
+def test_ctrl_c_stops_a_study_quietly_and_keeps_the_finished_variants(tmp_path):
     out = tmp_path / "out"
     study = write_study(tmp_path, "[0.0, 0.02, 0.04]", "[1.25, 1.26]")
     proc = _cli("study", str(study), "-o", str(out), "--workers", "1")
     try:
-        _wait_for(lambda: len(_rows(out)) >= 1, 240, "the first finished variant", [proc])
-        os.killpg(proc.pid, signal.SIGINT)
-        proc.wait(60)
+        _wait_for(lambda: len(_rows(out)) >= 1, 300, "the first finished variant", [proc])
+        os.killpg(proc.pid, signal.SIGINT)  # as a terminal does: the workers get it too
+        start = time.monotonic()
+        text, _ = proc.communicate(timeout=STOP_BOUND)
+        stopped = time.monotonic() - start
     finally:
         if proc.poll() is None:
             os.killpg(proc.pid, signal.SIGKILL)
-    # The interrupt stopped the study: no summary table, and the re-run has work left.
-    assert proc.returncode != 0, "the study ended normally instead of being interrupted"
+    assert proc.returncode == 130, text
+    assert "Traceback" not in text and "CommClosedError" not in text, text
+    assert "interrupted: finished variants are kept" in text.replace("\n", " "), text
     assert not (out / "summary.csv").exists()
-    finished = sorted(_rows(out))
-    outcome = run_study(study, out, workers=2)
-    assert outcome.computed, f"every variant had finished before the interrupt: {finished}"
-    assert sorted(outcome.skipped) == finished
-    assert sorted(outcome.computed) == sorted(set(outcome.table["variant"]) - set(finished))
-    assert len(outcome.table) == 6 and (outcome.table["status"] == "ok").all()
+    assert stopped < STOP_BOUND
+    finished = _rows(out)
+    assert 1 <= len(finished) < 6 and all(r["status"] == "ok" for r in finished.values())
 
 
 @pytest.fixture(scope="module")
@@ -377,3 +404,63 @@ def test_killing_a_worker_mid_study_still_yields_every_variant(tmp_path, dask_cl
     table = pd.read_csv(out / "summary.csv")
     assert len(table) == 8 and (table["status"] == "ok").all(), text
     assert len(_rows(out)) == 8
+
+
+def _process_tree(pid: int) -> set[int]:
+    pids, todo = set(), [pid]
+    while todo:
+        p = todo.pop()
+        pids.add(p)
+        for task in Path(f"/proc/{p}/task").glob("*"):
+            with contextlib.suppress(OSError):
+                todo += [int(c) for c in (task / "children").read_text().split()]
+    return pids
+
+
+def _listening_ports(pids: set[int]) -> set[int]:
+    """TCP ports the processes ``pids`` listen on (from /proc: their sockets' inodes)."""
+    inodes = set()
+    for pid in pids:
+        for fd in Path(f"/proc/{pid}/fd").glob("*"):
+            with contextlib.suppress(OSError):
+                link = os.readlink(fd)
+                if link.startswith("socket:["):
+                    inodes.add(link[8:-1])
+    ports = set()
+    for table in ("/proc/net/tcp", "/proc/net/tcp6"):
+        with contextlib.suppress(OSError):
+            for line in Path(table).read_text().splitlines()[1:]:
+                f = line.split()
+                if f[3] == "0A" and f[9] in inodes:  # 0A: LISTEN
+                    ports.add(int(f[1].rsplit(":", 1)[1], 16))
+    return ports
+
+
+def _speaks_http(port: int) -> bool:
+    with socket.create_connection(("127.0.0.1", port), timeout=5) as s:
+        s.settimeout(3)
+        s.sendall(b"GET / HTTP/1.0\r\nHost: localhost\r\n\r\n")
+        try:
+            return s.recv(5) == b"HTTP/"
+        except (TimeoutError, OSError):  # a Dask comm waits for its handshake, or hangs up
+            return False
+
+
+def test_a_local_study_runs_no_http_server(tmp_path):
+    """Dask starts unauthenticated HTTP servers (scheduler: port 8787, workers: random ports)
+    even without a dashboard. While the study runs, every port its processes listen on is asked
+    for a web page: none may answer (only Dask's own protocol listens)."""
+    seen: dict[int, bool] = {}
+
+    def probe(done: int, total: int, row: dict) -> None:
+        if row and not seen:
+            for port in _listening_ports(_process_tree(os.getpid())):
+                seen[port] = _speaks_http(port)
+
+    outcome = run_study(write_study(tmp_path, "[0.0]", "[1.25, 1.26]"), tmp_path / "o", workers=1,
+                        progress=probe)  # fmt: skip
+    assert not outcome.failed
+    # the scheduler, the nanny and the worker each listen for Dask's protocol: the probe works
+    assert len(seen) >= 3, seen
+    assert 8787 not in seen
+    assert not any(seen.values()), f"HTTP servers on ports {[p for p, h in seen.items() if h]}"

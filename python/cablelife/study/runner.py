@@ -8,6 +8,7 @@ from __future__ import annotations
 import os
 import uuid
 from collections.abc import Callable
+from contextlib import suppress
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -155,11 +156,28 @@ def _run_pending(client, cluster, pending, out, study, rows, total, progress) ->
             _quiet_shutdown()
         for fut in futures:
             fut.cancel()
+        if cluster is not None:
+            _stop_local_workers(cluster)
         raise
     finally:
         client.close()
         if cluster is not None:
             cluster.close()
+
+
+def _stop_local_workers(cluster) -> None:
+    """Ends the local workers at once: a graceful close would let each finish its running
+    variant first (minutes, and a study that goes on after Ctrl-C). Their nannies are told not
+    to restart them. The variants they ran are computed on the next run."""
+    import signal
+
+    for nanny in list(cluster.workers.values()):
+        with suppress(Exception):
+            nanny.close_gracefully(reason="cablelife study interrupted")
+        pid = getattr(nanny, "pid", None)
+        if pid:
+            with suppress(OSError):
+                os.kill(pid, signal.SIGKILL)
 
 
 def _quiet_shutdown() -> None:
