@@ -5,6 +5,7 @@ from __future__ import annotations
 import contextlib
 import json
 import os
+import shutil
 import signal
 import socket
 import subprocess
@@ -464,3 +465,66 @@ def test_a_local_study_runs_no_http_server(tmp_path):
     assert len(seen) >= 3, seen
     assert 8787 not in seen
     assert not any(seen.values()), f"HTTP servers on ports {[p for p, h in seen.items() if h]}"
+
+
+def _certificates(folder: Path) -> dict[str, Path]:
+    """A CA and one certificate it signed (for scheduler, worker and client), by openssl."""
+    if shutil.which("openssl") is None:
+        pytest.skip("openssl is not installed (it makes the test certificates)")
+    ca, ca_key = folder / "ca.pem", folder / "ca-key.pem"
+    cert, key, csr = folder / "cert.pem", folder / "key.pem", folder / "cert.csr"
+    ext = folder / "ext.cnf"
+    ext.write_text("subjectAltName=DNS:localhost,IP:127.0.0.1\n")
+    run = lambda *a: subprocess.run(["openssl", *a], check=True, capture_output=True)  # noqa: E731
+    run("req", "-x509", "-newkey", "rsa:2048", "-nodes", "-keyout", ca_key, "-out", ca,
+        "-days", "2", "-subj", "/CN=cablelife test CA")  # fmt: skip
+    run("req", "-newkey", "rsa:2048", "-nodes", "-keyout", key, "-out", csr,
+        "-subj", "/CN=localhost")  # fmt: skip
+    run("x509", "-req", "-in", csr, "-CA", ca, "-CAkey", ca_key, "-CAcreateserial",
+        "-out", cert, "-days", "2", "-extfile", ext)  # fmt: skip
+    return {"ca": ca, "cert": cert, "key": key}
+
+
+def test_study_on_a_tls_scheduler_with_client_certificates(tmp_path):
+    pem = _certificates(tmp_path)
+    tls = ["--tls-ca-file", str(pem["ca"]), "--tls-cert", str(pem["cert"]),
+           "--tls-key", str(pem["key"])]  # fmt: skip
+    file = tmp_path / "scheduler.json"
+    common = {"cwd": tmp_path, "start_new_session": True, "stdout": subprocess.DEVNULL,
+              "stderr": subprocess.DEVNULL}  # fmt: skip
+    procs = [
+        subprocess.Popen(
+            [sys.executable, "-m", "distributed.cli.dask_scheduler", "--protocol", "tls",
+             "--host", "127.0.0.1", "--port", "0", "--no-dashboard", "--scheduler-file",
+             str(file), *tls],
+            **common,
+        )
+    ]  # fmt: skip
+    try:
+        _wait_for(file.exists, 60, "the scheduler file", procs)
+        address = json.loads(file.read_text())["address"]
+        assert address.startswith("tls://")
+        procs.append(
+            subprocess.Popen(
+                [sys.executable, "-m", "distributed.cli.dask_worker", address, "--nthreads",
+                 "1", "--no-dashboard", "--local-directory", str(tmp_path / "w"), *tls],
+                **common,
+            )
+        )  # fmt: skip
+        study = str(write_study(tmp_path, "[0.0]", "[1.25]"))
+        # without the certificates: a clear error, no traceback
+        plain = _cli("study", study, "-o", str(tmp_path / "x"), "--scheduler", address)
+        text, _ = plain.communicate(timeout=120)
+        assert plain.returncode == 2 and "--tls-cert" in text and "Traceback" not in text, text
+        bad = _cli("study", study, "--tls-cert", str(pem["cert"]))  # TLS options, no tls://
+        text, _ = bad.communicate(timeout=120)
+        assert bad.returncode == 2 and "need a tls:// scheduler" in text, text
+        good = _cli("study", study, "-o", str(tmp_path / "out"), "--scheduler", address, *tls)
+        text, _ = good.communicate(timeout=600)
+        assert good.returncode == 0, text
+        assert "1 computed, 0 already finished, 0 failed" in text
+    finally:
+        for p in procs:
+            if p.poll() is None:
+                os.killpg(p.pid, signal.SIGKILL)
+                p.wait(30)

@@ -51,9 +51,12 @@ def _client(scheduler: str | None, workers: int | None, security=None):
     if scheduler is not None:
         try:
             return Client(scheduler, timeout="20s", security=security), None
-        except OSError as err:
+        except (OSError, TypeError, ValueError) as err:  # TypeError: tls:// without TLS set-up
+            hint = ""
+            if scheduler.startswith("tls://") and security is None:
+                hint = "; a tls:// scheduler needs --tls-ca-file, --tls-cert and --tls-key"
             raise ConnectionError(
-                f"--scheduler {scheduler!r}: no Dask scheduler answers there ({err})"
+                f"--scheduler {scheduler!r}: no Dask scheduler answers there ({err}){hint}"
             ) from None
     n = workers or os.cpu_count() or 1
     # No HTTP server anywhere (Dask starts unauthenticated ones even without a dashboard: the
