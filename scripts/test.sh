@@ -6,7 +6,9 @@
 # The environment `.venv-test` (git-ignored) is removed and created anew on every run and gets
 # `.[test]` only, so a dependency that is not declared in pyproject.toml fails here instead of
 # passing by accident. Cargo and maturin share one target folder (CARGO_TARGET_DIR), so the
-# release build of the extension and `cargo test --release` reuse each other's crates.
+# release build of the extension and `cargo test --release` share the compiled crates (rod,
+# fatigue, volume, nalgebra, rayon, ...); only pyo3 and the binding crate differ between the two
+# (the extension module does not link libpython, the test binaries do).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$PWD
@@ -26,7 +28,6 @@ venv=$root/.venv-test
 rm -rf "$venv"
 python3 -m venv "$venv"
 py=$venv/bin/python
-"$py" -m pip install --disable-pip-version-check -q --upgrade pip
 "$py" -m pip install --disable-pip-version-check -q -e '.[test]'
 
 # Headless Chromium renders the HTML report in its test (Debian's package). It is installed

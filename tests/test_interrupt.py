@@ -249,3 +249,46 @@ def test_demo_stops_on_ctrl_c_and_keeps_the_partial_runs(cli, tmp_path):
     for r in results:
         assert r.complete is False and r.message == "interrupted"
         assert 0 < r.cable.n_steps < 40001
+
+
+MAIN_THREAD_RUN = """
+import sys
+import numpy as np
+from cablelife.scene import load_scene
+from cablelife.simulate import build_cable, clip_poses, output_times
+
+scene = load_scene(sys.argv[1])
+cable = scene.cables[0]
+times = output_times(scene, "quasistatic")
+pos, quat = clip_poses(scene, cable, times)
+core = build_cable(scene, cable)
+out = {}
+
+def progress(done, total):
+    print(f"step {done}", file=sys.stderr, flush=True)
+
+try:
+    out = core.run_sequence(pos, quat, progress, 1)
+    print("finished:", out["error"], flush=True)
+except KeyboardInterrupt:
+    print("KeyboardInterrupt", flush=True)
+"""
+
+
+def test_a_solver_call_on_the_main_thread_raises_keyboard_interrupt(tmp_path):
+    """Called on the main thread, the solver sees Ctrl-C itself (Python's signal check), stops
+    after its step, and the caller gets its KeyboardInterrupt when the call returns — not an
+    error string that reads like a solver failure (as `cablelife modes` would report it)."""
+    scene = long_scene(tmp_path, 2.0, 0.004)
+    proc = subprocess.Popen(
+        [sys.executable, "-c", MAIN_THREAD_RUN, str(scene)],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True,
+    )  # fmt: skip
+    try:
+        assert proc.stderr.readline().startswith("step "), "no progress"
+        os.killpg(proc.pid, signal.SIGINT)
+        out, err = proc.communicate(timeout=STOP_BOUND)
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+    assert out.strip() == "KeyboardInterrupt", out + err

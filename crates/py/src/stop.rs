@@ -9,6 +9,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
+use pyo3::exceptions::PyKeyboardInterrupt;
 use pyo3::prelude::*;
 
 /// Why a run stopped when its stop flag was set or Ctrl-C arrived.
@@ -96,7 +97,14 @@ impl Poller {
         let total = self.total;
         let progress = &self.progress;
         Python::attach(|py| {
-            if py.check_signals().is_err() {
+            if let Err(e) = py.check_signals() {
+                if e.is_instance_of::<PyKeyboardInterrupt>(py) {
+                    // Ctrl-C on the main thread (a direct call, as in `cablelife modes`): the run
+                    // stops with what it computed, and the caller still gets its
+                    // KeyboardInterrupt when the call returns (the signal is raised again).
+                    // SAFETY: the GIL is held; the call only sets Python's signal flag.
+                    unsafe { pyo3::ffi::PyErr_SetInterrupt() };
+                }
                 return Some(INTERRUPTED.to_string());
             }
             if let Some(cb) = progress {
