@@ -17,6 +17,9 @@ class SceneFileError(ValueError):
     """A file named in a scene that may not or cannot be read."""
 
 
+ALLOW_OUTSIDE_HELP = (
+    "read files named in the scene (measured signals, motion_file) also outside the scene's folder"
+)
 ALLOW_HINT = (
     "files outside the scene's folder are read only when allowed: set [files] allow_outside = "
     "true in the scene or pass --allow-outside-files"
@@ -39,8 +42,7 @@ def resolve_scene_file(
         full = (p if p.is_absolute() else base / p).resolve()
         if not allow_outside and not full.is_relative_to(base):
             raise SceneFileError(
-                f"{item} = {str(path)!r} is outside the scene's folder {str(base)!r}; "
-                f"{ALLOW_HINT}"
+                f"{item} = {str(path)!r} is outside the scene's folder {str(base)!r}; {ALLOW_HINT}"
             )
         p = full
     if p.is_dir():

@@ -12,10 +12,10 @@ from typing import Annotated, Literal
 
 import numpy as np
 from pydantic import (
+    AfterValidator,
     BaseModel,
     ConfigDict,
     Field,
-    AfterValidator,
     Strict,
     ValidationError,
     field_validator,
@@ -23,7 +23,7 @@ from pydantic import (
 )
 
 from cablelife import _core
-from cablelife.limits import LIMITS, MAX_SEGMENTS, check_name
+from cablelife.limits import LIMITS, MAX_SEGMENTS, MIN_SEGMENTS, check_name
 from cablelife.paths import SceneFileError, resolve_scene_file, shown_names
 from cablelife.sections import SectionProperties, from_material, from_measured
 from cablelife.signals.spec import ChannelMotion, TableSignal
@@ -214,7 +214,7 @@ class Cable(_Model):
 
     name: Name
     length: Length  # m
-    segments: Annotated[int, Strict(), Field(ge=1, le=MAX_SEGMENTS)] | None = None
+    segments: Annotated[int, Strict()] | None = None
     max_segment_length: PositiveFloat | None = None  # m
     natural_curvature: Vec3 = (0.0, 0.0, 0.0)  # κ₁, κ₂, twist in 1/m
     section: Annotated[CircleSection | TubeSection, Field(discriminator="shape")] | None = None
@@ -223,6 +223,17 @@ class Cable(_Model):
     clips: Annotated[list[Clip], Field(min_length=1)]
     loads: list[Load] = []
     damping: Damping = Damping()
+
+    @field_validator("segments")
+    @classmethod
+    def _segments(cls, v):
+        if v is not None and not MIN_SEGMENTS <= v <= MAX_SEGMENTS:
+            raise ValueError(
+                f"segments = {v}: allowed: {MIN_SEGMENTS} to {MAX_SEGMENTS}; fewer cannot "
+                "represent a cable bent between clips (one segment is a straight bar), more is "
+                "finer than any cable needs while results grow with the segments"
+            )
+        return v
 
     @model_validator(mode="after")
     def _consistent(self):
@@ -259,7 +270,7 @@ class Cable(_Model):
         if self.segments is not None:
             return self.segments
         if self.max_segment_length is not None:
-            return max(1, math.ceil(self.length / self.max_segment_length))
+            return max(MIN_SEGMENTS, math.ceil(self.length / self.max_segment_length))
         return 50
 
     def properties(self) -> SectionProperties:
@@ -371,7 +382,9 @@ class Simulation(_Model):
     spectral_radius: Annotated[float, Strict(), Field(ge=0.0, le=1.0)] = 0.9  # ρ∞ of generalized-α
     # Dynamic Newton iteration: converged when the correction is below this fraction of the
     # step's increment (docs/dynamics.md: the error it leaves vs the time-step error).
-    newton_tolerance: Annotated[float, Strict(), Field(gt=0.0, lt=1.0)] = _core.DEFAULT_NEWTON_TOLERANCE
+    newton_tolerance: Annotated[float, Strict(), Field(gt=0.0, lt=1.0)] = (
+        _core.DEFAULT_NEWTON_TOLERANCE
+    )
 
 
 class Scene(_Model):

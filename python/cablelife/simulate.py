@@ -57,9 +57,7 @@ def _grid_steps(duration: float, time_step: float) -> int:
 def _needs_run_grid(scene: Scene) -> bool:
     """Whether a body's motion depends on the run's whole time grid even at t = 0: PSD
     realisations are drawn on it, measured signals are filtered at its Nyquist frequency."""
-    return any(
-        m.signal.type in ("psd", "measured") for b in scene.bodies for m in b.motion
-    )
+    return any(m.signal.type in ("psd", "measured") for b in scene.bodies for m in b.motion)
 
 
 def check_run_size(scene: Scene, mode: str) -> None:
@@ -296,6 +294,8 @@ def _run_cable(scene: Scene, cable: Cable, times: np.ndarray, mode: str, progres
             pos, quat = clip_poses(scene, cable, times)
             out = core.run_sequence(pos, quat, callback, max(1, times.size // 100))
             saved = times
+    except SceneError:
+        raise  # already names the cable
     except ValueError as err:
         raise SceneError(f"cable '{cable.name}': {err}") from None
     wall = _time.perf_counter() - start

@@ -14,11 +14,15 @@ def is_result_file(path: Path) -> bool:
 
     from cablelife.results import FORMAT
 
+    if path.is_dir():
+        raise ValueError(f"{str(path)!r} is a directory; give result and damage files")
     try:
         with h5py.File(path, "r") as f:
             return f.attrs.get("format") == FORMAT
-    except OSError as e:
-        raise ValueError(f"{str(path)!r} is not a readable HDF5 file: {e}") from None
+    except OSError:
+        raise ValueError(
+            f"{str(path)!r} is not a readable HDF5 file (truncated, empty or of another kind)"
+        ) from None
 
 
 def _made_from(source: str, damage: Path, result: Path) -> bool:
@@ -100,20 +104,21 @@ def report_command(
     ] = 10.0,
 ) -> None:
     """Write a self-contained HTML report (works offline) of one or several runs."""
-    from rich.console import Console
-
+    from cablelife.clitext import console as make_console
+    from cablelife.clitext import escape, print_error, printed_warnings
     from cablelife.report.html import write_report
     from cablelife.volume.cli import parse_length
 
-    err = Console(stderr=True)
+    err = make_console(stderr=True)
     try:
         h = None if voxel.strip().lower() == "none" else parse_length(voxel)
-        runs = report_runs(files)
+        with printed_warnings(err):  # partial results
+            runs = report_runs(files)
         path = write_report(
             output, runs, color_by=color_by, frames=frames, voxel=h, bend_factor=bend_factor
         )
-    except (ValueError, FileNotFoundError) as e:
-        err.print(f"[bold red]error:[/] {e}", highlight=False, soft_wrap=True)
+    except (ValueError, FileNotFoundError, OSError) as e:
+        print_error(err, e)
         raise typer.Exit(2) from None
     size = path.stat().st_size / 1e6
-    Console().print(f"report written to {path} ({size:.1f} MB)")
+    make_console().print(escape(f"report written to {path} ({size:.1f} MB)"))

@@ -80,13 +80,14 @@ def run_study(
     scheduler: str | None = None,
     workers: int | None = None,
     progress: Callable[[int, int, dict], None] | None = None,
+    allow_outside_files: bool = False,
 ) -> StudyOutcome:
     """Runs every unfinished variant of the study and writes the summary table and plot.
 
     ``progress(done, total, row)`` is called after each variant (finished ones count at once).
     """
     study, study_dir = load_study(study_path)
-    variants = expand(study, study_dir)
+    variants = expand(study, study_dir, allow_outside_files)
     out = Path(out_dir) if out_dir is not None else default_out_dir(study_path, study)
     out.mkdir(parents=True, exist_ok=True)
     shutil.copyfile(study_path, out / "study.toml")
