@@ -294,7 +294,10 @@ def test_markup_in_paths_is_printed_as_written(tmp_path):
     assert out.exists() and "[red]out.h5" in text.replace("\n", "")
     bad = scene()
     _set("cables.0.length", True)(bad)
-    cli(["run", write_scene(folder, bad, "[/b].toml"), "-q"], ("[/b].toml", "runs[bold]:x:"))
+    cli(["run", write_scene(folder, bad, "x.toml"), "-q"], ("runs[bold]:x:/x.toml",))
+    closing = tmp_path / "runs["  # with the file "x].toml": the path holds "[/x]"
+    closing.mkdir()
+    cli(["run", write_scene(closing, bad, "x].toml"), "-q"], ("runs[/x].toml",))
 
 
 def test_summary_headers_keep_their_units(tmp_path):

@@ -172,8 +172,12 @@ def schema(
     text = json.dumps(json_schema(), indent=2)
     if output is None:
         console.print_json(text)
-    else:
+        return
+    try:
         output.write_text(text + "\n")
+    except OSError as err:
+        what = "is a directory" if output.is_dir() else f"cannot be written ({err.strerror})"
+        raise fail(f"--output {str(output)!r} {what}") from None
 
 
 def _register_optional() -> None:

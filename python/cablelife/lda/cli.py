@@ -47,6 +47,8 @@ def lda_command(
 
     console = make_console()
     try:
+        if hot_spots < 0:
+            raise ValueError(f"--hot-spots = {hot_spots}: allowed: 0 or more")
         settings = LdaSettings.from_options(
             wohler_k=wohler_k,
             wohler_alpha=wohler_alpha,
@@ -98,6 +100,8 @@ def compare_command(
 
     console = make_console()
     try:
+        if hot_spots < 0:
+            raise ValueError(f"--hot-spots = {hot_spots}: allowed: 0 or more")
         names = None if labels is None else [s.strip() for s in labels.split(",")]
         with printed_warnings(console):  # partial results, sampling
             cmp = compare(files, names, check_settings=not force, n_hot_spots=hot_spots)

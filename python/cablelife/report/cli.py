@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Annotated
 
@@ -62,7 +63,7 @@ def attach_damage(results: list[Path], damages: list[tuple[Path, object]]) -> di
 def report_runs(files: list[Path]):
     """Result files become runs (labelled by file stem); each damage file (``cablelife lda``)
     is attached to the result it was made from, else to the results in order."""
-    from cablelife.lda.io import load_damage
+    from cablelife.lda.io import is_damage_file, load_damage
     from cablelife.report.html import ReportRun
     from cablelife.results import load_result
 
@@ -72,8 +73,13 @@ def report_runs(files: list[Path]):
             raise FileNotFoundError(f"file {str(p)!r} does not exist")
         if is_result_file(p):
             results.append(p)
-        else:
+        elif is_damage_file(p):
             damages.append((p, load_damage(p)))
+        else:
+            raise ValueError(
+                f"{str(p)!r} is not a cablelife result file nor a damage file (format "
+                "attribute); give RESULT.h5 files and their damage files (cablelife lda)"
+            )
     if not results:
         raise ValueError("files: give at least one result file (RESULT.h5)")
     attached = attach_damage(results, damages)
@@ -111,6 +117,8 @@ def report_command(
 
     err = make_console(stderr=True)
     try:
+        if not (math.isfinite(bend_factor) and bend_factor > 0):
+            raise ValueError(f"--bend-factor = {bend_factor}: allowed: a number > 0")
         h = None if voxel.strip().lower() == "none" else parse_length(voxel)
         with printed_warnings(err):  # partial results
             runs = report_runs(files)
