@@ -26,8 +26,9 @@ def good(tmp_path_factory):
     d["bodies"] = [
         {
             "name": "engine",
-            "motion": [{"channel": "z", "signal": {"type": "sine", "amplitude": 0.02,
-                                                   "frequency": 2.0}}],
+            "motion": [
+                {"channel": "z", "signal": {"type": "sine", "amplitude": 0.02, "frequency": 2.0}}
+            ],
         }
     ]
     d["cables"][0]["clips"][1]["body"] = "engine"
@@ -80,35 +81,67 @@ def _forged_steps(f):
 RESULT_DEFECTS = [
     ("no-format", lambda f: f.attrs.__delitem__("format"), ("not a cablelife result",)),
     ("no-cables", lambda f: f.__delitem__("cables"), ("group 'cables' is missing",)),
-    ("empty-cables", lambda f: [f["cables"].__delitem__(k) for k in list(f["cables"])],
-     ("group 'cables' is empty",)),
-    ("no-positions", lambda f: f.__delitem__(f"{CABLE}/positions"),
-     ("'hose'", "dataset 'positions' is missing")),
-    ("positions-shape", lambda f: _replace(f, f"{CABLE}/positions", data=np.zeros((5, 9, 2))),
-     ("dataset 'positions' has shape (5, 9, 2)", "expected (5, 9, 3)")),
-    ("forces-forged-2e9", lambda f: _replace(f, f"{CABLE}/forces", shape=(2_000_000_000, 50, 3),
-                                             dtype="f8", chunks=True),
-     ("dataset 'forces' has shape (2000000000, 50, 3)", "expected (5, 8, 3)")),
-    ("time-forged-2e9", lambda f: _replace(f, f"{CABLE}/time", shape=(2_000_000_000,),
-                                           dtype="f8", chunks=True),
-     ("dataset 'time' has 2000000000 steps", "at most 5")),
+    (
+        "empty-cables",
+        lambda f: [f["cables"].__delitem__(k) for k in list(f["cables"])],
+        ("group 'cables' is empty",),
+    ),
+    (
+        "no-positions",
+        lambda f: f.__delitem__(f"{CABLE}/positions"),
+        ("'hose'", "dataset 'positions' is missing"),
+    ),
+    (
+        "positions-shape",
+        lambda f: _replace(f, f"{CABLE}/positions", data=np.zeros((5, 9, 2))),
+        ("dataset 'positions' has shape (5, 9, 2)", "expected (5, 9, 3)"),
+    ),
+    (
+        "forces-forged-2e9",
+        lambda f: _replace(
+            f, f"{CABLE}/forces", shape=(2_000_000_000, 50, 3), dtype="f8", chunks=True
+        ),
+        ("dataset 'forces' has shape (2000000000, 50, 3)", "expected (5, 8, 3)"),
+    ),
+    (
+        "time-forged-2e9",
+        lambda f: _replace(f, f"{CABLE}/time", shape=(2_000_000_000,), dtype="f8", chunks=True),
+        ("dataset 'time' has 2000000000 steps", "at most 5"),
+    ),
     ("all-forged-2e9", _forged_steps, ("allowed: at most", "GiB")),
-    ("time-strings", lambda f: _replace(f, f"{CABLE}/time", data=np.array([b"a"] * 5)),
-     ("dataset 'time' holds", "expected numbers")),
-    ("arc-length-2d", lambda f: _replace(f, f"{CABLE}/arc_length", data=np.zeros((9, 2))),
-     ("dataset 'arc_length' has shape (9, 2)",)),
+    (
+        "time-strings",
+        lambda f: _replace(f, f"{CABLE}/time", data=np.array([b"a"] * 5)),
+        ("dataset 'time' holds", "expected numbers"),
+    ),
+    (
+        "arc-length-2d",
+        lambda f: _replace(f, f"{CABLE}/arc_length", data=np.zeros((9, 2))),
+        ("dataset 'arc_length' has shape (9, 2)",),
+    ),
     ("nan-forces", _nan("forces"), ("dataset 'forces'", "non-finite value nan")),
     ("inf-positions", _nan("positions", np.inf), ("dataset 'positions'", "non-finite value inf")),
-    ("nan-reaction", lambda f: _replace(f, f"{CABLE}/clips/a/reaction_force",
-                                        data=np.full((5, 3), np.nan)),
-     ("clips/a/reaction_force", "non-finite")),
-    ("no-reaction", lambda f: f.__delitem__(f"{CABLE}/clips/b/reaction_moment"),
-     ("clip 'b'", "dataset 'reaction_moment' is missing")),
+    (
+        "nan-reaction",
+        lambda f: _replace(f, f"{CABLE}/clips/a/reaction_force", data=np.full((5, 3), np.nan)),
+        ("clips/a/reaction_force", "non-finite"),
+    ),
+    (
+        "no-reaction",
+        lambda f: f.__delitem__(f"{CABLE}/clips/b/reaction_moment"),
+        ("clip 'b'", "dataset 'reaction_moment' is missing"),
+    ),
     ("bad-mode", lambda f: f.attrs.__setitem__("mode", "fast"), ("attribute 'mode' is 'fast'",)),
-    ("bad-scene-toml", lambda f: f.attrs.__setitem__("scene_toml", "[x"),
-     ("attribute 'scene_toml' is not a valid scene",)),
-    ("renamed-cable", lambda f: f.move(CABLE, "cables/other"),
-     ("cable 'other'", "not a cable of the stored scene")),
+    (
+        "bad-scene-toml",
+        lambda f: f.attrs.__setitem__("scene_toml", "[x"),
+        ("attribute 'scene_toml' is not a valid scene",),
+    ),
+    (
+        "renamed-cable",
+        lambda f: f.move(CABLE, "cables/other"),
+        ("cable 'other'", "not a cable of the stored scene"),
+    ),
 ]
 
 
@@ -149,8 +182,7 @@ READERS = {
     "volume": lambda bad, good, tmp: ["volume", bad, "-o", tmp / "v.stl"],
     "paraview": lambda bad, good, tmp: ["paraview", bad, "-o", tmp / "p.pvd"],
     "compare": lambda bad, good, tmp: ["compare", good, bad],
-    "report": lambda bad, good, tmp: ["report", good, bad, "-o", tmp / "r.html", "--voxel",
-                                      "none"],
+    "report": lambda bad, good, tmp: ["report", good, bad, "-o", tmp / "r.html", "--voxel", "none"],
 }
 OUTPUTS = {"lda": "d.h5", "volume": "v.stl", "paraview": "p.pvd", "report": "r.html"}
 
@@ -187,41 +219,73 @@ def test_result_is_a_directory(good, tmp_path, reader):
 
 @pytest.mark.parametrize("reader", list(READERS))
 def test_result_missing(good, tmp_path, reader):
-    cli(READERS[reader](tmp_path / "none.h5", good[0], tmp_path), ("none.h5", "does not exist"),
-        case=f"{reader}:missing")
+    cli(
+        READERS[reader](tmp_path / "none.h5", good[0], tmp_path),
+        ("none.h5", "does not exist"),
+        case=f"{reader}:missing",
+    )
 
 
 def test_forged_result_in_a_real_process(good, tmp_path):
     """The 2e9 × 50 × 3 dataset of a 5 MB file: refused before any allocation."""
     bad = make_bad_result(good[0], tmp_path, _forged_steps)
     assert bad.stat().st_size < 5_000_000
-    cli_subprocess(["lda", bad, "-o", tmp_path / "d.h5"], ("bad.h5", "allowed: at most"),
-                   case="lda:forged-subprocess")
+    cli_subprocess(
+        ["lda", bad, "-o", tmp_path / "d.h5"],
+        ("bad.h5", "allowed: at most"),
+        case="lda:forged-subprocess",
+    )
 
 
 DAMAGE_DEFECTS = [
     ("truncated", "truncated", ("not a readable HDF5 file",)),
-    ("no-damage-planes", lambda f: f.__delitem__(f"{CABLE}/damage_planes"),
-     ("dataset 'damage_planes' is missing",)),
-    ("damage-planes-shape", lambda f: _replace(f, f"{CABLE}/damage_planes", data=np.zeros((2, 2))),
-     ("dataset 'damage_planes' has shape (2, 2)",)),
-    ("nan-damage", lambda f: _replace(f, f"{CABLE}/damage_planes",
-                                      data=np.where(True, np.nan, f[f"{CABLE}/damage_planes"][()])),
-     ("damage_planes", "non-finite")),
-    ("negative-damage", lambda f: _replace(f, f"{CABLE}/damage_planes",
-                                           data=-np.ones(f[f"{CABLE}/damage_planes"].shape)),
-     ("negative damage",)),
-    ("forged-2e9", lambda f: _replace(f, f"{CABLE}/section_index", shape=(2_000_000_000,),
-                                      dtype="i8", chunks=True),
-     ("has shape",)),
+    (
+        "no-damage-planes",
+        lambda f: f.__delitem__(f"{CABLE}/damage_planes"),
+        ("dataset 'damage_planes' is missing",),
+    ),
+    (
+        "damage-planes-shape",
+        lambda f: _replace(f, f"{CABLE}/damage_planes", data=np.zeros((2, 2))),
+        ("dataset 'damage_planes' has shape (2, 2)",),
+    ),
+    (
+        "nan-damage",
+        lambda f: _replace(
+            f,
+            f"{CABLE}/damage_planes",
+            data=np.where(True, np.nan, f[f"{CABLE}/damage_planes"][()]),
+        ),
+        ("damage_planes", "non-finite"),
+    ),
+    (
+        "negative-damage",
+        lambda f: _replace(
+            f, f"{CABLE}/damage_planes", data=-np.ones(f[f"{CABLE}/damage_planes"].shape)
+        ),
+        ("negative damage",),
+    ),
+    (
+        "forged-2e9",
+        lambda f: _replace(
+            f, f"{CABLE}/section_index", shape=(2_000_000_000,), dtype="i8", chunks=True
+        ),
+        ("has shape",),
+    ),
     ("no-source", lambda f: f.attrs.__delitem__("source"), ("attributes ['source'] are missing",)),
 ]
 
 DAMAGE_READERS = {
-    "paraview": lambda bad, res, dmg, tmp: ["paraview", res, "--damage", bad, "-o",
-                                            tmp / "p.pvd"],
-    "report": lambda bad, res, dmg, tmp: ["report", res, bad, "-o", tmp / "r.html", "--voxel",
-                                          "none"],
+    "paraview": lambda bad, res, dmg, tmp: ["paraview", res, "--damage", bad, "-o", tmp / "p.pvd"],
+    "report": lambda bad, res, dmg, tmp: [
+        "report",
+        res,
+        bad,
+        "-o",
+        tmp / "r.html",
+        "--voxel",
+        "none",
+    ],
     "compare": lambda bad, res, dmg, tmp: ["compare", dmg, bad],
 }
 
@@ -243,8 +307,11 @@ def test_bad_damage_file(good, tmp_path, reader, name, defect, expect):
     else:
         data = damage.read_bytes()
         bad.write_bytes(data[: len(data) // 3])
-    cli(DAMAGE_READERS[reader](bad, result, damage, tmp_path), ("bad.damage.h5", *expect),
-        case=f"damage-{reader}:{name}")
+    cli(
+        DAMAGE_READERS[reader](bad, result, damage, tmp_path),
+        ("bad.damage.h5", *expect),
+        case=f"damage-{reader}:{name}",
+    )
 
 
 @pytest.fixture(scope="module")
@@ -269,8 +336,11 @@ def test_partial_result_is_said_in_compare(partial, good):
 
 def test_partial_result_is_said_in_report(partial, tmp_path):
     out = tmp_path / "r.html"
-    cli(["report", partial, "-o", out, "--voxel", "none", "--frames", "2"], ("partial result",),
-        code=0)
+    cli(
+        ["report", partial, "-o", out, "--voxel", "none", "--frames", "2"],
+        ("partial result",),
+        code=0,
+    )
     assert "incomplete run" in out.read_text()
 
 
@@ -337,7 +407,10 @@ def test_schema_output_errors(tmp_path):
 def test_good_result_gives_finite_outputs(good, tmp_path):
     """The other side of the NaN rule: outputs of good files are written and finite."""
     result, damage = good
-    cli(["paraview", result, "--damage", damage, "-o", tmp_path / "p.pvd"], code=0,
-        outputs=tuple(tmp_path.glob("*.vtp")))
+    cli(
+        ["paraview", result, "--damage", damage, "-o", tmp_path / "p.pvd"],
+        code=0,
+        outputs=tuple(tmp_path.glob("*.vtp")),
+    )
     cli(["volume", result, "-o", tmp_path / "v.stl"], code=0, outputs=(tmp_path / "v.stl",))
     assert write_scene  # the helper module is shared

@@ -53,7 +53,11 @@ SCENE_CASES = [
     ("modulus-bool", _set("cables.0.material.youngs_modulus", True), ("youngs_modulus", "True")),
     ("density-list", _set("cables.0.material.density", [1.0]), ("density", "valid number")),
     ("poisson-string", _set("cables.0.material.poisson_ratio", "0.3"), ("poisson_ratio", "'0.3'")),
-    ("position-2", _set("cables.0.clips.1.position", [0.8, 0.2]), (f"{CLIP}.position[2]", "missing")),
+    (
+        "position-2",
+        _set("cables.0.clips.1.position", [0.8, 0.2]),
+        (f"{CLIP}.position[2]", "missing"),
+    ),
     ("position-string", _set("cables.0.clips.1.position", "0,0,0"), (f"{CLIP}.position",)),
     ("position-bool", _set("cables.0.clips.1.position", [0.8, True, 0.0]), (f"{CLIP}.position",)),
     ("direction-zero", _set("cables.0.clips.1.direction", [0, 0, 0]), ("zero vector",)),
@@ -99,15 +103,25 @@ SCENE_CASES = [
         lambda d: (_cable(d).pop("segments"), _cable(d).update(max_segment_length=1e-9)),
         ("max_segment_length", "20000 segments"),
     ),
-    ("tube-radii", _set("cables.0.section", {"shape": "tube", "outer_radius": 0.004,
-                                              "inner_radius": 0.005}), ("inner_radius",)),
+    (
+        "tube-radii",
+        _set("cables.0.section", {"shape": "tube", "outer_radius": 0.004, "inner_radius": 0.005}),
+        ("inner_radius",),
+    ),
     (
         "measured-EA-tiny",
         lambda d: (
             _cable(d).pop("section"),
             _cable(d).pop("material"),
-            _cable(d).update(stiffness={"EA": 1e-300, "EI": 0.1, "GJ": 0.1,
-                                        "mass_per_length": 0.1, "radius": 0.005}),
+            _cable(d).update(
+                stiffness={
+                    "EA": 1e-300,
+                    "EI": 0.1,
+                    "GJ": 0.1,
+                    "mass_per_length": 0.1,
+                    "radius": 0.005,
+                }
+            ),
         ),
         ("stiffness.EA", "1e-300"),
     ),
@@ -228,7 +242,7 @@ def test_bad_scene(tmp_path, case, mutate, expect):
 
 
 RAW_CASES = [
-    ("invalid-utf8", b"[simulation]\nmode = \"st\xff\xfeatic\"\n", ("not UTF-8 text",)),
+    ("invalid-utf8", b'[simulation]\nmode = "st\xff\xfeatic"\n', ("not UTF-8 text",)),
     ("binary", bytes(range(256)) * 4, ("binary file",)),
     ("nested-arrays", ("a = " + "[" * 5000 + "]" * 5000 + "\n").encode(), ("nested",)),
     ("nested-tables", ("a = " + "{b = " * 200 + "1" + "}" * 200 + "\n").encode(), ("nested",)),

@@ -23,8 +23,9 @@ LIMITS: dict[str, tuple[float, float]] = {
 
 # Segments of one cable. Fewer than MIN_SEGMENTS cannot represent a cable bent between two
 # clips (one segment is a straight bar; the hose of the tests is 16 % off in its bending
-# moment at 4 segments, 1.5 % at 10, docs/scene.md). Beyond this the rod is finer than the cable's diameter could ever
-# need, and results (13 numbers per segment and saved step) outgrow memory.
+# moment at 4 segments, 1.5 % at 10, docs/scene.md). Beyond MAX_SEGMENTS the rod is finer
+# than any cable's diameter could need, and results (13 numbers per segment and saved step)
+# outgrow memory.
 MIN_SEGMENTS = 4
 MAX_SEGMENTS = 20_000
 

@@ -356,7 +356,8 @@ def read_pose_table(path: Path, what: str) -> dict[str, np.ndarray]:
         if not np.all(np.isfinite(v)):
             row = int(np.flatnonzero(~np.isfinite(v))[0]) + 2
             raise SceneError(
-                f"{what}: column {c!r} has a missing or non-numeric value in line {row}"
+                f"{what} = {str(path)!r}: column {c!r} has a missing or non-numeric value in "
+                f"line {row}"
             )
     if table["t"].size < 2 or np.any(np.diff(table["t"]) <= 0):
         raise SceneError(f"{what}: the times in column 't' must increase strictly (≥ 2 rows)")

@@ -57,6 +57,8 @@ def study_command(
         TextColumn("{task.description}"),
     )
     try:
+        if workers is not None and workers < 1:
+            raise StudyError(f"--workers = {workers}: allowed: 1 or more")
         with Progress(*columns, console=console, transient=True) as bar:
             task = bar.add_task("", total=None)
 
