@@ -7,7 +7,7 @@ import copy
 
 import pytest
 import tomli_w
-from badinput import CASES_RUN, cli, scene, write_scene
+from badinput import cli, scene, write_scene
 
 SECRET = "root:x:0:0:secret-line-that-must-not-be-echoed"
 
@@ -456,10 +456,3 @@ def test_help_texts_keep_brackets():
     ):
         text = cli([command, "--help"], code=0, case=f"help:{command}")
         assert needle.replace(" ", "") in "".join(text.split()), (command, needle)
-
-
-def test_zz_count(capsys):
-    """Records how many bad-input cases ran in this session (all test_bad_input_* files)."""
-    with capsys.disabled():
-        print(f"\nbad-input cases run: {len(CASES_RUN)}")
-    assert CASES_RUN
