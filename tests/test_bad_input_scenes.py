@@ -95,6 +95,17 @@ SCENE_CASES = [
     ("length-nan", _set("cables.0.length", float("nan")), (f"{C}.length", "nan")),
     ("position-huge", _set("cables.0.clips.1.position", [1e300, 0, 0]), ("position", "1e+300")),
     ("gravity-nan", _set("simulation.gravity", [0, 0, float("nan")]), ("simulation.gravity",)),
+    ("gravity-huge", _set("simulation.gravity", [0, 0, -1e300]), ("simulation.gravity[2]",)),
+    (
+        "curvature-huge",
+        _set("cables.0.natural_curvature", [1e300, 0, 0]),
+        ("natural_curvature[0]", "1e+300"),
+    ),
+    (
+        "load-huge",
+        _set("cables.0.loads", [{"s": 0.5, "force": [0, 0, 1e300]}]),
+        ("loads[0].force[2]", "1e+300"),
+    ),
     ("segments-0", _set("cables.0.segments", 0), (f"{C}.segments", "0")),
     ("segments-negative", _set("cables.0.segments", -3), (f"{C}.segments", "-3")),
     ("segments-huge", _set("cables.0.segments", 10_000_000), (f"{C}.segments", "10000000")),

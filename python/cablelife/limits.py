@@ -19,6 +19,10 @@ LIMITS: dict[str, tuple[float, float]] = {
     "bending_stiffness": (1e-15, 1e13),  # N m², EI and GJ
     "mass_per_length": (1e-9, 1e5),  # kg/m
     "rotary_inertia": (1e-20, 1e5),  # kg m
+    "curvature": (-1e4, 1e4),  # 1/m, natural curvature (bend radius ≥ 0.1 mm)
+    "acceleration": (-1e4, 1e4),  # m/s², gravity (1000 g)
+    "force": (-1e9, 1e9),  # N, dead loads
+    "moment": (-1e9, 1e9),  # N m, dead loads
 }
 
 # Segments of one cable. Fewer than MIN_SEGMENTS cannot represent a cable bent between two

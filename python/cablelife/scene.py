@@ -52,6 +52,10 @@ Modulus = _bounded("modulus")  # Pa, E and G
 Density = _bounded("density")  # kg/m³
 AxialStiffness = _bounded("axial_stiffness")  # N
 BendingStiffness = _bounded("bending_stiffness")  # N m²
+Curvature = _bounded("curvature")  # 1/m
+Acceleration = _bounded("acceleration")  # m/s²
+Force = _bounded("force")  # N
+Moment = _bounded("moment")  # N m
 # Cable, clip and body names: HDF5 group names and table entries (limits.check_name).
 Name = Annotated[str, Strict(), Field(min_length=1), AfterValidator(check_name)]
 
@@ -183,8 +187,8 @@ class Load(_Model):
     """A dead load (global frame) at arc length ``s``."""
 
     s: NonNegativeFloat
-    force: Vec3 = (0.0, 0.0, 0.0)  # N
-    moment: Vec3 = (0.0, 0.0, 0.0)  # N m
+    force: tuple[Force, Force, Force] = (0.0, 0.0, 0.0)  # N
+    moment: tuple[Moment, Moment, Moment] = (0.0, 0.0, 0.0)  # N m
 
 
 class Damping(_Model):
@@ -216,7 +220,7 @@ class Cable(_Model):
     length: Length  # m
     segments: Annotated[int, Strict()] | None = None
     max_segment_length: PositiveFloat | None = None  # m
-    natural_curvature: Vec3 = (0.0, 0.0, 0.0)  # κ₁, κ₂, twist in 1/m
+    natural_curvature: tuple[Curvature, Curvature, Curvature] = (0.0, 0.0, 0.0)  # κ₁, κ₂, τ 1/m
     section: Annotated[CircleSection | TubeSection, Field(discriminator="shape")] | None = None
     material: Material | None = None
     stiffness: MeasuredStiffness | None = None
@@ -375,7 +379,7 @@ class Simulation(_Model):
     """Run settings."""
 
     mode: Literal["static", "quasistatic", "dynamic"] = "static"
-    gravity: Vec3 = (0.0, 0.0, -9.81)  # m/s²
+    gravity: tuple[Acceleration, Acceleration, Acceleration] = (0.0, 0.0, -9.81)  # m/s²
     duration: PositiveFloat | None = None  # s
     time_step: PositiveFloat = 1e-3  # s
     output_step: PositiveFloat | None = None  # s (default: every step)
