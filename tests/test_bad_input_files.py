@@ -414,3 +414,27 @@ def test_good_result_gives_finite_outputs(good, tmp_path):
     )
     cli(["volume", result, "-o", tmp_path / "v.stl"], code=0, outputs=(tmp_path / "v.stl",))
     assert write_scene  # the helper module is shared
+
+
+@pytest.mark.parametrize("command", ["run", "lda", "volume", "paraview", "report", "signal"])
+@pytest.mark.parametrize("where", ["missing-folder", "directory"])
+def test_output_that_cannot_be_written(good, tmp_path, command, where):
+    result, _ = good
+    out = tmp_path / "no-such" / "out.x" if where == "missing-folder" else tmp_path
+    spec = tmp_path / "spec.toml"
+    spec.write_text(
+        '[signal]\nduration = 1.0\ntime_step = 0.01\n[[channels]]\nname = "z"\n'
+        'channel = "z"\nsignal = { type = "sine", amplitude = 0.01, frequency = 1.0 }\n'
+    )
+    args = {
+        "run": ["run", write_scene(tmp_path, scene()), "-q", "-o", out],
+        "lda": ["lda", result, "-o", out],
+        "volume": ["volume", result, "-o", out],
+        "paraview": ["paraview", result, "-o", out],
+        "report": ["report", result, "-o", out, "--voxel", "none", "--frames", "2"],
+        "signal": ["signal", spec, "-o", out, "--no-plot"],
+    }[command]
+    if where == "missing-folder" and command in ("lda", "paraview", "report"):
+        cli(args, code=0, case=f"{command}:output-{where}")  # these create the folder
+    else:
+        cli(args, (str(out),), case=f"{command}:output-{where}")

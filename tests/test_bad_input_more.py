@@ -239,6 +239,11 @@ SIGNAL_CASES = [
         ("time_step", "samples", "allowed"),
     ),
     (
+        "steps-inf",
+        {**_spec(), "signal": {"duration": 1e300, "time_step": 1e-300}},
+        ("time_step", "inf samples"),
+    ),
+    (
         "time-step-string",
         {**_spec(), "signal": {"duration": 1.0, "time_step": "1ms"}},
         ("time_step", "'1ms'"),

@@ -224,6 +224,11 @@ SCENE_CASES = [
         ("memory", "time_step"),
     ),
     (
+        "duration-1e300-time-step-1e-300",
+        lambda d: d["simulation"].update(mode="dynamic", duration=1e300, time_step=1e-300),
+        ("simulation.time_step = 1e-300", "inf time steps", "memory"),
+    ),
+    (
         "time-step-longer-than-duration",
         lambda d: d["simulation"].update(mode="quasistatic", duration=0.1, time_step=1.0),
         ("time_step", "duration"),

@@ -105,6 +105,9 @@ def run(
         raise fail(str(err)) from None
     if allow_outside_files:
         sc.files.allow_outside = True
+    if output is not None and (output.is_dir() or not output.parent.is_dir()):
+        why = "is a directory" if output.is_dir() else "is in a folder that does not exist"
+        raise fail(f"--output {str(output)!r} {why}; give a file in an existing folder")
     progress = Progress(
         TextColumn("{task.description}"),
         BarColumn(),
@@ -133,7 +136,11 @@ def run(
             )
         raise fail(str(err), code=1) from None
     if output is not None:  # saved first: a summary that cannot be printed loses nothing
-        result.save(output)
+        try:
+            result.save(output)
+        except OSError as err:
+            print_summary(result)
+            raise fail(f"--output {str(output)!r} cannot be written ({err})") from None
     print_summary(result)
     if output is not None:
         console.print(escape(f"result saved to {output}"))

@@ -50,8 +50,9 @@ def euler_matrix(angles) -> np.ndarray:
     return Rotation.from_euler("xyz", angles).as_matrix()
 
 
-def _grid_steps(duration: float, time_step: float) -> int:
-    return int(np.floor(duration / time_step + 1e-9)) + 1
+def _grid_steps(duration: float, time_step: float) -> float:
+    """Points of the grid 0, time_step, …, duration (a float: may be inf for absurd input)."""
+    return float(np.floor(duration / time_step + 1e-9)) + 1.0
 
 
 def _needs_run_grid(scene: Scene) -> bool:

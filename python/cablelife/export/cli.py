@@ -31,6 +31,8 @@ def paraview_command(
     try:
         if every < 1:
             raise ValueError(f"every = {every}: must be >= 1")
+        if output.is_dir():
+            raise ValueError(f"--output {str(output)!r} is a directory; give a .pvd file")
         with printed_warnings(err):
             res = load_result(result)
         names = [cable] if cable is not None else list(res.cables)

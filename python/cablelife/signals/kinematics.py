@@ -63,14 +63,14 @@ def time_grid(duration: float, time_step: float, start: float = 0.0) -> np.ndarr
             f"time_step: {time_step:g} s is longer than the duration {duration:g} s; "
             "allowed: time_step <= duration"
         )
-    steps = int(np.floor(duration / time_step + 1e-9))
+    steps = float(np.floor(duration / time_step + 1e-9))  # float: inf for absurd input
     if steps + 1 > MAX_SAMPLES:
         raise SignalError(
             f"time_step: {time_step:g} s over {duration:g} s is {steps + 1:.4g} samples; "
             f"allowed: at most {MAX_SAMPLES:.0e} per channel (memory); use a larger time_step "
             "or a shorter duration"
         )
-    return start + time_step * np.arange(steps + 1)
+    return start + time_step * np.arange(int(steps) + 1)
 
 
 def time_step_of(time: np.ndarray) -> float:
