@@ -461,3 +461,15 @@ def test_help_texts_keep_brackets():
     ):
         text = cli([command, "--help"], code=0, case=f"help:{command}")
         assert needle.replace(" ", "") in "".join(text.split()), (command, needle)
+
+
+@pytest.mark.parametrize("fmt", ["mdf4", "tdms"])
+def test_foreign_measurement_file_is_not_quoted(tmp_path, fmt):
+    (tmp_path / "rec.dat").write_text(SECRET + "\n")
+    d = _moving_scene({**_measured("rec.dat"), "format": fmt})
+    text = cli(
+        ["run", write_scene(tmp_path, d), "-q"],
+        ("rec.dat", "cannot read as"),
+        case=f"files:foreign-{fmt}",
+    )
+    assert "secret-line" not in text and "root:x" not in text

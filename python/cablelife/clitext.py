@@ -11,22 +11,12 @@ from contextlib import contextmanager
 from rich.console import Console
 from rich.markup import escape
 
-__all__ = ["console", "err_console", "escape", "print_error", "printed_warnings", "say"]
+__all__ = ["console", "escape", "print_error", "print_warning", "printed_warnings"]
 
 
 def console(stderr: bool = False) -> Console:
     """A console that prints text as given: no emoji codes, no automatic highlighting."""
     return Console(stderr=stderr, emoji=False, highlight=False)
-
-
-def err_console() -> Console:
-    return console(stderr=True)
-
-
-def say(out: Console, text: str, style: str | None = None) -> None:
-    """Prints plain ``text`` (escaped), optionally in ``style``."""
-    body = escape(str(text))
-    out.print(f"[{style}]{body}[/]" if style else body, soft_wrap=True, highlight=False)
 
 
 def print_error(out: Console, message) -> None:

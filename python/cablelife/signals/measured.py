@@ -125,7 +125,11 @@ def read_mdf4(path: Path, channel: str, group: str | int | None = None) -> Recor
     try:
         mdf = MDF(path)
     except Exception as err:  # asammdf raises many types for foreign files
-        raise SignalError(f"file {str(path)!r}: cannot read as ASAM MDF ({err})") from None
+        # the reader's message may quote the file's first bytes: named by type only
+        raise SignalError(
+            f"file {str(path)!r}: cannot read as ASAM MDF ({type(err).__name__}: not an MDF "
+            "file, or damaged)"
+        ) from None
     try:
         occurrences = mdf.channels_db.get(channel)
         if not occurrences:
@@ -180,7 +184,10 @@ def read_tdms(
     try:
         tdms = TdmsFile.read(path)
     except Exception as err:
-        raise SignalError(f"file {str(path)!r}: cannot read as TDMS ({err})") from None
+        raise SignalError(
+            f"file {str(path)!r}: cannot read as TDMS ({type(err).__name__}: not a TDMS file, "
+            "or damaged)"
+        ) from None
     holding = [g for g in tdms.groups() if channel in [c.name for c in g.channels()]]
     if group is not None:
         holding = [g for g in holding if g.name == str(group)]
