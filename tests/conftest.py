@@ -40,3 +40,12 @@ BASE = {
 def scene_dict():
     """A two-clip hose scene as a dict; tests modify their own copy."""
     return copy.deepcopy(BASE)
+
+
+def pytest_terminal_summary(terminalreporter):
+    """The number of bad-input cases run (tests/test_bad_input_*.py), when there were any."""
+    import sys
+
+    badinput = sys.modules.get("badinput")
+    if badinput is not None and badinput.CASES_RUN:
+        terminalreporter.write_line(f"bad-input cases run: {len(badinput.CASES_RUN)}")

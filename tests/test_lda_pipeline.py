@@ -188,7 +188,7 @@ def test_cli_functions(tmp_path):
     assert out.exit_code == 0, out.output
     assert "best: a.damage" in out.output
     out = runner.invoke(app, ["lda", str(tmp_path / "a.h5"), "--wohler-k", "-1"])
-    assert out.exit_code == 1 and "k = -1" in out.output
+    assert out.exit_code == 2 and "k = -1" in out.output
 
 
 def test_zero_damage_and_single_step_results(tmp_path):

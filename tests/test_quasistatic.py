@@ -92,8 +92,10 @@ def test_interrupted_run_keeps_the_steps_computed(scene_dict, tmp_path):
     assert partial.cable.positions.shape == (n, 41, 3)
     path = partial.save(tmp_path / "partial.h5")
     from cablelife import load_result
+    from cablelife.resultcheck import PartialResultWarning
 
-    back = load_result(path)
+    with pytest.warns(PartialResultWarning, match="partial result"):
+        back = load_result(path)
     assert not back.complete and back.cable.n_steps == n
 
 

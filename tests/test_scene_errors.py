@@ -51,7 +51,7 @@ def test_unknown_key_and_missing_value(scene_dict):
 def test_non_positive_radius(scene_dict):
     scene_dict["cables"][0]["section"]["radius"] = -0.005
     msg = error_of(scene_dict)
-    assert "cables[0].section.circle.radius" in msg and "greater than 0" in msg
+    assert "cables[0].section.circle.radius" in msg and "greater than or equal to 0.00001" in msg
     assert "-0.005" in msg
 
 

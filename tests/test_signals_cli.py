@@ -80,7 +80,7 @@ def test_bad_spec_gives_key_path_and_exit_code(app, tmp_path):
     spec = tmp_path / "bad.toml"
     spec.write_text(SPEC.replace('frame = "body"', 'frame = "wheel"'))
     result = run(app, spec)
-    assert result.exit_code == 1
+    assert result.exit_code == 2
     assert "channels.1.frame: Input should be 'global' or 'body' (got 'wheel')" in result.output
     assert "Traceback" not in result.output
 
@@ -89,13 +89,13 @@ def test_bad_output_extension(app, tmp_path):
     spec = tmp_path / "s.toml"
     spec.write_text(SPEC)
     result = run(app, spec, "-o", tmp_path / "s.xlsx")
-    assert result.exit_code == 1
+    assert result.exit_code == 2
     assert "extension '.xlsx' is not supported; allowed: .csv, .h5, .hdf5" in result.output
 
 
 def test_missing_spec_file(app, tmp_path):
     result = run(app, tmp_path / "none.toml")
-    assert result.exit_code == 1 and "none.toml' does not exist" in result.output
+    assert result.exit_code == 2 and "none.toml' does not exist" in result.output
 
 
 @pytest.mark.parametrize("example", sorted(EXAMPLES.glob("*.toml")), ids=lambda p: p.name)
@@ -116,5 +116,5 @@ def test_error_text_with_brackets_is_printed_verbatim(app, tmp_path):
     spec = tmp_path / "s.toml"
     spec.write_text(SPEC.replace("seed = 1", "seed = 1, unit = '[m/s^2]^2/Hz'"))
     result = run(app, spec)
-    assert result.exit_code == 1
+    assert result.exit_code == 2
     assert "unit '[m/s^2]^2/Hz' is not allowed with a profile" in result.output

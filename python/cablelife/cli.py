@@ -8,10 +8,12 @@ from typing import Annotated
 
 import typer
 from rich.console import Console
+from rich.markup import escape
 from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 from rich.table import Table
 
 from cablelife.interrupt import interrupted
+from cablelife.paths import ALLOW_OUTSIDE_HELP
 from cablelife.results import Result
 from cablelife.scene import SceneError, json_schema, load_scene
 from cablelife.signals.errors import SignalError
@@ -22,13 +24,14 @@ app = typer.Typer(
     help="cablelife: digital mock-up of cables and hoses (Cosserat rod simulation, fatigue).",
     no_args_is_help=True,
     pretty_exceptions_enable=False,
+    rich_markup_mode=None,  # help texts as written: "[pseudo-damage]", "s [m]" stay visible
 )
-console = Console()
-err_console = Console(stderr=True)
+console = Console(emoji=False, highlight=False)
+err_console = Console(stderr=True, emoji=False, highlight=False)
 
 
 def fail(message: str, code: int = 2) -> typer.Exit:
-    err_console.print(f"[bold red]error:[/] {message}", highlight=False, soft_wrap=True)
+    err_console.print(f"[bold red]error:[/] {escape(message)}", highlight=False, soft_wrap=True)
     return typer.Exit(code)
 
 
@@ -37,7 +40,9 @@ def print_summary(result: Result) -> None:
     for name, c in result.cables.items():
         s = cable_summary(c)
         t = Table(
-            title=f"cable '{name}' — {result.mode}, {s['steps']} step(s), {s['segments']} segments",
+            title=escape(
+                f"cable '{name}' — {result.mode}, {s['steps']} step(s), {s['segments']} segments"
+            ),
             title_justify="left",
         )
         t.add_column("quantity")
@@ -72,11 +77,13 @@ def print_summary(result: Result) -> None:
         console.print(t)
         ct = Table(title="clip reactions (max over time)", title_justify="left")
         ct.add_column("clip")
-        ct.add_column("s [m]", justify="right")
-        ct.add_column("|force| [N]", justify="right")
-        ct.add_column("|moment| [N m]", justify="right")
+        ct.add_column(escape("s [m]"), justify="right")
+        ct.add_column(escape("|force| [N]"), justify="right")
+        ct.add_column(escape("|moment| [N m]"), justify="right")
         for clip, v in s["clips"].items():
-            ct.add_row(clip, f"{v['s']:.3f}", f"{v['max_force']:.4g}", f"{v['max_moment']:.4g}")
+            ct.add_row(
+                escape(clip), f"{v['s']:.3f}", f"{v['max_force']:.4g}", f"{v['max_moment']:.4g}"
+            )
         console.print(ct)
 
 
@@ -88,12 +95,20 @@ def run(
     ] = None,
     output: Annotated[Path | None, typer.Option("-o", "--output", help="result HDF5 file")] = None,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="no progress bar")] = False,
+    allow_outside_files: Annotated[
+        bool, typer.Option("--allow-outside-files", help=ALLOW_OUTSIDE_HELP)
+    ] = False,
 ) -> None:
     """Simulate a scene and print a summary; with -o, save the result (HDF5)."""
     try:
         sc = load_scene(scene)
     except SceneError as err:
         raise fail(str(err)) from None
+    if allow_outside_files:
+        sc.files.allow_outside = True
+    if output is not None and (output.is_dir() or not output.parent.is_dir()):
+        why = "is a directory" if output.is_dir() else "is in a folder that does not exist"
+        raise fail(f"--output {str(output)!r} {why}; give a file in an existing folder")
     progress = Progress(
         TextColumn("{task.description}"),
         BarColumn(),
@@ -106,7 +121,7 @@ def run(
 
     def on_progress(cable: str, done: int, total: int) -> None:
         if cable not in tasks:
-            tasks[cable] = progress.add_task(f"cable '{cable}'", total=total)
+            tasks[cable] = progress.add_task(escape(f"cable '{cable}'"), total=total)
         progress.update(tasks[cable], completed=done)
 
     try:
@@ -119,17 +134,22 @@ def run(
         if output is not None:
             err.result.save(output)
             err_console.print(
-                f"partial result (steps before the {what}) saved to {output}", highlight=False
+                escape(f"partial result (steps before the {what}) saved to {output}")
             )
         if err.interrupted:
             raise interrupted(
                 "the run stopped early" + ("" if output else " (nothing saved)")
             ) from None
         raise fail(str(err), code=1) from None
+    if output is not None:  # saved first: a summary that cannot be printed loses nothing
+        try:
+            result.save(output)
+        except OSError as err:
+            print_summary(result)
+            raise fail(f"--output {str(output)!r} cannot be written ({err})") from None
     print_summary(result)
     if output is not None:
-        result.save(output)
-        console.print(f"result saved to {output}")
+        console.print(escape(f"result saved to {output}"))
 
 
 @app.command()
@@ -146,10 +166,10 @@ def modes(
     except (SceneError, SignalError) as err:
         raise fail(str(err)) from None
     for name, m in found.items():
-        t = Table(title=f"cable '{name}': natural frequencies", title_justify="left")
+        t = Table(title=escape(f"cable '{name}': natural frequencies"), title_justify="left")
         t.add_column("mode", justify="right")
-        t.add_column("f [Hz]", justify="right")
-        t.add_column("ω [rad/s]", justify="right")
+        t.add_column(escape("f [Hz]"), justify="right")
+        t.add_column(escape("ω [rad/s]"), justify="right")
         for i, (f, w) in enumerate(zip(m.frequencies, m.omega, strict=True), start=1):
             t.add_row(str(i), f"{f:.4g}", f"{w:.4g}")
         console.print(t)
@@ -165,10 +185,14 @@ def schema(
     text = json.dumps(json_schema(), indent=2)
     if output is None:
         console.print_json(text)
-    else:
-        from cablelife.atomic import write_text_atomic
+        return
+    from cablelife.atomic import write_text_atomic
 
+    try:
         write_text_atomic(output, text + "\n")
+    except OSError as err:
+        what = "is a directory" if output.is_dir() else f"cannot be written ({err.strerror})"
+        raise fail(f"--output {str(output)!r} {what}") from None
 
 
 def _register_optional() -> None:

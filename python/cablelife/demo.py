@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+import math
 import os
 import time
 from collections.abc import Callable
@@ -74,9 +75,13 @@ def demo_runs(
     return _runs(study, study_dir, seed, duration, quasistatic)
 
 
-def _runs(study, study_dir: Path, seed, duration, quasistatic) -> list[Variant]:
+def _runs(
+    study, study_dir: Path, seed, duration, quasistatic, allow_outside_files: bool = False
+) -> list[Variant]:
+    if duration is not None and not (math.isfinite(duration) and duration > 0):
+        raise StudyError(f"duration = {duration!r}: allowed: a finite number of seconds > 0")
     runs = []
-    for v in expand(study, study_dir):
+    for v in expand(study, study_dir, allow_outside_files):
         for mode in MODES if quasistatic else MODES[:1]:
             scene = reseed(v.scene, seed) if seed is not None else copy.deepcopy(v.scene)
             scene["simulation"]["mode"] = mode
@@ -97,13 +102,14 @@ def run_demo(
     report_frames: int = 40,
     workers: int | None = None,
     on_stage: Callable[[str, str], None] | None = None,
+    allow_outside_files: bool = False,
 ) -> DemoOutcome:
     """Runs the demo into ``out_dir``: simulations and LDA of all runs in parallel (one thread
     each), the comparison, and the report. ``on_stage(run, stage)`` follows the progress."""
     from cablelife.lda.compare import compare
 
     study, study_dir = load_study((example or example_dir()) / "variants.toml")
-    runs = _runs(study, study_dir, seed, duration, quasistatic)
+    runs = _runs(study, study_dir, seed, duration, quasistatic, allow_outside_files)
     out = Path(out_dir)
     times: dict[str, float] = {}
     t0 = time.perf_counter()

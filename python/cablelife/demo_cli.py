@@ -25,18 +25,26 @@ def demo_command(
         bool, typer.Option(help="Also run quasistatically, for comparison.")
     ] = True,
     report: Annotated[bool, typer.Option(help="Write the HTML report.")] = True,
+    allow_outside_files: Annotated[
+        bool,
+        typer.Option(
+            "--allow-outside-files",
+            help="read files named in the scenes also outside the example's folder",
+        ),
+    ] = False,
 ) -> None:
     """Two mounting variants, the same engine vibration: simulate, LDA, rank, report."""
     import warnings
 
-    from rich.console import Console
     from rich.live import Live
     from rich.table import Table
 
+    from cablelife.clitext import console as make_console
+    from cablelife.clitext import escape, print_error
     from cablelife.demo import run_demo
     from cablelife.study.spec import StudyError
 
-    console = Console()
+    console = make_console()
     state: dict[str, str] = {}
 
     def view() -> Table:
@@ -44,7 +52,7 @@ def demo_command(
         t.add_column("run")
         t.add_column("stage")
         for k, v in state.items():
-            t.add_row(k, "[green]done[/]" if v == "ok" else v)
+            t.add_row(escape(k), "[green]done[/]" if v == "ok" else escape(v))
         return t
 
     try:
@@ -64,6 +72,7 @@ def demo_command(
                     quasistatic=quasistatic,
                     report=report,
                     on_stage=on_stage,
+                    allow_outside_files=allow_outside_files,
                 )
             state["report"] = "ok" if report else "skipped"
             live.update(view())
@@ -73,16 +82,18 @@ def demo_command(
         raise interrupted(
             f"runs finished so far (and partial results) are kept in {output / 'variants'}"
         ) from None
-    except (StudyError, FileNotFoundError, RuntimeError) as e:
-        Console(stderr=True).print(f"[bold red]error:[/] {e}", highlight=False, soft_wrap=True)
+    except (StudyError, FileNotFoundError, RuntimeError, OSError, ValueError) as e:
+        print_error(make_console(stderr=True), e)
         raise typer.Exit(2) from None
     cmp = outcome.comparison
     console.print("\n[bold]Ranking by maximum pseudo-damage (dynamic runs):[/]")
-    console.print(cmp.table(2), soft_wrap=True, highlight=False)
+    console.print(escape(cmp.table(2)), soft_wrap=True, highlight=False)
     best, worst = cmp.variants[0], cmp.variants[-1]
     console.print(
-        f"\n[bold green]Variant {best.label} is preferred[/]: its maximum pseudo-damage is "
-        f"{worst.ratio:.2f}× lower than variant {worst.label}'s.",
+        f"\n[bold green]{escape(f'Variant {best.label} is preferred')}[/]: "
+        + escape(
+            f"its maximum pseudo-damage is {worst.ratio:.2f}× lower than variant {worst.label}'s."
+        ),
         highlight=False,
     )
     if outcome.quasistatic is not None:
@@ -93,17 +104,19 @@ def demo_command(
             if qs.get(v.label, 0) > 0
         ]
         console.print(
-            "Dynamic over quasistatic pseudo-damage (inertia): " + ", ".join(parts),
+            escape("Dynamic over quasistatic pseudo-damage (inertia): " + ", ".join(parts)),
             highlight=False,
         )
     for name, row in outcome.rows.items():
         for w in row.get("warnings", []):
-            console.print(f"[yellow]warning[/] ({name}): {w}", highlight=False, soft_wrap=True)
+            console.print(
+                f"[yellow]warning[/] {escape(f'({name}): {w}')}", highlight=False, soft_wrap=True
+            )
     t = outcome.stage_times
     console.print(
-        "Wall time: " + ", ".join(f"{k} {v:.2f} s" for k, v in t.items() if ":" not in k),
+        escape("Wall time: " + ", ".join(f"{k} {v:.2f} s" for k, v in t.items() if ":" not in k)),
         highlight=False,
     )
-    console.print(f"Runs, damage files and summaries: {outcome.out_dir / 'variants'}")
+    console.print(escape(f"Runs, damage files and summaries: {outcome.out_dir / 'variants'}"))
     if outcome.report is not None:
-        console.print(f"[bold]Report:[/] {outcome.report}")
+        console.print(f"[bold]Report:[/] {escape(str(outcome.report))}")

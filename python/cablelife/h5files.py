@@ -26,10 +26,23 @@ def atomic_h5(path: str | os.PathLike) -> Iterator[h5py.File]:
 def open_h5(path: str | os.PathLike, fmt: str, what: str) -> Iterator[h5py.File]:
     """Opens a cablelife file for reading; clear errors when it is missing or of another kind."""
     path = Path(path)
+    if path.is_dir():
+        raise ValueError(f"{what} file {str(path)!r} is a directory; give an HDF5 file")
     if not path.exists():
         raise FileNotFoundError(f"{what} file {str(path)!r} does not exist")
-    with h5py.File(path, "r") as f:
-        if f.attrs.get("format") != fmt:
+    try:
+        f = h5py.File(path, "r")
+    except OSError:
+        raise ValueError(
+            f"{what} file {str(path)!r} is not a readable HDF5 file (truncated, empty or of "
+            "another kind)"
+        ) from None
+    with f:
+        try:
+            found = f.attrs.get("format")
+        except OSError:
+            found = None
+        if found != fmt:
             raise ValueError(f"{str(path)!r} is not a cablelife {what} file (format attribute)")
         yield f
 

@@ -27,6 +27,7 @@ import h5py
 import numpy as np
 
 from cablelife.h5files import atomic_h5, open_h5, plain
+from cablelife.resultcheck import check_result_file, check_result_values, warn_partial
 
 FORMAT = "cablelife-result"
 FORMAT_VERSION = 1
@@ -167,6 +168,7 @@ def save_result(result: Result, path: str | os.PathLike) -> Path:
 def load_result(path: str | os.PathLike) -> Result:
     """Read a result written by :func:`save_result`."""
     with open_h5(path, FORMAT, "result") as f:
+        check_result_file(f, path)  # shapes, sizes, the stored scene: before reading
         cables = {}
         for name, g in f["cables"].items():
             clips = {
@@ -191,10 +193,13 @@ def load_result(path: str | os.PathLike) -> Result:
                 solver={k: plain(v) for k, v in solver.items()},
                 energies=energies,
             )
-        return Result(
+        result = Result(
             mode=str(f.attrs["mode"]),
             cables=cables,
             scene_toml=str(f.attrs.get("scene_toml", "")),
             complete=bool(f.attrs.get("complete", True)),
             message=str(f.attrs.get("message", "")),
         )
+    check_result_values(result, path)  # no NaN into reports, VTK files, damage maps
+    warn_partial(result, path)
+    return result

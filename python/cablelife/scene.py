@@ -12,23 +12,52 @@ from typing import Annotated, Literal
 
 import numpy as np
 from pydantic import (
+    AfterValidator,
     BaseModel,
     ConfigDict,
     Field,
-    NonNegativeFloat,
-    PositiveFloat,
-    PositiveInt,
+    Strict,
     ValidationError,
     field_validator,
     model_validator,
 )
 
 from cablelife import _core
+from cablelife.limits import LIMITS, MAX_SEGMENTS, MIN_SEGMENTS, check_name
+from cablelife.paths import SceneFileError, resolve_scene_file, shown_names
 from cablelife.sections import SectionProperties, from_material, from_measured
 from cablelife.signals.spec import ChannelMotion, TableSignal
 from cablelife.tomlfile import read_toml
 
-Vec3 = tuple[float, float, float]
+# Strict numbers: a TOML number is a number (ints are fine where floats are wanted); booleans
+# and strings are refused instead of coerced (``length = true`` is not 1 m).
+Real = Annotated[float, Strict()]
+PositiveFloat = Annotated[float, Strict(), Field(gt=0)]
+NonNegativeFloat = Annotated[float, Strict(), Field(ge=0)]
+PositiveInt = Annotated[int, Strict(), Field(gt=0)]
+Vec3 = tuple[Real, Real, Real]
+
+
+def _bounded(name: str):
+    """A strict float within the documented range ``LIMITS[name]`` (docs/scene.md, Limits)."""
+    lo, hi = LIMITS[name]
+    return Annotated[float, Strict(), Field(ge=lo, le=hi)]
+
+
+Length = _bounded("length")  # m, cable length
+Coordinate = _bounded("coordinate")  # m
+Point = tuple[Coordinate, Coordinate, Coordinate]
+Radius = _bounded("radius")  # m, section radii
+Modulus = _bounded("modulus")  # Pa, E and G
+Density = _bounded("density")  # kg/m³
+AxialStiffness = _bounded("axial_stiffness")  # N
+BendingStiffness = _bounded("bending_stiffness")  # N m²
+Curvature = _bounded("curvature")  # 1/m
+Acceleration = _bounded("acceleration")  # m/s²
+Force = _bounded("force")  # N
+Moment = _bounded("moment")  # N m
+# Cable, clip and body names: HDF5 group names and table entries (limits.check_name).
+Name = Annotated[str, Strict(), Field(min_length=1), AfterValidator(check_name)]
 
 
 class SceneError(ValueError):
@@ -43,15 +72,15 @@ class CircleSection(_Model):
     """Solid circular section."""
 
     shape: Literal["circle"]
-    radius: PositiveFloat
+    radius: Radius
 
 
 class TubeSection(_Model):
     """Circular tube (hose)."""
 
     shape: Literal["tube"]
-    outer_radius: PositiveFloat
-    inner_radius: PositiveFloat
+    outer_radius: Radius
+    inner_radius: Radius
 
     @model_validator(mode="after")
     def _radii(self):
@@ -66,10 +95,10 @@ class TubeSection(_Model):
 class Material(_Model):
     """Isotropic material: Young's modulus and Poisson's ratio (or shear modulus), density."""
 
-    youngs_modulus: PositiveFloat  # Pa
-    poisson_ratio: Annotated[float, Field(ge=0.0, le=0.5)] | None = None
-    shear_modulus: PositiveFloat | None = None  # Pa
-    density: PositiveFloat  # kg/m³
+    youngs_modulus: Modulus  # Pa
+    poisson_ratio: Annotated[float, Strict(), Field(ge=0.0, le=0.5)] | None = None
+    shear_modulus: Modulus | None = None  # Pa
+    density: Density  # kg/m³
 
     @model_validator(mode="after")
     def _elastic(self):
@@ -95,15 +124,15 @@ class MeasuredStiffness(_Model):
     """Effective stiffnesses as measured by cable suppliers, instead of section + material."""
 
     model_config = ConfigDict(extra="forbid", populate_by_name=True)
-    EA: PositiveFloat  # N
-    GA: PositiveFloat | None = None  # N (shear stiffness incl. shear coefficient)
-    EI: PositiveFloat | None = None  # N m² (round cables)
-    EI1: PositiveFloat | None = None  # N m² (non-round cables: both)
-    EI2: PositiveFloat | None = None
-    GJ: PositiveFloat  # N m²
-    mass_per_length: PositiveFloat  # kg/m
-    radius: PositiveFloat  # m, outer radius (contact, pictures, stresses)
-    rotary_inertia: PositiveFloat | None = None  # kg m (ρI per length)
+    EA: AxialStiffness  # N
+    GA: AxialStiffness | None = None  # N (shear stiffness incl. shear coefficient)
+    EI: BendingStiffness | None = None  # N m² (round cables)
+    EI1: BendingStiffness | None = None  # N m² (non-round cables: both)
+    EI2: BendingStiffness | None = None
+    GJ: BendingStiffness  # N m²
+    mass_per_length: _bounded("mass_per_length")  # kg/m
+    radius: Radius  # m, outer radius (contact, pictures, stresses)
+    rotary_inertia: _bounded("rotary_inertia") | None = None  # kg m (ρI per length)
 
     @model_validator(mode="after")
     def _bending(self):
@@ -117,10 +146,10 @@ class MeasuredStiffness(_Model):
 class Clip(_Model):
     """A clip holding the cable at arc length ``s`` (the clip centre)."""
 
-    name: Annotated[str, Field(min_length=1)]
+    name: Name
     s: NonNegativeFloat  # m
-    body: str = "world"
-    position: Vec3  # m
+    body: Annotated[str, Strict()] = "world"
+    position: Point  # m
     direction: Vec3  # cable tangent d3 at the clip
     normal: Vec3 | None = None  # d1 at the clip (fixes the twist); default: any normal
     type: Literal["fixed", "swivel", "ball"] = "fixed"
@@ -146,6 +175,11 @@ class Clip(_Model):
                 )
         if self.type == "ball" and self.length > 0:
             raise ValueError("a ball clip holds a point: its length must be 0")
+        if self.frame == "body" and self.body == "world":
+            raise ValueError(
+                "frame = 'body' needs a clip on a body, but body = 'world' (the fixed frame); "
+                "allowed: frame = 'global' on world clips, or name the clip's body"
+            )
         return self
 
 
@@ -153,8 +187,8 @@ class Load(_Model):
     """A dead load (global frame) at arc length ``s``."""
 
     s: NonNegativeFloat
-    force: Vec3 = (0.0, 0.0, 0.0)  # N
-    moment: Vec3 = (0.0, 0.0, 0.0)  # N m
+    force: tuple[Force, Force, Force] = (0.0, 0.0, 0.0)  # N
+    moment: tuple[Moment, Moment, Moment] = (0.0, 0.0, 0.0)  # N m
 
 
 class Damping(_Model):
@@ -182,17 +216,28 @@ DEFAULT_DAMPING_RATIO = 1.0
 class Cable(_Model):
     """One cable or hose."""
 
-    name: Annotated[str, Field(min_length=1)]
-    length: PositiveFloat  # m
-    segments: PositiveInt | None = None
+    name: Name
+    length: Length  # m
+    segments: Annotated[int, Strict()] | None = None
     max_segment_length: PositiveFloat | None = None  # m
-    natural_curvature: Vec3 = (0.0, 0.0, 0.0)  # κ₁, κ₂, twist in 1/m
+    natural_curvature: tuple[Curvature, Curvature, Curvature] = (0.0, 0.0, 0.0)  # κ₁, κ₂, τ 1/m
     section: Annotated[CircleSection | TubeSection, Field(discriminator="shape")] | None = None
     material: Material | None = None
     stiffness: MeasuredStiffness | None = None
     clips: Annotated[list[Clip], Field(min_length=1)]
     loads: list[Load] = []
     damping: Damping = Damping()
+
+    @field_validator("segments")
+    @classmethod
+    def _segments(cls, v):
+        if v is not None and not MIN_SEGMENTS <= v <= MAX_SEGMENTS:
+            raise ValueError(
+                f"segments = {v}: allowed: {MIN_SEGMENTS} to {MAX_SEGMENTS}; fewer cannot "
+                "represent a cable bent between clips (one segment is a straight bar), more is "
+                "finer than any cable needs while results grow with the segments"
+            )
+        return v
 
     @model_validator(mode="after")
     def _consistent(self):
@@ -202,6 +247,12 @@ class Cable(_Model):
             raise ValueError("give either section + material or stiffness, not both")
         if self.segments is not None and self.max_segment_length is not None:
             raise ValueError("give segments or max_segment_length, not both")
+        if self.max_segment_length is not None and self.n_segments > MAX_SEGMENTS:
+            raise ValueError(
+                f"max_segment_length = {self.max_segment_length} m gives {self.n_segments} "
+                f"segments on {self.length} m; allowed: at most {MAX_SEGMENTS} segments "
+                "(finer than any cable needs; results grow with the segments)"
+            )
         names = [c.name for c in self.clips]
         dup = {n for n in names if names.count(n) > 1}
         if dup:
@@ -223,7 +274,7 @@ class Cable(_Model):
         if self.segments is not None:
             return self.segments
         if self.max_segment_length is not None:
-            return max(1, math.ceil(self.length / self.max_segment_length))
+            return max(MIN_SEGMENTS, math.ceil(self.length / self.max_segment_length))
         return 50
 
     def properties(self) -> SectionProperties:
@@ -247,8 +298,8 @@ class Body(_Model):
     """A rigid body carrying clips; its motion is a list of channel signals, or a CSV table
     ``motion_file`` with columns t, x, y, z, rx, ry, rz (m, rad; global frame)."""
 
-    name: Annotated[str, Field(min_length=1)]
-    origin: Vec3 = (0.0, 0.0, 0.0)  # reference point (rotation centre) of the body, global
+    name: Name
+    origin: Point = (0.0, 0.0, 0.0)  # reference point (rotation centre) of the body, global
     orientation: Vec3 = (0.0, 0.0, 0.0)  # rx, ry, rz (rad) of the body frame, R = Rz Ry Rx
     motion: list[ChannelMotion] = []
     motion_file: Path | None = None
@@ -259,15 +310,20 @@ class Body(_Model):
             raise ValueError("give motion (channels) or motion_file, not both")
         return self
 
-    def channel_motions(self, base_dir: Path | None = None) -> list[ChannelMotion]:
+    def channel_motions(
+        self, base_dir: Path | None = None, allow_outside: bool = False
+    ) -> list[ChannelMotion]:
         """The body's channel signals; a ``motion_file`` table becomes six table signals
-        (linear interpolation between its rows: poses, not a sampled signal to filter)."""
+        (linear interpolation between its rows: poses, not a sampled signal to filter).
+        ``motion_file`` follows the rule of files named in scenes (cablelife.paths)."""
         if self.motion_file is None:
             return list(self.motion)
-        path = self.motion_file
-        if not path.is_absolute() and base_dir is not None:
-            path = base_dir / path
-        table = read_pose_table(path, f"bodies '{self.name}' motion_file")
+        what = f"bodies '{self.name}' motion_file"
+        try:
+            path = resolve_scene_file(base_dir, self.motion_file, allow_outside, what)
+        except SceneFileError as err:
+            raise SceneError(str(err)) from None
+        table = read_pose_table(path, what)
         return [
             ChannelMotion(
                 channel=ch,
@@ -287,13 +343,16 @@ def read_pose_table(path: Path, what: str) -> dict[str, np.ndarray]:
         raise SceneError(f"{what} = {str(path)!r} does not exist")
     try:
         data = np.genfromtxt(path, delimiter=",", names=True, dtype=float, encoding="utf-8")
-    except ValueError as err:
-        raise SceneError(f"{what} = {str(path)!r} is not a numeric CSV table: {err}") from None
+    except (ValueError, UnicodeDecodeError):
+        raise SceneError(
+            f"{what} = {str(path)!r} is not a numeric CSV table (UTF-8 text, a header row "
+            f"{','.join(POSE_COLUMNS)}, then numbers)"
+        ) from None
     names = data.dtype.names or ()
     missing = [c for c in POSE_COLUMNS if c not in names]
     if missing:
         raise SceneError(
-            f"{what} = {str(path)!r} lacks the columns {missing}; it has {list(names)}, "
+            f"{what} = {str(path)!r} lacks the columns {missing}; it has {shown_names(names)}, "
             f"needed: {list(POSE_COLUMNS)}"
         )
     table = {c: np.atleast_1d(data[c]) for c in POSE_COLUMNS}
@@ -301,32 +360,43 @@ def read_pose_table(path: Path, what: str) -> dict[str, np.ndarray]:
         if not np.all(np.isfinite(v)):
             row = int(np.flatnonzero(~np.isfinite(v))[0]) + 2
             raise SceneError(
-                f"{what}: column {c!r} has a missing or non-numeric value in line {row}"
+                f"{what} = {str(path)!r}: column {c!r} has a missing or non-numeric value in "
+                f"line {row}"
             )
     if table["t"].size < 2 or np.any(np.diff(table["t"]) <= 0):
         raise SceneError(f"{what}: the times in column 't' must increase strictly (≥ 2 rows)")
     return table
 
 
+class Files(_Model):
+    """Files named in the scene (measured signals, motion_file): outside the scene's folder
+    only with ``allow_outside = true`` (or the CLI flag ``--allow-outside-files``)."""
+
+    allow_outside: Annotated[bool, Strict()] = False
+
+
 class Simulation(_Model):
     """Run settings."""
 
     mode: Literal["static", "quasistatic", "dynamic"] = "static"
-    gravity: Vec3 = (0.0, 0.0, -9.81)  # m/s²
+    gravity: tuple[Acceleration, Acceleration, Acceleration] = (0.0, 0.0, -9.81)  # m/s²
     duration: PositiveFloat | None = None  # s
     time_step: PositiveFloat = 1e-3  # s
     output_step: PositiveFloat | None = None  # s (default: every step)
     max_iterations: PositiveInt = 40
-    spectral_radius: Annotated[float, Field(ge=0.0, le=1.0)] = 0.9  # ρ∞ of generalized-α
+    spectral_radius: Annotated[float, Strict(), Field(ge=0.0, le=1.0)] = 0.9  # ρ∞ of generalized-α
     # Dynamic Newton iteration: converged when the correction is below this fraction of the
     # step's increment (docs/dynamics.md: the error it leaves vs the time-step error).
-    newton_tolerance: Annotated[float, Field(gt=0.0, lt=1.0)] = _core.DEFAULT_NEWTON_TOLERANCE
+    newton_tolerance: Annotated[float, Strict(), Field(gt=0.0, lt=1.0)] = (
+        _core.DEFAULT_NEWTON_TOLERANCE
+    )
 
 
 class Scene(_Model):
     """A complete scene."""
 
     simulation: Simulation = Simulation()
+    files: Files = Files()
     bodies: list[Body] = []
     cables: Annotated[list[Cable], Field(min_length=1)]
     base_dir: Annotated[Path | None, Field(exclude=True)] = None

@@ -16,6 +16,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from cablelife import _core, interrupt
+from cablelife.limits import MAX_RUN_BYTES, human_bytes, run_bytes
 from cablelife.results import CableResult, ClipReaction, Result
 from cablelife.scene import Cable, Scene, SceneError
 from cablelife.signals import body_motion, time_grid
@@ -55,6 +56,44 @@ def euler_matrix(angles) -> np.ndarray:
     return Rotation.from_euler("xyz", angles).as_matrix()
 
 
+def _grid_steps(duration: float, time_step: float) -> float:
+    """Points of the grid 0, time_step, …, duration (a float: may be inf for absurd input)."""
+    return float(np.floor(duration / time_step + 1e-9)) + 1.0
+
+
+def _needs_run_grid(scene: Scene) -> bool:
+    """Whether a body's motion depends on the run's whole time grid even at t = 0: PSD
+    realisations are drawn on it, measured signals are filtered at its Nyquist frequency."""
+    return any(m.signal.type in ("psd", "measured") for b in scene.bodies for m in b.motion)
+
+
+def check_run_size(scene: Scene, mode: str) -> None:
+    """Refuses a run whose signals and results would not fit the memory limit, before
+    anything is allocated (docs/scene.md, Limits)."""
+    sim = scene.simulation
+    if sim.duration is None:
+        return
+    if mode == "static":
+        if not _needs_run_grid(scene):
+            return
+        steps, saved = _grid_steps(sim.duration, sim.time_step), 1
+    elif mode == "dynamic":
+        steps = _grid_steps(sim.duration, sim.time_step)
+        saved = _grid_steps(sim.duration, sim.output_step or sim.time_step)
+    else:
+        steps = saved = _grid_steps(sim.duration, sim.output_step or sim.time_step)
+    cables = [(c.n_segments, len(c.clips)) for c in scene.cables]
+    need = run_bytes(steps, saved, cables, len(scene.bodies))
+    if need > MAX_RUN_BYTES:
+        raise SceneError(
+            f"simulation.time_step = {sim.time_step:g} s over duration = {sim.duration:g} s "
+            f"is {steps:.4g} time steps ({saved:.4g} saved, {mode} mode); the signals and "
+            f"results would need about {human_bytes(need)} of memory, allowed: "
+            f"{human_bytes(MAX_RUN_BYTES)}; use a larger time_step or output_step, a shorter "
+            "duration or fewer segments"
+        )
+
+
 def output_times(scene: Scene, mode: str) -> np.ndarray:
     """The time grid of a run: the saved steps (static, quasistatic) or the integration
     steps (dynamic; every ``output_every``-th is saved)."""
@@ -76,18 +115,22 @@ def clip_kinematics(
     Without ``with_motion``: the reference poses (bodies at rest)."""
     n_t, n_c = times.size, len(cable.clips)
     grid = times
-    if n_t == 1:  # one pose (static run): the motions' value at that time on their usual grid
+    if n_t == 1:  # one pose (static run): the motions' value at that time
         sim = scene.simulation
-        grid = (
+        grid = (  # on the run's grid only where the value depends on it (PSD, measured)
             time_grid(sim.duration, sim.time_step, times[0])
-            if sim.duration is not None and sim.duration > sim.time_step
+            if sim.duration is not None
+            and sim.duration > sim.time_step
+            and with_motion
+            and _needs_run_grid(scene)
             else np.array([times[0], times[0] + sim.time_step])
         )
     motions = {}
     for body in scene.bodies:
         r0 = euler_matrix(body.orientation)
-        channels = body.channel_motions(scene.base_dir) if with_motion else []
-        motion = body_motion(channels, grid, scene.base_dir, r0) if channels else None
+        allow = scene.files.allow_outside
+        channels = body.channel_motions(scene.base_dir, allow) if with_motion else []
+        motion = body_motion(channels, grid, scene.base_dir, r0, allow) if channels else None
         motions[body.name] = (body, r0, motion)
     out = {
         k: np.zeros((n_t, n_c, 3))
@@ -149,7 +192,7 @@ def build_cable(scene: Scene, cable: Cable) -> _core.Cable:
     ]
     loads = [(ld.s, list(ld.force), list(ld.moment)) for ld in cable.loads]
     try:
-        return _core.Cable(
+        core = _core.Cable(
             cable.length,
             cable.n_segments,
             props.shear_stiffness,
@@ -164,6 +207,14 @@ def build_cable(scene: Scene, cable: Cable) -> _core.Cable:
         )
     except ValueError as err:
         raise SceneError(f"cable '{cable.name}': {err}") from None
+    used = int(core.arc_length.size - 1)
+    if cable.segments is not None and used > cable.segments:
+        raise SceneError(
+            f"cable '{cable.name}': segments = {cable.segments}, but its clips and loads split "
+            f"the cable into {used} intervals that need one segment each; allowed: segments "
+            f">= {used} (or max_segment_length)"
+        )
+    return core
 
 
 def output_every(scene: Scene) -> int:
@@ -258,6 +309,8 @@ def _run_cable(
             pos, quat = clip_poses(scene, cable, times)
             out = core.run_sequence(pos, quat, callback, max(1, times.size // 100), stop=stop)
             saved = times
+    except SceneError:
+        raise  # already names the cable
     except ValueError as err:
         raise SceneError(f"cable '{cable.name}': {err}") from None
     wall = _time.perf_counter() - start
@@ -314,6 +367,7 @@ def simulate(scene: Scene, mode: str | None = None, progress: Progress | None = 
         raise SceneError(
             f"mode = {mode!r} is not a simulation mode; allowed: 'static', 'quasistatic', 'dynamic'"
         )
+    check_run_size(scene, mode)
     times = output_times(scene, mode)
     workers = max(1, min(len(scene.cables), os.cpu_count() or 1))
     with interrupt.stop_flag() as stop, ThreadPoolExecutor(max_workers=workers) as pool:

@@ -21,18 +21,21 @@ def paraview_command(
     ] = None,
 ) -> None:
     """Write one VTK PolyData file per saved step plus a .pvd index for ParaView."""
-    from rich.console import Console
-
+    from cablelife.clitext import console as make_console
+    from cablelife.clitext import escape, print_error, printed_warnings
     from cablelife.export.paraview import write_paraview
     from cablelife.plots.fatigue_data import damage_maps
     from cablelife.results import load_result
 
-    err = Console(stderr=True)
+    err = make_console(stderr=True)
     written = []
     try:
         if every < 1:
             raise ValueError(f"every = {every}: must be >= 1")
-        res = load_result(result)
+        if output.is_dir():
+            raise ValueError(f"--output {str(output)!r} is a directory; give a .pvd file")
+        with printed_warnings(err):
+            res = load_result(result)
         names = [cable] if cable is not None else list(res.cables)
         maps = damage_maps(damage) if damage is not None else {}
         if maps and not set(maps) & set(names):
@@ -55,8 +58,8 @@ def paraview_command(
 
         done = ", ".join(map(str, written)) or "none"
         raise interrupted(f"complete time series: {done}; frame files of the others kept") from None
-    except (ValueError, FileNotFoundError) as e:
-        err.print(f"[bold red]error:[/] {e}", highlight=False, soft_wrap=True)
+    except (ValueError, FileNotFoundError, OSError) as e:
+        print_error(err, e)
         raise typer.Exit(2) from None
     for p in written:
-        Console().print(f"ParaView time series written to {p}")
+        make_console().print(escape(f"ParaView time series written to {p}"))

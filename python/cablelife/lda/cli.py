@@ -38,15 +38,17 @@ def lda_command(
     hot_spots: Annotated[int, typer.Option(help="Hot spots to list.")] = 5,
 ) -> None:
     """Comparative load data analysis: pseudo-damage map of a result."""
-    from rich.console import Console
     from rich.progress import Progress
 
+    from cablelife.clitext import console as make_console
+    from cablelife.clitext import escape, print_error, print_warning
     from cablelife.lda.pipeline import analyse, default_damage_path
-    from cablelife.lda.sampling import SamplingWarning
     from cablelife.lda.settings import LdaSettings
 
-    console = Console()
+    console = make_console()
     try:
+        if hot_spots < 0:
+            raise ValueError(f"--hot-spots = {hot_spots}: allowed: 0 or more")
         settings = LdaSettings.from_options(
             wohler_k=wohler_k,
             wohler_alpha=wohler_alpha,
@@ -62,29 +64,29 @@ def lda_command(
             Progress(console=console, transient=True) as bar,
             warnings.catch_warnings(record=True) as caught,
         ):
-            warnings.simplefilter("always", SamplingWarning)
+            warnings.simplefilter("always")  # sampling, partial results
             tasks = {}
 
             def progress(cable, done, total):
                 if cable not in tasks:
-                    tasks[cable] = bar.add_task(f"LDA {cable}", total=total)
+                    tasks[cable] = bar.add_task(escape(f"LDA {cable}"), total=total)
                 bar.update(tasks[cable], completed=done)
 
             analysis = analyse(
                 result, threads=threads, progress=progress, **settings.analyse_kwargs()
             )
         for w in caught:
-            console.print(f"[yellow]warning:[/] {w.message}", soft_wrap=True)
+            print_warning(console, w.message)
         path = analysis.save(output or default_damage_path(result))
     except KeyboardInterrupt:
         from cablelife.interrupt import interrupted
 
         raise interrupted("no damage file written") from None
-    except (ValueError, FileNotFoundError) as e:
-        console.print(f"[red]error:[/] {e}", soft_wrap=True)
-        raise typer.Exit(1) from e
-    console.print(analysis.summary(hot_spots), soft_wrap=True, highlight=False)
-    console.print(f"damage file: {path}")
+    except (ValueError, FileNotFoundError, OSError) as e:
+        print_error(console, e)
+        raise typer.Exit(2) from None
+    console.print(escape(analysis.summary(hot_spots)), soft_wrap=True, highlight=False)
+    console.print(escape(f"damage file: {path}"))
 
 
 def compare_command(
@@ -96,16 +98,19 @@ def compare_command(
     ] = False,
 ) -> None:
     """Rank variants by maximum pseudo-damage, with ratios to the best and hot spots."""
-    from rich.console import Console
-
+    from cablelife.clitext import console as make_console
+    from cablelife.clitext import escape, print_error, printed_warnings
     from cablelife.lda.compare import compare
 
-    console = Console()
+    console = make_console()
     try:
+        if hot_spots < 0:
+            raise ValueError(f"--hot-spots = {hot_spots}: allowed: 0 or more")
         names = None if labels is None else [s.strip() for s in labels.split(",")]
-        cmp = compare(files, names, check_settings=not force, n_hot_spots=hot_spots)
-    except (ValueError, FileNotFoundError, TypeError) as e:
-        console.print(f"[red]error:[/] {e}", soft_wrap=True)
-        raise typer.Exit(1) from e
-    console.print(cmp.table(hot_spots), soft_wrap=True, highlight=False)
-    console.print(f"best: {cmp.best.label}")
+        with printed_warnings(console):  # partial results, sampling
+            cmp = compare(files, names, check_settings=not force, n_hot_spots=hot_spots)
+    except (ValueError, FileNotFoundError, TypeError, OSError) as e:
+        print_error(console, e)
+        raise typer.Exit(2) from None
+    console.print(escape(cmp.table(hot_spots)), soft_wrap=True, highlight=False)
+    console.print(escape(f"best: {cmp.best.label}"))

@@ -40,6 +40,7 @@ from cablelife.lda.rainflow import RainflowMatrix
 from cablelife.lda.sampling import SamplingCheck
 from cablelife.lda.stress import CircularSection
 from cablelife.lda.wohler import WohlerCurve
+from cablelife.resultcheck import check_damage_file, check_damage_values
 
 FORMAT = "cablelife-damage"
 FORMAT_VERSION = 1
@@ -149,6 +150,7 @@ def is_damage_file(path: str | os.PathLike) -> bool:
 def load_damage(path: str | os.PathLike) -> DamageAnalysis:
     """Read a damage file written by :func:`save_damage`."""
     with open_h5(path, FORMAT, "damage") as f:
+        check_damage_file(f, path)  # shapes and sizes before reading
         a = {k: plain(v) for k, v in f.attrs.items()}
         curve = WohlerCurve.from_attrs(a)
         settings = {
@@ -186,4 +188,8 @@ def load_damage(path: str | os.PathLike) -> DamageAnalysis:
                 sampling=sampling,
                 rainflow=_get_rainflow(g["rainflow"], name) if "rainflow" in g else None,
             )
-    return DamageAnalysis(cables=cables, curve=curve, settings=settings, source=str(a["source"]))
+    analysis = DamageAnalysis(
+        cables=cables, curve=curve, settings=settings, source=str(a["source"])
+    )
+    check_damage_values(analysis, path)
+    return analysis

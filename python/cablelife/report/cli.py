@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Annotated
 
@@ -14,11 +15,15 @@ def is_result_file(path: Path) -> bool:
 
     from cablelife.results import FORMAT
 
+    if path.is_dir():
+        raise ValueError(f"{str(path)!r} is a directory; give result and damage files")
     try:
         with h5py.File(path, "r") as f:
             return f.attrs.get("format") == FORMAT
-    except OSError as e:
-        raise ValueError(f"{str(path)!r} is not a readable HDF5 file: {e}") from None
+    except OSError:
+        raise ValueError(
+            f"{str(path)!r} is not a readable HDF5 file (truncated, empty or of another kind)"
+        ) from None
 
 
 def _made_from(source: str, damage: Path, result: Path) -> bool:
@@ -58,7 +63,7 @@ def attach_damage(results: list[Path], damages: list[tuple[Path, object]]) -> di
 def report_runs(files: list[Path]):
     """Result files become runs (labelled by file stem); each damage file (``cablelife lda``)
     is attached to the result it was made from, else to the results in order."""
-    from cablelife.lda.io import load_damage
+    from cablelife.lda.io import is_damage_file, load_damage
     from cablelife.report.html import ReportRun
     from cablelife.results import load_result
 
@@ -68,8 +73,13 @@ def report_runs(files: list[Path]):
             raise FileNotFoundError(f"file {str(p)!r} does not exist")
         if is_result_file(p):
             results.append(p)
-        else:
+        elif is_damage_file(p):
             damages.append((p, load_damage(p)))
+        else:
+            raise ValueError(
+                f"{str(p)!r} is not a cablelife result file nor a damage file (format "
+                "attribute); give RESULT.h5 files and their damage files (cablelife lda)"
+            )
     if not results:
         raise ValueError("files: give at least one result file (RESULT.h5)")
     attached = attach_damage(results, damages)
@@ -100,15 +110,18 @@ def report_command(
     ] = 10.0,
 ) -> None:
     """Write a self-contained HTML report (works offline) of one or several runs."""
-    from rich.console import Console
-
+    from cablelife.clitext import console as make_console
+    from cablelife.clitext import escape, print_error, printed_warnings
     from cablelife.report.html import write_report
     from cablelife.volume.cli import parse_length
 
-    err = Console(stderr=True)
+    err = make_console(stderr=True)
     try:
+        if not (math.isfinite(bend_factor) and bend_factor > 0):
+            raise ValueError(f"--bend-factor = {bend_factor}: allowed: a number > 0")
         h = None if voxel.strip().lower() == "none" else parse_length(voxel)
-        runs = report_runs(files)
+        with printed_warnings(err):  # partial results
+            runs = report_runs(files)
         path = write_report(
             output, runs, color_by=color_by, frames=frames, voxel=h, bend_factor=bend_factor
         )
@@ -116,8 +129,8 @@ def report_command(
         from cablelife.interrupt import interrupted
 
         raise interrupted("no report written") from None
-    except (ValueError, FileNotFoundError) as e:
-        err.print(f"[bold red]error:[/] {e}", highlight=False, soft_wrap=True)
+    except (ValueError, FileNotFoundError, OSError) as e:
+        print_error(err, e)
         raise typer.Exit(2) from None
     size = path.stat().st_size / 1e6
-    Console().print(f"report written to {path} ({size:.1f} MB)")
+    make_console().print(escape(f"report written to {path} ({size:.1f} MB)"))

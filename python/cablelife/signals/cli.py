@@ -31,6 +31,12 @@ def signal_command(
         Path | None, typer.Option("--plot", help="PNG file (default: OUTPUT with .png).")
     ] = None,
     no_plot: Annotated[bool, typer.Option("--no-plot", help="Do not write the PNG.")] = False,
+    allow_outside_files: Annotated[
+        bool,
+        typer.Option(
+            "--allow-outside-files", help="read measured-signal files also outside SPEC's folder"
+        ),
+    ] = False,
     derivatives: Annotated[
         bool,
         typer.Option(
@@ -40,15 +46,15 @@ def signal_command(
 ) -> None:
     """Generate excitation signals from SPEC; write them (CSV or HDF5) and a PNG with the time
     history and the Welch PSD over the target."""
-    out = Console()
-    err = Console(stderr=True)
+    out = Console(emoji=False, highlight=False)
+    err = Console(stderr=True, emoji=False, highlight=False)
     output = output or spec.with_suffix(".csv")
     plot_path = None if no_plot else (plot or output.with_suffix(".png"))
     try:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             settings = load_spec(spec)
-            time, series = generate_channels(settings, base_dir=spec.parent)
+            time, series = generate_channels(settings, spec.parent, allow_outside_files)
             write_signals(output, time, series, derivatives, spec.read_text(encoding="utf-8"))
             if plot_path is not None:
                 from cablelife.signals.plot import plot_signals
@@ -56,26 +62,33 @@ def signal_command(
                 plot_signals(plot_path, time, series)
     except (SignalError, OSError) as error:
         err.print(f"[red]error:[/red] {escape(str(error))}", highlight=False, soft_wrap=True)
-        raise typer.Exit(code=1) from None
+        raise typer.Exit(code=2) from None
     for w in caught:
         err.print(
             f"[yellow]warning:[/yellow] {escape(str(w.message))}", highlight=False, soft_wrap=True
         )
 
-    table = Table(title=f"{spec.name}: {time.size} samples, step {settings.signal.time_step:g} s")
+    table = Table(
+        title=escape(f"{spec.name}: {time.size} samples, step {settings.signal.time_step:g} s")
+    )
     for column in ("channel", "frame", "type", "quantity", "RMS", "target RMS", "unit"):
         table.add_column(column)
     for s in series:
         quantity, rms, target = rms_summary(s, settings.signal.time_step)
         unit = {"displacement": "", "velocity": "/s", "acceleration": "/s^2"}[quantity]
         table.add_row(
-            s.name,
-            s.motion.frame,
-            s.motion.signal.type,
-            quantity,
-            f"{rms:.5g}",
-            "" if target is None else f"{target:.5g}",
-            s.motion.unit + unit,
+            *map(
+                escape,
+                (
+                    s.name,
+                    s.motion.frame,
+                    s.motion.signal.type,
+                    quantity,
+                    f"{rms:.5g}",
+                    "" if target is None else f"{target:.5g}",
+                    s.motion.unit + unit,
+                ),
+            )
         )
     out.print(table)
-    out.print(f"wrote {output}" + ("" if plot_path is None else f" and {plot_path}"))
+    out.print(escape(f"wrote {output}" + ("" if plot_path is None else f" and {plot_path}")))

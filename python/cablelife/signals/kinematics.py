@@ -47,6 +47,11 @@ class Kinematics:
         return cls(np.zeros(n), np.zeros(n), np.zeros(n))
 
 
+# Samples of one time grid: each channel keeps value, velocity and acceleration (3 × 8 bytes
+# per sample), so this bounds a channel at 1.2 GB.
+MAX_SAMPLES = 50_000_000
+
+
 def time_grid(duration: float, time_step: float, start: float = 0.0) -> np.ndarray:
     """Uniform grid ``start, start + dt, ...`` up to ``start + duration`` (inclusive, rounded)."""
     if not (np.isfinite(duration) and duration > 0):
@@ -58,8 +63,14 @@ def time_grid(duration: float, time_step: float, start: float = 0.0) -> np.ndarr
             f"time_step: {time_step:g} s is longer than the duration {duration:g} s; "
             "allowed: time_step <= duration"
         )
-    steps = int(np.floor(duration / time_step + 1e-9))
-    return start + time_step * np.arange(steps + 1)
+    steps = float(np.floor(duration / time_step + 1e-9))  # float: inf for absurd input
+    if steps + 1 > MAX_SAMPLES:
+        raise SignalError(
+            f"time_step: {time_step:g} s over {duration:g} s is {steps + 1:.4g} samples; "
+            f"allowed: at most {MAX_SAMPLES:.0e} per channel (memory); use a larger time_step "
+            "or a shorter duration"
+        )
+    return start + time_step * np.arange(int(steps) + 1)
 
 
 def time_step_of(time: np.ndarray) -> float:

@@ -10,6 +10,7 @@ are the spline's derivatives.
 from __future__ import annotations
 
 import io
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -17,6 +18,7 @@ import numpy as np
 from scipy.interpolate import CubicSpline
 from scipy.signal import butter, sosfiltfilt
 
+from cablelife.paths import SceneFileError, resolve_scene_file, shown_names
 from cablelife.signals.errors import SignalError
 from cablelife.signals.kinematics import Kinematics, time_step_of
 from cablelife.signals.spec import MeasuredSignal
@@ -66,7 +68,7 @@ def _find_column(names: list[str], wanted: str, path: Path, what: str) -> int:
     if wanted.lower() in lowered:
         return lowered.index(wanted.lower())
     raise SignalError(
-        f"file {str(path)!r}: {what} {wanted!r} not found; columns: {', '.join(names)}"
+        f"file {str(path)!r}: {what} {wanted!r} not found; columns: {shown_names(names)}"
     )
 
 
@@ -75,7 +77,13 @@ def read_csv(path: Path, channel: str, time_channel: str = "time") -> Record:
 
     Lines starting with ``#`` are comments.
     """
-    text = path.read_text(encoding="utf-8-sig")
+    try:
+        text = path.read_text(encoding="utf-8-sig")
+    except UnicodeDecodeError as err:
+        raise SignalError(
+            f"file {str(path)!r}: not UTF-8 text (invalid byte at offset {err.start}); a CSV "
+            "file must be UTF-8 text with a header row of column names"
+        ) from None
     lines = text.splitlines()
     header_row = next(
         (i for i, line in enumerate(lines) if line.strip() and not line.lstrip().startswith("#")),
@@ -101,9 +109,11 @@ def read_csv(path: Path, channel: str, time_channel: str = "time") -> Record:
             dtype=float,
         )
     except ValueError as err:
+        # where, not what: the message must not quote the file's content
+        where = re.search(r"row \d+, column \d+", str(err))
         raise SignalError(
             f"file {str(path)!r}: cannot read columns {names[t_col]!r} and {names[v_col]!r} as "
-            f"numbers ({err}; rows counted after the header)"
+            f"numbers ({where.group(0) + ' after the header' if where else 'a non-numeric value'})"
         ) from None
     return Record(data[:, 0], data[:, 1], f"file {str(path)!r}, channel {names[v_col]!r}")
 
@@ -115,7 +125,11 @@ def read_mdf4(path: Path, channel: str, group: str | int | None = None) -> Recor
     try:
         mdf = MDF(path)
     except Exception as err:  # asammdf raises many types for foreign files
-        raise SignalError(f"file {str(path)!r}: cannot read as ASAM MDF ({err})") from None
+        # the reader's message may quote the file's first bytes: named by type only
+        raise SignalError(
+            f"file {str(path)!r}: cannot read as ASAM MDF ({type(err).__name__}: not an MDF "
+            "file, or damaged)"
+        ) from None
     try:
         occurrences = mdf.channels_db.get(channel)
         if not occurrences:
@@ -170,7 +184,10 @@ def read_tdms(
     try:
         tdms = TdmsFile.read(path)
     except Exception as err:
-        raise SignalError(f"file {str(path)!r}: cannot read as TDMS ({err})") from None
+        raise SignalError(
+            f"file {str(path)!r}: cannot read as TDMS ({type(err).__name__}: not a TDMS file, "
+            "or damaged)"
+        ) from None
     holding = [g for g in tdms.groups() if channel in [c.name for c in g.channels()]]
     if group is not None:
         holding = [g for g in holding if g.name == str(group)]
@@ -280,9 +297,20 @@ def resample(
     return Kinematics(spline(t), spline(t, 1), spline(t, 2)), inside
 
 
-def measured(spec: MeasuredSignal, time: np.ndarray, base_dir: Path | None = None) -> Kinematics:
-    """The measured displacement/angle (SI) with derivatives on the simulation grid ``time``."""
-    path = spec.file if spec.file.is_absolute() or base_dir is None else base_dir / spec.file
+def measured(
+    spec: MeasuredSignal,
+    time: np.ndarray,
+    base_dir: Path | None = None,
+    allow_outside: bool = False,
+) -> Kinematics:
+    """The measured displacement/angle (SI) with derivatives on the simulation grid ``time``;
+    ``spec.file`` follows the rule of files named in scenes (cablelife.paths)."""
+    try:
+        path = resolve_scene_file(
+            base_dir, spec.file, allow_outside, f"measured signal (channel {spec.channel!r}) file"
+        )
+    except SceneFileError as err:
+        raise SignalError(str(err)) from None
     record = read_record(path, spec.channel, spec.resolved_format, spec.time_channel, spec.group)
     unit = spec.amplitude_unit
     factor = spec.scale * (unit.factor if unit else 1.0)

@@ -104,6 +104,7 @@ def body_motion(
     time: np.ndarray,
     base_dir: Path | None = None,
     orientation: np.ndarray | None = None,
+    allow_outside: bool = False,
 ) -> BodyMotion:
     """Combine a body's channel signals into its rigid motion on the uniform grid ``time``.
 
@@ -119,7 +120,7 @@ def body_motion(
     channels: dict[tuple[str, str], Kinematics] = {}
     for motion in motions:
         key = (motion.frame, motion.channel)
-        kin = kinematics(motion.signal, t, base_dir)
+        kin = kinematics(motion.signal, t, base_dir, allow_outside)
         channels[key] = channels[key] + kin if key in channels else kin
     zero = Kinematics.zeros(n)
 

@@ -11,7 +11,7 @@ import math
 from pathlib import Path
 from typing import Annotated, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import BaseModel, ConfigDict, Field, Strict, model_validator
 
 from cablelife.signals.profiles import get_profile
 from cablelife.signals.psd import PowerLawPsd
@@ -28,8 +28,10 @@ Frame = Literal["global", "body"]
 TRANSLATIONS = ("x", "y", "z")
 ROTATIONS = ("rx", "ry", "rz")
 
-PositiveFloat = Annotated[float, Field(gt=0)]
-NonNegativeFloat = Annotated[float, Field(ge=0)]
+# Strict numbers: a TOML number is a number (ints are fine), booleans and strings are refused.
+Real = Annotated[float, Strict()]
+PositiveFloat = Annotated[float, Strict(), Field(gt=0)]
+NonNegativeFloat = Annotated[float, Strict(), Field(ge=0)]
 
 
 class _Spec(BaseModel):
@@ -63,8 +65,8 @@ class SineSignal(_Spec):
     type: Literal["sine"]
     amplitude: NonNegativeFloat
     frequency: PositiveFloat  # Hz
-    phase: float = 0.0  # rad
-    offset: float = 0.0  # m or rad
+    phase: Real = 0.0  # rad
+    offset: Real = 0.0  # m or rad
     quantity: Quantity = "displacement"
     unit: str | None = None  # of amplitude; default SI (m, m/s, m/s² or rad, ...)
     fade_in: NonNegativeFloat = 0.0  # s
@@ -97,7 +99,7 @@ class SweepSignal(_Spec):
     amplitude: NonNegativeFloat
     quantity: Quantity = "displacement"
     unit: str | None = None
-    phase: float = 0.0  # rad
+    phase: Real = 0.0  # rad
     fade: NonNegativeFloat = 0.0  # s, at start and end
 
     @model_validator(mode="after")
@@ -152,7 +154,7 @@ class PsdSignal(_Spec):
     quantity: Quantity | None = None
     unit: str | None = None
     scale: PositiveFloat = 1.0
-    seed: Annotated[int, Field(ge=0)] = 0
+    seed: Annotated[int, Strict(), Field(ge=0)] = 0
     f_low: PositiveFloat | None = None  # Hz
     f_high: PositiveFloat | None = None  # Hz
     fade_in: NonNegativeFloat = 0.0  # s
@@ -261,9 +263,9 @@ class MeasuredSignal(_Spec):
     time_channel: str | None = None  # CSV default "time"; TDMS default: waveform properties
     group: str | int | None = None  # TDMS group name / MDF group index, if the name repeats
     unit: str | None = None  # of the file values (displacement/angle), default m or rad
-    scale: float = 1.0
+    scale: Real = 1.0
     remove_offset: Literal["none", "mean", "first"] = "none"
-    start_time: float | None = None  # s, file time
+    start_time: Real | None = None  # s, file time
     beyond_end: Literal["error", "hold", "zero"] = "error"
 
     @model_validator(mode="after")
@@ -299,8 +301,8 @@ class TableSignal(_Spec):
     """
 
     type: Literal["table"]
-    t: list[float]
-    value: list[float]
+    t: list[Real]
+    value: list[Real]
     unit: str | None = None  # displacement/angle unit, default m or rad
     interpolation: Literal["linear", "pchip", "cubic"] = "linear"
 
@@ -378,7 +380,7 @@ class SignalSettings(_Spec):
 
     duration: PositiveFloat  # s
     time_step: PositiveFloat  # s
-    start: float = 0.0  # s
+    start: Real = 0.0  # s
 
     @model_validator(mode="after")
     def _check(self) -> SignalSettings:

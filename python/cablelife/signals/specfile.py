@@ -60,13 +60,13 @@ def load_spec(path: Path) -> SignalFile:
 
 
 def generate_channels(
-    spec: SignalFile, base_dir: Path | None = None
+    spec: SignalFile, base_dir: Path | None = None, allow_outside: bool = False
 ) -> tuple[np.ndarray, list[ChannelSeries]]:
     """The time grid and every channel of a spec."""
     settings = spec.signal
     time = time_grid(settings.duration, settings.time_step, settings.start)
     series = [
-        ChannelSeries(name, ch, kinematics(ch.signal, time, base_dir))
+        ChannelSeries(name, ch, kinematics(ch.signal, time, base_dir, allow_outside))
         for name, ch in zip(spec.channel_names(), spec.channels, strict=True)
     ]
     return time, series

@@ -65,20 +65,28 @@ def study_command(
     tls_key: Annotated[
         Path | None, typer.Option(help="TLS: this client's private key (PEM) [in --tls-cert].")
     ] = None,
+    allow_outside_files: Annotated[
+        bool,
+        typer.Option(
+            "--allow-outside-files",
+            help="read files named in the scene also outside the scene's folder",
+        ),
+    ] = False,
 ) -> None:
     """Run a variant study on Dask: simulate, LDA and summary per variant, ranked by damage.
 
     A re-run skips finished variants; failed ones are reported and computed again next time.
     """
-    from rich.console import Console
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
     from rich.table import Table
 
+    from cablelife.clitext import console as make_console
+    from cablelife.clitext import escape, print_error
     from cablelife.study.runner import run_study
     from cablelife.study.spec import StudyError
 
-    console = Console()
-    err = Console(stderr=True)
+    console = make_console()
+    err = make_console(stderr=True)
     columns = (
         TextColumn("variants"),
         BarColumn(),
@@ -87,14 +95,19 @@ def study_command(
         TextColumn("{task.description}"),
     )
     try:
+        if workers is not None and workers < 1:
+            raise StudyError(f"--workers = {workers}: allowed: 1 or more")
         with Progress(*columns, console=console, transient=True) as bar:
             task = bar.add_task("", total=None)
 
             def progress(done: int, total: int, row: dict) -> None:
                 last = row.get("variant", "")
                 if row.get("status") == "failed":
-                    console.print(f"[red]variant {last} failed:[/] {row.get('error', '')}")
-                bar.update(task, completed=done, total=total, description=last)
+                    console.print(
+                        f"[red]{escape(f'variant {last} failed:')}[/] "
+                        f"{escape(str(row.get('error', '')))}"
+                    )
+                bar.update(task, completed=done, total=total, description=escape(str(last)))
 
             outcome = run_study(
                 study,
@@ -103,6 +116,7 @@ def study_command(
                 workers=workers,
                 progress=progress,
                 security=tls_security(scheduler, tls_ca_file, tls_cert, tls_key),
+                allow_outside_files=allow_outside_files,
             )
     except KeyboardInterrupt:
         from cablelife.interrupt import interrupted
@@ -110,34 +124,36 @@ def study_command(
         raise interrupted(
             "finished variants are kept; the same command computes the others"
         ) from None
-    except (StudyError, ConnectionError, FileNotFoundError) as e:
-        err.print(f"[bold red]error:[/] {e}", highlight=False, soft_wrap=True)
+    except (StudyError, ConnectionError, FileNotFoundError, OSError) as e:
+        print_error(err, e)
         raise typer.Exit(2) from None
     frame = outcome.table
-    t = Table(title=f"study {outcome.out_dir}", title_justify="left")
+    t = Table(title=escape(f"study {outcome.out_dir}"), title_justify="left")
     shown = ["rank", "variant", *outcome.parameters, "max_damage", "ratio_to_best"]
     shown += ["hot_spot_s_m", "hot_spot_clip", "motion_volume_l", "status"]
     shown = [c for c in shown if c in frame]
     for c in shown:
-        t.add_column(c, justify="left" if c in ("variant", "hot_spot_clip", "status") else "right")
+        t.add_column(
+            escape(c), justify="left" if c in ("variant", "hot_spot_clip", "status") else "right"
+        )
     for _, r in frame.head(20).iterrows():
         t.add_row(
             *[
-                _fmt(r[c]) if c not in ("variant", "hot_spot_clip", "status") else str(r[c])
+                escape(_fmt(r[c]) if c not in ("variant", "hot_spot_clip", "status") else str(r[c]))
                 for c in shown
             ]
         )
     console.print(t)
     if len(frame) > 20:
-        console.print(f"… {len(frame) - 20} more in {outcome.csv}")
+        console.print(escape(f"… {len(frame) - 20} more in {outcome.csv}"))
     console.print(
         f"{len(outcome.computed)} computed, {len(outcome.skipped)} already finished, "
         f"{len(outcome.failed)} failed"
     )
     for name, e in outcome.failed.items():
-        console.print(f"[red]failed[/] {name}: {e}", highlight=False)
-    console.print(f"summary: {outcome.csv}, {outcome.parquet}")
+        console.print(f"[red]failed[/] {escape(f'{name}: {e}')}", highlight=False)
+    console.print(escape(f"summary: {outcome.csv}, {outcome.parquet}"))
     if outcome.plot is not None:
-        console.print(f"plot: {outcome.plot}")
+        console.print(escape(f"plot: {outcome.plot}"))
     if outcome.failed:
         raise typer.Exit(1)

@@ -99,6 +99,7 @@ def run_study(
     workers: int | None = None,
     progress: Callable[[int, int, dict], None] | None = None,
     security=None,
+    allow_outside_files: bool = False,
 ) -> StudyOutcome:
     """Runs every unfinished variant of the study and writes the summary table and plot.
 
@@ -106,7 +107,7 @@ def run_study(
     ``security``: a ``distributed.security.Security`` for a ``tls://`` scheduler address.
     """
     study, study_dir = load_study(study_path)
-    variants = expand(study, study_dir)
+    variants = expand(study, study_dir, allow_outside_files)
     out = Path(out_dir) if out_dir is not None else default_out_dir(study_path, study)
     out.mkdir(parents=True, exist_ok=True)
     write_atomic(out / "study.toml", lambda f: f.write(Path(study_path).read_bytes()))

@@ -51,10 +51,17 @@ def _grid_name(values: dict[str, float]) -> str:
     return _safe("_".join(f"{k}={v:g}" for k, v in values.items()))
 
 
-def base_scene(study: StudyFile, study_dir: Path) -> tuple[dict, Path]:
-    """The base scene dict with the study's mode/duration overrides, and its directory."""
+def base_scene(
+    study: StudyFile, study_dir: Path, allow_outside_files: bool = False
+) -> tuple[dict, Path]:
+    """The base scene dict with the study's mode/duration overrides, and its directory;
+    ``allow_outside_files`` sets the scene's ``files.allow_outside`` (CLI flag)."""
     path = study.study.scene if study.study.scene.is_absolute() else study_dir / study.study.scene
     data = read_toml(path, "study.scene: scene file", StudyError)
+    if allow_outside_files:
+        files = data.setdefault("files", {})
+        if isinstance(files, dict):
+            files["allow_outside"] = True
     sim = data.setdefault("simulation", {})
     if study.study.mode is not None:
         sim["mode"] = study.study.mode
@@ -63,9 +70,9 @@ def base_scene(study: StudyFile, study_dir: Path) -> tuple[dict, Path]:
     return data, path.parent.resolve()
 
 
-def expand(study: StudyFile, study_dir: Path) -> list[Variant]:
+def expand(study: StudyFile, study_dir: Path, allow_outside_files: bool = False) -> list[Variant]:
     """All variants, each scene validated (a bad value fails here, before any run)."""
-    base, scene_dir = base_scene(study, study_dir)
+    base, scene_dir = base_scene(study, study_dir, allow_outside_files)
     params = {p.name: p for p in study.parameters}
     if study.study.combine == "grid":
         combos = [

@@ -44,15 +44,16 @@ def volume_command(
     unit: Annotated[str, typer.Option(help="length unit in the mesh file: m or mm")] = "m",
 ) -> None:
     """Motion volume (union of the tube over all saved steps) as a watertight mesh."""
-    from rich.console import Console
     from rich.table import Table
 
+    from cablelife.clitext import console as make_console
+    from cablelife.clitext import escape, print_error, printed_warnings
     from cablelife.results import load_result
     from cablelife.volume.compare import compare_volumes
     from cablelife.volume.motion import motion_volume
 
-    console = Console()
-    err = Console(stderr=True)
+    console = make_console()
+    err = make_console(stderr=True)
 
     def source(path: Path):
         res = load_result(path)
@@ -66,26 +67,29 @@ def volume_command(
 
     a_saved = False
     try:
+        if unit not in ("m", "mm"):
+            raise ValueError(f"unit = {unit!r}: allowed: 'm' or 'mm'")
         h = parse_length(voxel)
-        a = motion_volume(source(result), h)
-        a.save(output, unit=unit)
-        a_saved = True
-        b = motion_volume(source(compare), h) if compare is not None else None
+        with printed_warnings(err):
+            a = motion_volume(source(result), h)
+            a.save(output, unit=unit)
+            a_saved = True
+            b = motion_volume(source(compare), h) if compare is not None else None
     except KeyboardInterrupt:
         from cablelife.interrupt import interrupted
 
         kept = f"the mesh was saved to {output}" if a_saved else "no mesh written"
         raise interrupted(kept) from None
-    except (ValueError, FileNotFoundError) as e:
-        err.print(f"[bold red]error:[/] {e}", highlight=False, soft_wrap=True)
+    except (ValueError, FileNotFoundError, OSError) as e:
+        print_error(err, e)
         raise typer.Exit(2) from None
     t = Table(title=f"motion volume at {h * 1e3:g} mm voxels", title_justify="left")
     t.add_column("run")
-    t.add_column("volume [l]", justify="right")
+    t.add_column(escape("volume [l]"), justify="right")
     t.add_column("bounding box")
-    t.add_row(result.name, f"{a.litres:.4g}", _fmt_box(a.bounding_box))
+    t.add_row(escape(result.name), f"{a.litres:.4g}", escape(_fmt_box(a.bounding_box)))
     if b is not None:
-        t.add_row(compare.name, f"{b.litres:.4g}", _fmt_box(b.bounding_box))
+        t.add_row(escape(compare.name), f"{b.litres:.4g}", escape(_fmt_box(b.bounding_box)))
     console.print(t)
     if b is not None:
         c = compare_volumes(a, b)
@@ -103,4 +107,4 @@ def volume_command(
         ct.add_row("A sticks out of B by", f"{c.a_beyond_b.distance * 1e3:.2f} mm")
         ct.add_row("B sticks out of A by", f"{c.b_beyond_a.distance * 1e3:.2f} mm")
         console.print(ct)
-    console.print(f"mesh saved to {output}")
+    console.print(escape(f"mesh saved to {output}"))
