@@ -188,6 +188,8 @@ def schema(
         return
     from cablelife.atomic import write_text_atomic
 
+    if not output.parent.is_dir():
+        raise fail(f"--output {str(output)!r} is in a folder that does not exist")
     try:
         write_text_atomic(output, text + "\n")
     except OSError as err:
