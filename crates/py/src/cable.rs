@@ -52,6 +52,12 @@ struct Record {
     iterations: Vec<i64>,
     substeps: Vec<i64>,
     residual: Vec<f64>,
+    /// Negative eigenvalues of the tangent stiffness (−1: not checked, dynamic steps).
+    unstable: Vec<i64>,
+    /// Snap-through in the step: fraction of the step, largest jump (m) and its node.
+    snap_fraction: Vec<f64>,
+    snap_jump: Vec<f64>,
+    snap_node: Vec<i64>,
     elastic_energy: Vec<f64>,
     kinetic_energy: Vec<f64>,
     load_potential: Vec<f64>,
@@ -73,6 +79,10 @@ impl Record {
             iterations: Vec::with_capacity(n),
             substeps: Vec::with_capacity(n),
             residual: Vec::with_capacity(n),
+            unstable: Vec::with_capacity(n),
+            snap_fraction: Vec::with_capacity(n),
+            snap_jump: Vec::with_capacity(n),
+            snap_node: Vec::with_capacity(n),
             elastic_energy: Vec::with_capacity(n),
             kinetic_energy: Vec::with_capacity(n),
             load_potential: Vec::with_capacity(n),
@@ -102,6 +112,19 @@ impl Record {
         self.iterations.push(stats.iterations as i64);
         self.substeps.push(stats.substeps as i64);
         self.residual.push(stats.residual);
+        self.unstable.push(stats.unstable as i64);
+        let snap = stats.snap.unwrap_or(rod::Snap {
+            fraction: f64::NAN,
+            jump: 0.0,
+            node: 0,
+        });
+        self.snap_fraction.push(snap.fraction);
+        self.snap_jump.push(snap.jump);
+        self.snap_node.push(if stats.snap.is_some() {
+            snap.node as i64
+        } else {
+            -1
+        });
         self.elastic_energy.push(ws.elastic_energy);
         self.load_potential.push(ws.load_potential);
     }
@@ -139,6 +162,10 @@ impl Record {
         d.set_item("iterations", PyArray1::from_vec(py, self.iterations))?;
         d.set_item("substeps", PyArray1::from_vec(py, self.substeps))?;
         d.set_item("residual", PyArray1::from_vec(py, self.residual))?;
+        d.set_item("unstable", PyArray1::from_vec(py, self.unstable))?;
+        d.set_item("snap_fraction", PyArray1::from_vec(py, self.snap_fraction))?;
+        d.set_item("snap_jump", PyArray1::from_vec(py, self.snap_jump))?;
+        d.set_item("snap_node", PyArray1::from_vec(py, self.snap_node))?;
         for (key, values) in [
             ("elastic_energy", self.elastic_energy),
             ("kinetic_energy", self.kinetic_energy),
@@ -479,8 +506,10 @@ impl Cable {
                                 iterations: s.iterations,
                                 residual: s.residual,
                                 substeps: s.substeps - 1,
+                                ..Default::default()
                             };
                             rec.push(rod, &st, &dy.ws, &stats);
+                            *rec.unstable.last_mut().expect("pushed") = -1;
                             rec.push_energies(&dy.energies);
                         }
                     }

@@ -2,10 +2,11 @@
 //! search on the scaled residual, load continuation when plain Newton fails, and sub-stepped
 //! clip motions for sequences of equilibria.
 use crate::assembly::{KinkAt, Workspace};
-use crate::model::{Pose, Rod};
+use crate::model::{NodeKind, Pose, Rod};
 use crate::rotation::slerp;
+use crate::stability::{free_rigid_motions, Inertia, StabilityCheck};
 use crate::state::State;
-use nalgebra::Vector6;
+use nalgebra::{Vector3, Vector6};
 use std::fmt;
 
 #[derive(Clone, Debug)]
@@ -44,6 +45,34 @@ pub struct SolveStats {
     pub residual: f64,
     /// Number of continuation or sub-steps used (0: plain Newton worked).
     pub substeps: usize,
+    /// Negative eigenvalues of the tangent stiffness at the returned state (0: stable).
+    pub unstable: usize,
+    /// Unstable equilibria met and left on the way (see `Statics::ensure_stable`).
+    pub escapes: usize,
+    /// The largest jump to another stable branch in a quasistatic step, if any.
+    pub snap: Option<Snap>,
+}
+
+/// A snap-through: the equilibrium branch ended (or became unstable) inside a step and the
+/// cable jumped to another stable equilibrium.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Snap {
+    /// Fraction of the step's clip motion at which it happened.
+    pub fraction: f64,
+    /// Largest node displacement of the jump, m, and that node.
+    pub jump: f64,
+    pub node: usize,
+}
+
+impl SolveStats {
+    /// Keeps the larger snap of two.
+    fn merge_snap(&mut self, other: Option<Snap>) {
+        if let Some(o) = other {
+            if self.snap.is_none_or(|s| o.jump > s.jump) {
+                self.snap = Some(o);
+            }
+        }
+    }
 }
 
 #[derive(Clone, Debug)]
@@ -55,6 +84,13 @@ pub enum SolveError {
     Singular {
         node: usize,
         s: f64,
+    },
+    /// The clips leave a rigid-body motion of a part of the cable free.
+    RigidBody {
+        /// The clips holding that part, and the free motion (translation, rotation).
+        clips: String,
+        translation: Vector3<f64>,
+        rotation: Vector3<f64>,
     },
     NotConverged {
         iterations: usize,
@@ -73,9 +109,32 @@ impl fmt::Display for SolveError {
             ),
             SolveError::Singular { node, s } => write!(
                 f,
-                "the stiffness matrix is singular near node {node} (s = {s:.4} m): the clips \
-                 leave a rigid-body motion of the cable free (add a fixed clip or a constraint)"
+                "the stiffness matrix is singular near node {node} (s = {s:.4} m), although the \
+                 clips hold the cable against every rigid-body motion: a section stiffness is \
+                 zero or too small to resolve against the others (check the section and \
+                 material), or the state is at a bifurcation"
             ),
+            SolveError::RigidBody {
+                clips,
+                translation,
+                rotation,
+            } => {
+                let what = if rotation.norm() > 1e-6 {
+                    let a = rotation.normalize();
+                    format!(
+                        "a rotation about the axis ({:.3}, {:.3}, {:.3})",
+                        a.x, a.y, a.z
+                    )
+                } else {
+                    let t = translation.normalize();
+                    format!("a translation along ({:.3}, {:.3}, {:.3})", t.x, t.y, t.z)
+                };
+                write!(
+                    f,
+                    "the stiffness matrix is singular: the clips {clips} leave a rigid-body \
+                     motion of the cable free ({what}); add a fixed clip or hold it otherwise"
+                )
+            }
             SolveError::NotConverged {
                 iterations,
                 residual,
@@ -93,6 +152,14 @@ impl std::error::Error for SolveError {}
 /// Initial damping of the pseudo-transient path relative to the stiffest diagonal entry.
 const PTC_START: f64 = 1e-3;
 
+/// Bisection depth of a quasistatic step from which a failed sub-step is relaxed by energy
+/// descent (the branch may end in a fold there).
+const SNAP_DEPTH: usize = 6;
+
+/// A jump of a node by more than this fraction of the cable length within a sub-step of
+/// 2⁻⁶ of a step is reported as a snap-through.
+const SNAP_JUMP: f64 = 0.01;
+
 /// A static/quasistatic solver for one cable: the workspace and options.
 pub struct Statics {
     pub ws: Workspace,
@@ -107,6 +174,9 @@ pub struct Statics {
     prev: State,
     has_prev: bool,
     force_scale: f64,
+    /// Stability check (block LDLᵀ inertia) and the state before an escape.
+    pub stability: StabilityCheck,
+    before: State,
 }
 
 impl Statics {
@@ -133,6 +203,8 @@ impl Statics {
             prev: State::empty(),
             has_prev: false,
             force_scale: weight.max(loads).max(bend).max(1e-12),
+            stability: StabilityCheck::new(rod.n_edges() + 1),
+            before: State::empty(),
         }
     }
 
@@ -326,8 +398,51 @@ impl Statics {
     /// Static equilibrium: plain Newton; then pseudo-transient continuation; then load
     /// continuation from the unloaded routed shape (gravity and loads ramped), with plain and
     /// then damped Newton steps.
+    ///
+    /// The equilibrium found is checked for stability and, if unstable, left for a stable one
+    /// (`ensure_stable`); a singular system is diagnosed (a rigid-body motion the clips leave
+    /// free, or a zero stiffness).
     pub fn solve(&mut self, rod: &Rod, st: &mut State) -> Result<SolveStats, SolveError> {
         self.has_prev = false; // a new sequence starts here
+        self.check_held(rod, st)?;
+        let mut stats = self.solve_any(rod, st)?;
+        self.ensure_stable(rod, st, &mut stats, 0.0)?;
+        Ok(stats)
+    }
+
+    /// Fails with `RigidBody` if the clips leave a rigid-body motion of a part free.
+    pub fn check_held(&self, rod: &Rod, st: &State) -> Result<(), SolveError> {
+        for seg in &rod.segments {
+            let fixed = seg
+                .clips
+                .iter()
+                .any(|&c| rod.spec.clips[c].kind == crate::model::ClipKind::Fixed);
+            if fixed {
+                continue;
+            }
+            if let (n, Some((t, w))) = free_rigid_motions(rod, &seg.clips, &st.clip_pose) {
+                debug_assert!(n > 0);
+                let names: Vec<String> = seg
+                    .clips
+                    .iter()
+                    .map(|&c| format!("'{}'", rod.spec.clips[c].name))
+                    .collect();
+                return Err(SolveError::RigidBody {
+                    clips: if names.is_empty() {
+                        "(none)".into()
+                    } else {
+                        names.join(", ")
+                    },
+                    translation: t,
+                    rotation: w,
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// Any equilibrium: plain Newton, pseudo-transient, load continuation (see `solve`).
+    fn solve_any(&mut self, rod: &Rod, st: &mut State) -> Result<SolveStats, SolveError> {
         let start = st.clone();
         // Plain Newton converges in a handful of iterations from a good guess; a slow start
         // means a poor guess, for which the pseudo-transient path is the better use of time.
@@ -360,6 +475,215 @@ impl Statics {
             }
         }
         Err(last)
+    }
+
+    /// Inertia of the tangent stiffness at `st` (the Jacobian assembled there: after a
+    /// converged solve it already is, `assemble` false).
+    pub fn inertia(
+        &mut self,
+        rod: &Rod,
+        st: &State,
+        assemble: bool,
+    ) -> Result<Inertia, SolveError> {
+        if assemble {
+            self.ws
+                .assemble_static(rod, st, 1.0, true)
+                .map_err(|k| Self::kink_err(rod, k))?;
+        }
+        Ok(self.stability.inertia(&self.ws.jac, 0..rod.arc.len()))
+    }
+
+    /// Checks the equilibrium `st` (just converged: the Jacobian is assembled there) for
+    /// stability; an unstable one is left along a direction of negative curvature (both signs
+    /// tried, the lower energy kept) and relaxed (`relax`: pseudo-transient continuation) into a stable one, with larger
+    /// perturbations if that lands on an unstable state again. `stats.unstable` is the count
+    /// of negative eigenvalues at the state returned (0 unless no stable state was found);
+    /// `stats.snap` the jump if there was an escape (at `fraction` of a quasistatic step).
+    pub fn ensure_stable(
+        &mut self,
+        rod: &Rod,
+        st: &mut State,
+        stats: &mut SolveStats,
+        fraction: f64,
+    ) -> Result<(), SolveError> {
+        let mut inertia = self.inertia(rod, st, false)?;
+        stats.unstable = inertia.negative;
+        if inertia.negative == 0 {
+            return Ok(());
+        }
+        self.before.clone_from(st);
+        let l = rod.spec.length;
+        for attempt in 0..4 {
+            if !self.unstable_mode(rod) {
+                break;
+            }
+            // Scale: 0.1 rad of rotation or 2 % of the length, whichever comes first.
+            let (mut dx, mut dth) = (0.0f64, 0.0f64);
+            for (b, d) in self.trial.iter().enumerate() {
+                for k in 0..6 {
+                    if rod.mask[b][k] {
+                        if k < 3 {
+                            dx = dx.max(d[k].abs());
+                        } else {
+                            dth = dth.max(d[k].abs());
+                        }
+                    }
+                }
+            }
+            let amp = f64::from(1u32 << attempt) / (dth / 0.1).max(dx / (0.02 * l)).max(1e-300);
+            let mut best = (f64::INFINITY, 0.0);
+            for sign in [1.0, -1.0] {
+                st.clone_from(&self.before);
+                st.apply_increment(rod, &self.trial, sign * amp);
+                if self.ws.assemble_static(rod, st, 1.0, false).is_ok() {
+                    let e = self.ws.elastic_energy + self.ws.load_potential;
+                    if e < best.0 {
+                        best = (e, sign);
+                    }
+                }
+            }
+            if best.1 == 0.0 {
+                break;
+            }
+            st.clone_from(&self.before);
+            st.apply_increment(rod, &self.trial, best.1 * amp);
+            let found = self.relax(rod, st);
+            if std::env::var_os("ROD_DEBUG").is_some() {
+                eprintln!("escape {attempt}: amp {amp:.3e} dx {dx:.3e} dth {dth:.3e} -> {found:?}");
+            }
+            match found {
+                Ok(s) => {
+                    stats.iterations += s.iterations;
+                    stats.residual = s.residual;
+                    inertia = self.inertia(rod, st, false)?;
+                    if inertia.negative == 0 {
+                        stats.unstable = 0;
+                        stats.escapes += 1;
+                        stats.merge_snap(Some(self.jump_from_before(rod, st, fraction)));
+                        return Ok(());
+                    }
+                }
+                Err(SolveError::Singular { .. }) | Err(SolveError::NotConverged { .. }) => {}
+                Err(e) => return Err(e),
+            }
+            // Not stable: try again from the unstable state with a larger perturbation.
+            st.clone_from(&self.before);
+            self.inertia(rod, st, true)?;
+        }
+        // No stable state found: return the unstable equilibrium, flagged.
+        st.clone_from(&self.before);
+        inertia = self.inertia(rod, st, true)?;
+        stats.unstable = inertia.negative;
+        Ok(())
+    }
+
+    /// The mode of the most negative eigenvalue of H φ = λ D φ (H the symmetric tangent
+    /// stiffness assembled in the workspace, D the damping diagonal of `pseudo_transient`), in
+    /// `self.trial`: a direction of negative curvature from the block LDLᵀ, refined by inverse
+    /// iteration with H shifted below that eigenvalue (the shift raised until the shifted
+    /// matrix is positive definite). The workspace Jacobian is left as it was.
+    fn unstable_mode(&mut self, rod: &Rod) -> bool {
+        let nb = rod.arc.len();
+        if !self.stability.negative_direction(0..nb, &mut self.trial) {
+            return false;
+        }
+        let damping = |b: usize, k: usize| -> f64 {
+            if k < 3 {
+                rod.ds_node[b]
+            } else {
+                rod.ds_edge[b.min(nb - 2)].powi(3) / 12.0
+            }
+        };
+        let d_norm = |z: &[Vector6<f64>]| -> f64 {
+            let mut sum = 0.0;
+            for (b, v) in z.iter().enumerate() {
+                for k in 0..6 {
+                    if rod.mask[b][k] {
+                        sum += damping(b, k) * v[k] * v[k];
+                    }
+                }
+            }
+            sum
+        };
+        // Rayleigh quotient zᵀHz / zᵀDz (the skew part of J drops out of zᵀJz).
+        self.ws.jac.mul(&self.trial, &mut self.delta);
+        let zhz: f64 = self
+            .trial
+            .iter()
+            .zip(&self.delta)
+            .map(|(a, b)| a.dot(b))
+            .sum();
+        let rho = zhz / d_norm(&self.trial).max(1e-300);
+        if !(rho < 0.0 && rho.is_finite()) {
+            return true; // keep the LDLᵀ direction
+        }
+        let shift = |jac: &mut crate::block_tridiag::BlockTridiag, mu: f64| {
+            for b in 0..nb {
+                for k in 0..6 {
+                    if rod.mask[b][k] {
+                        jac.diag[b][(k, k)] -= mu * damping(b, k);
+                    }
+                }
+            }
+        };
+        let mut mu = 1.5 * rho;
+        let mut ok = false;
+        for _ in 0..30 {
+            shift(&mut self.ws.jac, mu);
+            let inertia = self.stability.inertia(&self.ws.jac, 0..nb);
+            if inertia.negative == 0 && inertia.zero == 0 && self.ws.jac.factor().is_ok() {
+                ok = true;
+                break;
+            }
+            shift(&mut self.ws.jac, -mu);
+            mu *= 1.5;
+        }
+        if ok {
+            for _ in 0..8 {
+                for (b, v) in self.trial.iter_mut().enumerate() {
+                    for k in 0..6 {
+                        v[k] *= if rod.mask[b][k] { damping(b, k) } else { 0.0 };
+                    }
+                }
+                self.ws.jac.solve_factored(&mut self.trial);
+                let n = d_norm(&self.trial).sqrt().max(1e-300);
+                self.trial.iter_mut().for_each(|v| *v /= n);
+            }
+            shift(&mut self.ws.jac, -mu);
+        }
+        true
+    }
+
+    /// From a perturbed state into an equilibrium nearby along a damped path: pseudo-transient
+    /// continuation, finished by plain Newton where a nearly neutral mode (e.g. the plane of a
+    /// buckled round section) makes it creep near the solution.
+    fn relax(&mut self, rod: &Rod, st: &mut State) -> Result<SolveStats, SolveError> {
+        let found = self.pseudo_transient(rod, st, 1.0, 20 * self.opts.max_iterations);
+        match found {
+            Err(SolveError::NotConverged { iterations, .. }) => {
+                let mut s = self.newton(rod, st, 1.0, false)?;
+                s.iterations += iterations;
+                Ok(s)
+            }
+            other => other,
+        }
+    }
+
+    /// The largest node displacement from `self.before` to `st`.
+    fn jump_from_before(&self, rod: &Rod, st: &State, fraction: f64) -> Snap {
+        let mut snap = Snap {
+            fraction,
+            jump: 0.0,
+            node: 0,
+        };
+        for (n, (a, b)) in self.before.x.iter().zip(&st.x).enumerate() {
+            let d = (a - b).norm();
+            if rod.node_kind[n] == NodeKind::Free && d > snap.jump {
+                snap.jump = d;
+                snap.node = n;
+            }
+        }
+        snap
     }
 
     fn continuation(
@@ -407,7 +731,10 @@ impl Statics {
         self.saved.clone_from(st);
         st.set_clip_poses(rod, target);
         match self.newton(rod, st, 1.0, false) {
-            Ok(s) => return Ok(s),
+            Ok(mut s) => {
+                self.ensure_stable(rod, st, &mut s, 1.0)?;
+                return Ok(s);
+            }
             Err(e @ SolveError::Singular { .. }) => return Err(e),
             Err(_) => st.clone_from(&self.saved),
         }
@@ -427,10 +754,14 @@ impl Statics {
             self.saved.clone_from(st);
             st.set_clip_poses(rod, &poses);
             match self.newton(rod, st, 1.0, false) {
-                Ok(s) => {
+                Ok(mut s) => {
+                    self.ensure_stable(rod, st, &mut s, f)?;
                     total.iterations += s.iterations;
                     total.residual = s.residual;
                     total.substeps += 1;
+                    total.unstable = s.unstable;
+                    total.escapes += s.escapes;
+                    total.merge_snap(s.snap);
                     done = f;
                     if depth > 1 {
                         depth -= 1;
@@ -439,6 +770,30 @@ impl Statics {
                 }
                 Err(e) => {
                     st.clone_from(&self.saved);
+                    if depth >= SNAP_DEPTH {
+                        // The branch may end here (a fold): relax into a stable equilibrium
+                        // at these clip poses; a large jump is a snap-through.
+                        st.set_clip_poses(rod, &poses);
+                        self.before.clone_from(&self.saved);
+                        let relaxed = self.relax(rod, st);
+                        if let Ok(mut s) = relaxed {
+                            self.ensure_stable(rod, st, &mut s, f)?;
+                            if s.unstable == 0 {
+                                total.iterations += s.iterations;
+                                total.residual = s.residual;
+                                total.substeps += 1;
+                                total.unstable = 0;
+                                let snap = self.jump_from_before(rod, st, f);
+                                if snap.jump > SNAP_JUMP * rod.spec.length {
+                                    total.escapes += 1;
+                                    total.merge_snap(Some(snap));
+                                }
+                                done = f;
+                                continue;
+                            }
+                        }
+                        st.clone_from(&self.saved);
+                    }
                     df *= 0.5;
                     depth += 1;
                     if depth > self.opts.max_substep_depth {
