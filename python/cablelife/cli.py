@@ -50,6 +50,24 @@ def print_summary(result: Result) -> None:
             "min bend radius",
             f"{s['min_bend_radius']:.4g} m at s = {s['min_bend_radius_s']:.3f} m",
         )
+        for key, label in (
+            ("max_axial_strain", "max axial strain F3/EA"),
+            ("max_shear_strain", "max shear strain |F1/GA1, F2/GA2|"),
+        ):
+            v = s[key]
+            t.add_row(label, f"{100 * v['value']:.3g} % at s = {v['s']:.3f} m, t = {v['t']:.4g} s")
+        if s["prestrain"] > 0:
+            t.add_row(
+                "span pre-strain (clips farther apart than the cable)",
+                f"{100 * s['prestrain']:.3g} %",
+            )
+        if s["unstable_steps"]:
+            t.add_row("unstable static states", f"{s['unstable_steps']}")
+        for snap in s["snap_throughs"]:
+            t.add_row(
+                "snap-through",
+                f"t = {snap['t']:.4g} s, jump {snap['jump']:.3g} m at s = {snap['s']:.3f} m",
+            )
         t.add_row(
             "Newton iterations per step",
             f"mean {s['newton_iterations_mean']:.1f}, max {s['newton_iterations_max']}",

@@ -321,6 +321,8 @@ class Simulation(_Model):
     # Dynamic Newton iteration: converged when the correction is below this fraction of the
     # step's increment (docs/dynamics.md: the error it leaves vs the time-step error).
     newton_tolerance: Annotated[float, Field(gt=0.0, lt=1.0)] = _core.DEFAULT_NEWTON_TOLERANCE
+    # Strains outside the model's validity range (docs/solver.md): a warning, or an error.
+    strain_limit: Literal["warn", "error"] = "warn"
 
 
 class Scene(_Model):

@@ -52,7 +52,8 @@ struct Record {
     iterations: Vec<i64>,
     substeps: Vec<i64>,
     residual: Vec<f64>,
-    /// Negative eigenvalues of the tangent stiffness (−1: not checked, dynamic steps).
+    /// Negative eigenvalues of the tangent stiffness (−1: not checked: dynamic steps, dead
+    /// moments).
     unstable: Vec<i64>,
     /// Snap-through in the step: fraction of the step, largest jump (m) and its node.
     snap_fraction: Vec<f64>,
@@ -112,7 +113,7 @@ impl Record {
         self.iterations.push(stats.iterations as i64);
         self.substeps.push(stats.substeps as i64);
         self.residual.push(stats.residual);
-        self.unstable.push(stats.unstable as i64);
+        self.unstable.push(stats.unstable.map_or(-1, |n| n as i64));
         let snap = stats.snap.unwrap_or(rod::Snap {
             fraction: f64::NAN,
             jump: 0.0,
@@ -215,12 +216,37 @@ fn poll(progress: &Option<Py<PyAny>>, done: usize, total: usize) -> Option<Strin
     })
 }
 
+/// (clip a, clip b, chord, cable length between them) of each span.
+type SpanTuple = (String, String, f64, f64);
+
 /// One cable: mesh, state and solver.
 #[pyclass(module = "cablelife._core")]
 pub struct Cable {
     rod: Rod,
     state: Option<State>,
     solver: Statics,
+}
+
+impl Cable {
+    /// The spans between consecutive clips at the clip poses of the first step.
+    fn spans(&self, poses: Option<&Vec<Pose>>) -> Vec<SpanTuple> {
+        let Some(poses) = poses else {
+            return vec![];
+        };
+        let clips = &self.rod.spec.clips;
+        rod::routing::span_stretches(&self.rod, poses)
+            .into_iter()
+            .map(|sp| {
+                let (a, b) = sp.clips;
+                (
+                    clips[a].name.clone(),
+                    clips[b].name.clone(),
+                    sp.chord,
+                    sp.length,
+                )
+            })
+            .collect()
+    }
 }
 
 #[pymethods]
@@ -345,11 +371,11 @@ impl Cable {
             )));
         }
         let poses = read_poses(&pos, &qs)?;
+        let spans = self.spans(poses.first());
         let rod = &self.rod;
         let solver = &mut self.solver;
         let state_slot = &mut self.state;
         let every = progress_every.max(1);
-        // Routing problems (a cable too short between two clips) are input errors.
         let initial = route(rod, poses.first().map(|p| p.as_slice()))
             .map_err(|e| PyValueError::new_err(e.0))?;
         let (record, error) = py.detach(move || {
@@ -385,6 +411,7 @@ impl Cable {
         });
         let d = record.into_dict(py, self.rod.arc.len(), n_clips)?;
         d.set_item("error", error)?;
+        d.set_item("spans", spans)?;
         Ok(d)
     }
 
@@ -476,6 +503,7 @@ impl Cable {
         };
         let initial = route(&self.rod, poses.first().map(|p| p.as_slice()))
             .map_err(|e| PyValueError::new_err(e.0))?;
+        let spans = self.spans(poses.first());
         let rod = &self.rod;
         let solver = &mut self.solver;
         let state_slot = &mut self.state;
@@ -509,7 +537,6 @@ impl Cable {
                                 ..Default::default()
                             };
                             rec.push(rod, &st, &dy.ws, &stats);
-                            *rec.unstable.last_mut().expect("pushed") = -1;
                             rec.push_energies(&dy.energies);
                         }
                     }
@@ -533,6 +560,7 @@ impl Cable {
         });
         let d = record.into_dict(py, self.rod.arc.len(), n_clips)?;
         d.set_item("error", error)?;
+        d.set_item("spans", spans)?;
         Ok(d)
     }
 

@@ -45,8 +45,9 @@ pub struct SolveStats {
     pub residual: f64,
     /// Number of continuation or sub-steps used (0: plain Newton worked).
     pub substeps: usize,
-    /// Negative eigenvalues of the tangent stiffness at the returned state (0: stable).
-    pub unstable: usize,
+    /// Negative eigenvalues of the tangent stiffness at the returned state (0: stable; None:
+    /// not checked — dead moments make the loads non-conservative, see `ensure_stable`).
+    pub unstable: Option<usize>,
     /// Unstable equilibria met and left on the way (see `Statics::ensure_stable`).
     pub escapes: usize,
     /// The largest jump to another stable branch in a quasistatic step, if any.
@@ -177,6 +178,7 @@ pub struct Statics {
     /// Stability check (block LDLᵀ inertia) and the state before an escape.
     pub stability: StabilityCheck,
     before: State,
+    relax_start: State,
 }
 
 impl Statics {
@@ -205,6 +207,7 @@ impl Statics {
             force_scale: weight.max(loads).max(bend).max(1e-12),
             stability: StabilityCheck::new(rod.n_edges() + 1),
             before: State::empty(),
+            relax_start: State::empty(),
         }
     }
 
@@ -407,6 +410,7 @@ impl Statics {
         self.check_held(rod, st)?;
         let mut stats = self.solve_any(rod, st)?;
         self.ensure_stable(rod, st, &mut stats, 0.0)?;
+        stats.snap = None; // leaving an unstable first solution is no jump of the cable
         Ok(stats)
     }
 
@@ -506,8 +510,14 @@ impl Statics {
         stats: &mut SolveStats,
         fraction: f64,
     ) -> Result<(), SolveError> {
+        if rod.edge_moment.iter().any(|m| *m != Vector3::zeros()) {
+            // A dead moment is not conservative on the rotation group: the symmetric part of
+            // the tangent is then no stability criterion (that needs the dynamics).
+            stats.unstable = None;
+            return Ok(());
+        }
         let mut inertia = self.inertia(rod, st, false)?;
-        stats.unstable = inertia.negative;
+        stats.unstable = Some(inertia.negative);
         if inertia.negative == 0 {
             return Ok(());
         }
@@ -557,7 +567,7 @@ impl Statics {
                     stats.residual = s.residual;
                     inertia = self.inertia(rod, st, false)?;
                     if inertia.negative == 0 {
-                        stats.unstable = 0;
+                        stats.unstable = Some(0);
                         stats.escapes += 1;
                         stats.merge_snap(Some(self.jump_from_before(rod, st, fraction)));
                         return Ok(());
@@ -573,7 +583,7 @@ impl Statics {
         // No stable state found: return the unstable equilibrium, flagged.
         st.clone_from(&self.before);
         inertia = self.inertia(rod, st, true)?;
-        stats.unstable = inertia.negative;
+        stats.unstable = Some(inertia.negative);
         Ok(())
     }
 
@@ -638,18 +648,46 @@ impl Statics {
             shift(&mut self.ws.jac, -mu);
             mu *= 1.5;
         }
-        if ok {
-            for _ in 0..8 {
-                for (b, v) in self.trial.iter_mut().enumerate() {
+        if !ok {
+            return true;
+        }
+        let iterate = |ws: &mut Workspace, z: &mut [Vector6<f64>], count: usize| {
+            for _ in 0..count {
+                for (b, v) in z.iter_mut().enumerate() {
                     for k in 0..6 {
                         v[k] *= if rod.mask[b][k] { damping(b, k) } else { 0.0 };
                     }
                 }
-                self.ws.jac.solve_factored(&mut self.trial);
-                let n = d_norm(&self.trial).sqrt().max(1e-300);
-                self.trial.iter_mut().for_each(|v| *v /= n);
+                ws.jac.solve_factored(z);
+                let n = d_norm(z).sqrt().max(1e-300);
+                z.iter_mut().for_each(|v| *v /= n);
+            }
+        };
+        iterate(&mut self.ws, &mut self.trial, 8);
+        shift(&mut self.ws.jac, -mu);
+        // Nearly equal negative eigenvalues (a round section: one per bending plane, split
+        // only by imperfections) need a shift close to the eigenvalue to separate: shift by
+        // the Rayleigh quotient less 1 % (10 % if that is not below the spectrum).
+        self.ws.jac.mul(&self.trial, &mut self.delta);
+        let zhz: f64 = self
+            .trial
+            .iter()
+            .zip(&self.delta)
+            .map(|(a, b)| a.dot(b))
+            .sum();
+        let rho = zhz / d_norm(&self.trial).max(1e-300);
+        for gap in [0.01, 0.1] {
+            let mu = rho * (1.0 + gap);
+            shift(&mut self.ws.jac, mu);
+            let inertia = self.stability.inertia(&self.ws.jac, 0..nb);
+            let pd = inertia.negative == 0 && inertia.zero == 0 && self.ws.jac.factor().is_ok();
+            if pd {
+                iterate(&mut self.ws, &mut self.trial, 40);
             }
             shift(&mut self.ws.jac, -mu);
+            if pd {
+                break;
+            }
         }
         true
     }
@@ -658,6 +696,11 @@ impl Statics {
     /// continuation, finished by plain Newton where a nearly neutral mode (e.g. the plane of a
     /// buckled round section) makes it creep near the solution.
     fn relax(&mut self, rod: &Rod, st: &mut State) -> Result<SolveStats, SolveError> {
+        self.relax_start.clone_from(st);
+        if let Ok(s) = self.descend(rod, st, 20 * self.opts.max_iterations) {
+            return Ok(s);
+        }
+        st.clone_from(&self.relax_start);
         let found = self.pseudo_transient(rod, st, 1.0, 20 * self.opts.max_iterations);
         match found {
             Err(SolveError::NotConverged { iterations, .. }) => {
@@ -667,6 +710,157 @@ impl Statics {
             }
             other => other,
         }
+    }
+
+    /// Energy descent into a stable equilibrium: steps (J + σD)Δ = −r with σ ≥ 0 the least
+    /// (of a geometric sequence) that makes the symmetric part of J + σD positive definite, so
+    /// Δ is a descent direction and a saddle cannot attract the iteration; backtracking on the
+    /// potential energy (Armijo), or, near the minimum where the energy's round-off hides the
+    /// decrease, on the natural monotonicity test. σ is lowered after each step; it ends as
+    /// Newton at a minimum. Dead moments are not conservative: then only the monotonicity test.
+    pub fn descend(
+        &mut self,
+        rod: &Rod,
+        st: &mut State,
+        max_iterations: usize,
+    ) -> Result<SolveStats, SolveError> {
+        let h = rod.mean_ds();
+        let l = rod.spec.length;
+        let nb = rod.arc.len();
+        let conservative = rod.edge_moment.iter().all(|m| *m == Vector3::zeros());
+        let damping = |b: usize, k: usize| -> f64 {
+            if k < 3 {
+                rod.ds_node[b]
+            } else {
+                rod.ds_edge[b.min(nb - 2)].powi(3) / 12.0
+            }
+        };
+        let add_damping = |jac: &mut crate::block_tridiag::BlockTridiag, sigma: f64| {
+            for b in 0..nb {
+                for k in 0..6 {
+                    if rod.mask[b][k] {
+                        jac.diag[b][(k, k)] += sigma * damping(b, k);
+                    }
+                }
+            }
+        };
+        self.ws
+            .assemble_static(rod, st, 1.0, true)
+            .map_err(|k| Self::kink_err(rod, k))?;
+        let mut energy = self.ws.elastic_energy + self.ws.load_potential;
+        let (_, mut rinf) = self.ws.residual_norms(h);
+        let mut sigma_ref = 0.0f64;
+        for b in 0..nb {
+            for k in 0..6 {
+                if rod.mask[b][k] {
+                    sigma_ref = sigma_ref.max(self.ws.jac.diag[b][(k, k)].abs() / damping(b, k));
+                }
+            }
+        }
+        let floor = 1e-12 * sigma_ref;
+        let mut sigma = 0.0f64;
+        let mut next_newton = 0;
+        let mut stats = SolveStats::default();
+        for it in 0..max_iterations {
+            stats.iterations = it + 1;
+            if rinf <= self.opts.residual_tolerance * self.force_scale {
+                stats.iterations = it;
+                stats.residual = rinf;
+                return Ok(stats);
+            }
+            // The least σ (0, then 10× steps) that makes J + σD positive definite.
+            let mut pd = false;
+            for _ in 0..40 {
+                add_damping(&mut self.ws.jac, sigma);
+                let inertia = self.stability.inertia(&self.ws.jac, 0..nb);
+                if inertia.negative == 0 && inertia.zero == 0 && self.ws.factor(rod).is_ok() {
+                    pd = true;
+                    break;
+                }
+                add_damping(&mut self.ws.jac, -sigma);
+                sigma = (sigma * 10.0).max(floor);
+            }
+            if !pd {
+                break;
+            }
+            let (dx, dth) = self.ws.newton_correction(&mut self.delta);
+            let step = (dx / l).max(dth);
+            if !step.is_finite() {
+                break;
+            }
+            // Directional derivative of the energy along Δ: rᵀΔ < 0.
+            let slope: f64 = self
+                .ws
+                .rhs
+                .iter()
+                .zip(&self.delta)
+                .map(|(r, d)| r.dot(d))
+                .sum();
+            let norm0 = scaled_norm(&self.delta, l);
+            let mut alpha = 1.0f64.min(self.opts.max_rotation_step / dth.max(1e-300));
+            self.base.clone_from(st);
+            let mut accepted = false;
+            for _ in 0..30 {
+                st.apply_increment(rod, &self.delta, alpha);
+                if self.ws.assemble_static(rod, st, 1.0, false).is_ok() {
+                    let e = self.ws.elastic_energy + self.ws.load_potential;
+                    let armijo = conservative && e <= energy + 1e-4 * alpha * slope;
+                    for (d, r) in self.trial.iter_mut().zip(&self.ws.rhs) {
+                        *d = -r;
+                    }
+                    self.ws.jac.solve_factored(&mut self.trial);
+                    let theta = scaled_norm(&self.trial, l) / norm0.max(1e-300);
+                    if e.is_finite() && (armijo || theta <= 1.0 - 0.25 * alpha) {
+                        energy = e;
+                        accepted = true;
+                        break;
+                    }
+                }
+                st.clone_from(&self.base);
+                alpha *= 0.5;
+            }
+            if !accepted {
+                sigma = (sigma * 10.0).max(floor);
+                self.ws
+                    .assemble_static(rod, st, 1.0, true)
+                    .map_err(|k| Self::kink_err(rod, k))?;
+                continue;
+            }
+            self.ws
+                .assemble_static(rod, st, 1.0, true)
+                .map_err(|k| Self::kink_err(rod, k))?;
+            (_, rinf) = self.ws.residual_norms(h);
+            if std::env::var_os("ROD_DEBUG").is_some() {
+                eprintln!("descend {it} sigma {sigma:.3e} alpha {alpha:.3e} E {energy:.9e} rinf {rinf:.3e}");
+            }
+            if sigma == 0.0 && alpha == 1.0 && step < self.opts.step_tolerance {
+                stats.residual = rinf;
+                return Ok(stats);
+            }
+            if sigma == 0.0 && it >= next_newton {
+                // Positive definite: Newton from here, which does not creep along a nearly
+                // neutral direction as the backtracking does; kept if it ends stable.
+                self.base.clone_from(st);
+                if let Ok(s) = self.newton(rod, st, 1.0, false) {
+                    stats.iterations += s.iterations;
+                    if self.stability.inertia(&self.ws.jac, 0..nb).negative == 0 {
+                        stats.residual = s.residual;
+                        return Ok(stats);
+                    }
+                }
+                next_newton = it + 10;
+                st.clone_from(&self.base);
+                self.ws
+                    .assemble_static(rod, st, 1.0, true)
+                    .map_err(|k| Self::kink_err(rod, k))?;
+            }
+            sigma = if sigma <= floor { 0.0 } else { 0.1 * sigma };
+        }
+        Err(SolveError::NotConverged {
+            iterations: stats.iterations,
+            residual: rinf,
+            load_factor: 1.0,
+        })
     }
 
     /// The largest node displacement from `self.before` to `st`.
@@ -778,11 +972,11 @@ impl Statics {
                         let relaxed = self.relax(rod, st);
                         if let Ok(mut s) = relaxed {
                             self.ensure_stable(rod, st, &mut s, f)?;
-                            if s.unstable == 0 {
+                            if s.unstable.unwrap_or(0) == 0 {
                                 total.iterations += s.iterations;
                                 total.residual = s.residual;
                                 total.substeps += 1;
-                                total.unstable = 0;
+                                total.unstable = s.unstable;
                                 let snap = self.jump_from_before(rod, st, f);
                                 if snap.jump > SNAP_JUMP * rod.spec.length {
                                     total.escapes += 1;
