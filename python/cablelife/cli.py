@@ -51,8 +51,8 @@ def print_summary(result: Result) -> None:
             f"{s['min_bend_radius']:.4g} m at s = {s['min_bend_radius_s']:.3f} m",
         )
         for key, label in (
-            ("max_axial_strain", "max axial strain F3/EA"),
-            ("max_shear_strain", "max shear strain |F1/GA1, F2/GA2|"),
+            ("max_axial_strain", "max axial strain Γ3"),
+            ("max_shear_strain", "max shear strain |Γ1, Γ2|"),
         ):
             v = s[key]
             t.add_row(label, f"{100 * v['value']:.3g} % at s = {v['s']:.3f} m, t = {v['t']:.4g} s")

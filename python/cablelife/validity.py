@@ -15,9 +15,9 @@ import numpy as np
 
 from cablelife.results import CableResult
 
-#: Largest axial strain ε₃ = F3/EA inside the validity range.
+#: Largest axial strain Γ₃ (= F3/EA at rest) inside the validity range.
 AXIAL_STRAIN_LIMIT = 0.05
-#: Largest shear strain |(F1/GA₁, F2/GA₂)| inside the validity range.
+#: Largest shear strain |(Γ₁, Γ₂)| inside the validity range.
 SHEAR_STRAIN_LIMIT = 0.05
 #: Pre-strain of a taut span (clips farther apart than the cable between them) above which
 #: the mounting is reported.
@@ -37,12 +37,18 @@ class StabilityWarning(UserWarning):
 
 
 def strains(c: CableResult) -> tuple[np.ndarray, np.ndarray]:
-    """Axial strain ε₃ = F3/EA and shear strain |(F1/GA₁, F2/GA₂)| per step and edge (T, N),
-    from the section forces (in dynamic runs they include the damping forces)."""
-    s = c.section
-    axial = c.forces[..., 2] / s["EA"]
-    shear = np.hypot(c.forces[..., 0] / s["GA1"], c.forces[..., 1] / s["GA2"])
-    return axial, shear
+    """Axial strain Γ₃ and shear strain |(Γ₁, Γ₂)| per step and edge (T, N) from the saved
+    configuration, Γ = Rᵀ (x_{n+1} − x_n)/Δs − e₃ (the model's strain; unlike F/EA it holds no
+    damping forces in dynamic runs)."""
+    from scipy.spatial.transform import Rotation
+
+    t, n = c.quaternions.shape[:2]
+    if t == 0 or n == 0:
+        return np.zeros((t, n)), np.zeros((t, n))
+    tangent = np.diff(c.positions, axis=1) / np.diff(c.arc_length)[None, :, None]
+    rot = Rotation.from_quat(c.quaternions.reshape(-1, 4), scalar_first=True)
+    gamma = rot.inv().apply(tangent.reshape(-1, 3)).reshape(t, n, 3)
+    return gamma[..., 2] - 1.0, np.hypot(gamma[..., 0], gamma[..., 1])
 
 
 def _largest(values: np.ndarray, c: CableResult) -> dict:

@@ -557,7 +557,7 @@ impl Statics {
             }
             st.clone_from(&self.before);
             st.apply_increment(rod, &self.trial, best.1 * amp);
-            let found = self.relax(rod, st);
+            let found = self.relax(rod, st, true);
             if std::env::var_os("ROD_DEBUG").is_some() {
                 eprintln!("escape {attempt}: amp {amp:.3e} dx {dx:.3e} dth {dth:.3e} -> {found:?}");
             }
@@ -692,12 +692,19 @@ impl Statics {
         true
     }
 
-    /// From a perturbed state into an equilibrium nearby along a damped path: pseudo-transient
-    /// continuation, finished by plain Newton where a nearly neutral mode (e.g. the plane of a
-    /// buckled round section) makes it creep near the solution.
-    fn relax(&mut self, rod: &Rod, st: &mut State) -> Result<SolveStats, SolveError> {
+    /// From a perturbed (or no longer equilibrated) state into a stable equilibrium: energy
+    /// descent (`descend`); if that fails, pseudo-transient continuation finished by plain
+    /// Newton where a nearly neutral mode (e.g. the plane of a buckled round section) makes it
+    /// creep near the solution.
+    fn relax(
+        &mut self,
+        rod: &Rod,
+        st: &mut State,
+        newton_shortcut: bool,
+    ) -> Result<SolveStats, SolveError> {
         self.relax_start.clone_from(st);
-        if let Ok(s) = self.descend(rod, st, 20 * self.opts.max_iterations) {
+        let found = self.descend(rod, st, 20 * self.opts.max_iterations, newton_shortcut);
+        if let Ok(s) = found {
             return Ok(s);
         }
         st.clone_from(&self.relax_start);
@@ -718,11 +725,15 @@ impl Statics {
     /// potential energy (Armijo), or, near the minimum where the energy's round-off hides the
     /// decrease, on the natural monotonicity test. σ is lowered after each step; it ends as
     /// Newton at a minimum. Dead moments are not conservative: then only the monotonicity test.
+    /// With `newton_shortcut`, plain Newton is tried wherever J is positive definite (it may
+    /// jump to a farther stable state: for escapes from unstable states, not for following a
+    /// branch).
     pub fn descend(
         &mut self,
         rod: &Rod,
         st: &mut State,
         max_iterations: usize,
+        newton_shortcut: bool,
     ) -> Result<SolveStats, SolveError> {
         let h = rod.mean_ds();
         let l = rod.spec.length;
@@ -837,7 +848,7 @@ impl Statics {
                 stats.residual = rinf;
                 return Ok(stats);
             }
-            if sigma == 0.0 && it >= next_newton {
+            if newton_shortcut && sigma == 0.0 && it >= next_newton {
                 // Positive definite: Newton from here, which does not creep along a nearly
                 // neutral direction as the backtracking does; kept if it ends stable.
                 self.base.clone_from(st);
@@ -965,26 +976,36 @@ impl Statics {
                 Err(e) => {
                     st.clone_from(&self.saved);
                     if depth >= SNAP_DEPTH {
-                        // The branch may end here (a fold): relax into a stable equilibrium
-                        // at these clip poses; a large jump is a snap-through.
-                        st.set_clip_poses(rod, &poses);
-                        self.before.clone_from(&self.saved);
-                        let relaxed = self.relax(rod, st);
-                        if let Ok(mut s) = relaxed {
+                        // The branch may end here (a fold): relax into a stable equilibrium at
+                        // these clip poses or, where the landscape is too flat for that next to
+                        // the fold, at the step's target; a large jump is a snap-through at f.
+                        for (to, poses_to) in [(f, &poses), (1.0, &target.to_vec())] {
+                            st.clone_from(&self.saved);
+                            st.set_clip_poses(rod, poses_to);
+                            let relaxed = self.relax(rod, st, true);
+                            if std::env::var_os("ROD_DEBUG").is_some() {
+                                eprintln!("fold? f {f} → {to}, depth {depth}: {relaxed:?}");
+                            }
+                            let Ok(mut s) = relaxed else { continue };
                             self.ensure_stable(rod, st, &mut s, f)?;
-                            if s.unstable.unwrap_or(0) == 0 {
-                                total.iterations += s.iterations;
-                                total.residual = s.residual;
-                                total.substeps += 1;
-                                total.unstable = s.unstable;
-                                let snap = self.jump_from_before(rod, st, f);
-                                if snap.jump > SNAP_JUMP * rod.spec.length {
-                                    total.escapes += 1;
-                                    total.merge_snap(Some(snap));
-                                }
-                                done = f;
+                            if s.unstable.unwrap_or(0) != 0 {
                                 continue;
                             }
+                            total.iterations += s.iterations;
+                            total.residual = s.residual;
+                            total.substeps += 1;
+                            total.unstable = s.unstable;
+                            self.before.clone_from(&self.saved);
+                            let snap = self.jump_from_before(rod, st, f);
+                            if snap.jump > SNAP_JUMP * rod.spec.length {
+                                total.escapes += 1;
+                                total.merge_snap(Some(snap));
+                            }
+                            done = to;
+                            break;
+                        }
+                        if done >= f {
+                            continue;
                         }
                         st.clone_from(&self.saved);
                     }

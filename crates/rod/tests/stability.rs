@@ -299,3 +299,92 @@ fn free_rigid_body_motions_are_named() {
         "{e}"
     );
 }
+
+/// Incomplete elliptic integral of the first kind F(φ | m) by composite Simpson (smooth for
+/// m < 1).
+fn ellip_f(phi: f64, m: f64) -> f64 {
+    let n = 2000;
+    let h = phi / n as f64;
+    let f = |t: f64| 1.0 / (1.0 - m * t.sin().powi(2)).sqrt();
+    let mut sum = f(0.0) + f(phi);
+    for i in 1..n {
+        sum += if i % 2 == 1 { 4.0 } else { 2.0 } * f(i as f64 * h);
+    }
+    sum * h / 3.0
+}
+
+/// The clamp angle β (against the lean) at which the buckled clamped–free elastica under the
+/// dead load p (EI = 1, L = 1) loses its branch: the shape turns from β through 0 to the tip
+/// angle θ_L = 2 asin k, so √p = K(k) + F(asin(sin(β/2)/k) | k²); the branch exists while the
+/// minimum over k of the right side is ≤ √p, and folds where it equals it.
+fn fold_clamp_angle(p: f64) -> f64 {
+    let lam = p.sqrt();
+    let g_min = |beta: f64| {
+        let s = (0.5 * beta).sin();
+        let g = |k: f64| ellip_ke(k * k).0 + ellip_f((s / k).min(1.0).asin(), k * k);
+        let (mut a, mut b) = (s * (1.0 + 1e-12), 1.0 - 1e-9);
+        let r = 0.5 * (5f64.sqrt() - 1.0);
+        for _ in 0..100 {
+            let (c, d) = (b - r * (b - a), a + r * (b - a));
+            if g(c) < g(d) {
+                b = d
+            } else {
+                a = c
+            }
+        }
+        g(0.5 * (a + b))
+    };
+    let (mut lo, mut hi) = (1e-3, 1.5);
+    for _ in 0..60 {
+        let mid = 0.5 * (lo + hi);
+        if g_min(mid) < lam {
+            lo = mid
+        } else {
+            hi = mid
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+/// Turns the clamp of the buckled column against its lean in steps of `d_beta` until it snaps
+/// to the other side; returns the clamp angle of the snap and the snap.
+fn snap_angle(n: usize, d_beta: f64) -> (f64, rod::Snap) {
+    let ei = 1.0;
+    let p = 2.0 * euler_load(ei);
+    let rod = Rod::new(column(n, stiff(ei, 4.0 * ei), p, 1e-6 * p)).unwrap();
+    let mut st = route(&rod, None).unwrap();
+    let mut solver = Statics::new(&rod, NewtonOptions::default());
+    solver.solve(&rod, &mut st).unwrap();
+    assert!(st.x.last().unwrap().y < -0.5, "leans to −y");
+    for k in 1..200 {
+        let beta = k as f64 * d_beta;
+        // The clamp turns about +z: its tangent towards +y, against the lean.
+        let pose = pose([0.0; 3], [beta.cos(), beta.sin(), 0.0], [0.0, 0.0, 1.0]);
+        let stats = solver
+            .sequence_step(&rod, &mut st, &[pose])
+            .unwrap_or_else(|e| panic!("step {k}, β = {beta}: {e}"));
+        assert_eq!(stats.unstable, Some(0), "step {k}");
+        if let Some(snap) = stats.snap {
+            assert!(st.x.last().unwrap().y > 0.5, "leans to +y after the snap");
+            return (beta - (1.0 - snap.fraction) * d_beta, snap);
+        }
+    }
+    panic!("no snap-through");
+}
+
+#[test]
+fn the_buckled_column_snaps_through_where_its_elastica_branch_folds() {
+    let beta_c = fold_clamp_angle(2.0 * euler_load(1.0));
+    assert!((beta_c - 0.54498).abs() < 1e-4, "{beta_c}"); // scipy: 0.5449801
+    let d_beta = 0.01;
+    let (beta, snap) = snap_angle(40, d_beta);
+    // The jump is the tip's, across to the other side (≈ twice the lean of ~0.8 m).
+    assert_eq!(snap.node, 40);
+    assert!(snap.jump > 1.0, "{snap:?}");
+    let err40 = (beta - beta_c).abs();
+    let (beta80, _) = snap_angle(80, d_beta);
+    let err80 = (beta80 - beta_c).abs();
+    eprintln!("snap at {beta} (N = 40), {beta80} (N = 80), fold {beta_c}");
+    assert!(err80 < 0.01 * beta_c, "{beta80} vs {beta_c}");
+    assert!(err80 < err40, "{err40} → {err80}");
+}
