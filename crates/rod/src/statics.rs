@@ -584,6 +584,9 @@ impl Statics {
         st.clone_from(&self.before);
         inertia = self.inertia(rod, st, true)?;
         stats.unstable = Some(inertia.negative);
+        if std::env::var_os("ROD_DEBUG").is_some() {
+            eprintln!("no stable state found: {inertia:?}");
+        }
         Ok(())
     }
 
