@@ -10,7 +10,7 @@
 use crate::block_tridiag::{Block, BlockTridiag};
 use crate::model::{ClipKind, Pose, Rod};
 use crate::rotation::{rotation_matrix, skew};
-use nalgebra::{Cholesky, Matrix6, SymmetricEigen, Vector3, Vector6};
+use nalgebra::{Matrix6, SymmetricEigen, Vector3, Vector6};
 use std::ops::Range;
 
 /// Inertia of a symmetric matrix (the counts of its eigenvalue signs); `zero` counts pivots
@@ -48,14 +48,17 @@ impl StabilityCheck {
         let mut out = Inertia::default();
         self.negative_pivot = None;
         let mut worst = 0.0f64;
+        // H_{b,b+1} of the previous block: H_{b+1,b} = its transpose.
+        let mut prev_upper = Block::zeros();
         for b in r.clone() {
             let d = &jac.diag[b];
             let mut s = 0.5 * (d + d.transpose());
-            // Scale of the block before the Schur update: the size of its round-off.
+            // Scales before the Schur update: the size of its round-off, per slot and per block
+            // (units differ between slots: positions and rotations).
+            let tiny = s.diagonal().map(|v| ZERO_PIVOT * v.abs());
             let scale = s.diagonal().amax().max(1e-300);
             if b > r.start {
-                let l = 0.5 * (jac.lower[b] + jac.upper[b - 1].transpose());
-                s -= l * self.w[b - 1];
+                s -= prev_upper.transpose() * self.w[b - 1];
                 s = 0.5 * (s + s.transpose());
             }
             let upper = if b + 1 < r.end {
@@ -63,9 +66,12 @@ impl StabilityCheck {
             } else {
                 Block::zeros()
             };
-            if let Some(ch) = Cholesky::new(s) {
+            prev_upper = upper;
+            let mut l = s;
+            if cholesky_in_place(&mut l, &tiny) {
                 if b + 1 < r.end {
-                    self.w[b] = ch.solve(&upper);
+                    self.w[b] = upper;
+                    cholesky_solve(&l, &mut self.w[b]);
                 }
                 continue;
             }
@@ -116,6 +122,54 @@ impl StabilityCheck {
 
 /// A rigid-body motion: translation and rotation (about the global origin).
 pub type RigidMotion = (Vector3<f64>, Vector3<f64>);
+
+/// Cholesky factor L (lower triangle, in place) of a symmetric 6×6 block; false if the pivot of
+/// slot j is not above `tiny[j]` (not positive definite, or nearly singular). Hand-written: it
+/// is the hot path of the check (nalgebra's generic Cholesky and solve cost 2× more here).
+#[inline]
+fn cholesky_in_place(a: &mut Block, tiny: &Vector6<f64>) -> bool {
+    for j in 0..6 {
+        let mut d = a[(j, j)];
+        for k in 0..j {
+            d -= a[(j, k)] * a[(j, k)];
+        }
+        if d.is_nan() || d <= tiny[j] {
+            return false;
+        }
+        let d = d.sqrt();
+        a[(j, j)] = d;
+        let inv = 1.0 / d;
+        for i in j + 1..6 {
+            let mut v = a[(i, j)];
+            for k in 0..j {
+                v -= a[(i, k)] * a[(j, k)];
+            }
+            a[(i, j)] = v * inv;
+        }
+    }
+    true
+}
+
+/// X ← (L Lᵀ)⁻¹ X with the factor of `cholesky_in_place`.
+#[inline]
+fn cholesky_solve(l: &Block, x: &mut Block) {
+    for c in 0..6 {
+        for i in 0..6 {
+            let mut v = x[(i, c)];
+            for k in 0..i {
+                v -= l[(i, k)] * x[(k, c)];
+            }
+            x[(i, c)] = v / l[(i, i)];
+        }
+        for i in (0..6).rev() {
+            let mut v = x[(i, c)];
+            for k in i + 1..6 {
+                v -= l[(k, i)] * x[(k, c)];
+            }
+            x[(i, c)] = v / l[(i, i)];
+        }
+    }
+}
 
 /// The rigid-body motions (translation t, rotation ω about the global origin) of an
 /// independent part that the clips `clips` at `poses` leave free: the null space of their
