@@ -168,3 +168,31 @@ def test_the_cli_summary_shows_strains_and_pre_strain(tmp_path):
         cwd=root,
     )
     assert proc.returncode == 1 and "axial strain 36 %" in proc.stderr
+
+
+def test_the_modes_of_a_taut_mounting_are_those_of_the_tensioned_string():
+    from cablelife.modal import cable_modes
+
+    sc = scene_from_dict(two_clips(1.02))
+    modes = cable_modes(sc, sc.cables[0], 4)
+    # The lowest transverse mode (a torsional one, at (1/2L)√(GJ/ρI_p) = 55 Hz, moves no node).
+    transverse = np.abs(modes.shapes[..., 1:]).max(axis=(1, 2)) > 1e-3 * np.abs(modes.shapes).max()
+    f1 = modes.frequencies[np.flatnonzero(transverse)[0]]
+    tension, rho_a, eps = STIFFNESS["EA"] * 0.02, STIFFNESS["mass_per_length"], 0.02
+    # String of the stretched length L(1+ε) with its mass ρA L: f = √(T(1+ε)/ρA) / (2L(1+ε)).
+    # Bending stiffness at clamped ends raises it by at most 2/λ, λ = L√(T/EI) (0.6 %); the
+    # lumped-mass discretisation (N = 20) lowers it by π²/(24N²) (0.1 %).
+    string = np.sqrt(tension * (1 + eps) / rho_a) / (2 * (1 + eps))
+    lam = np.sqrt(tension / EI)
+    assert string * (1 - np.pi**2 / (24 * 20**2)) <= f1 <= string * (1 + 2 / lam), (f1, string)
+
+
+def test_a_dynamic_run_starts_from_the_stable_buckled_state():
+    data = column(2 * EULER, 1e-3, 20, mode="dynamic")
+    data["simulation"].update(duration=0.01, time_step=1e-3)
+    res = simulate(scene_from_dict(data)).cables["column"]
+    assert res.solver["unstable"][0] == 0 and (res.solver["unstable"][1:] == -1).all()
+    x_ref, y_ref = elastica_tip(2 * EULER)
+    assert res.positions[0, -1, 2] == pytest.approx(y_ref, abs=0.02)
+    # At rest in a stable equilibrium with the clips at rest: it stays there.
+    assert np.abs(res.positions[-1] - res.positions[0]).max() < 1e-6
