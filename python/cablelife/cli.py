@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 from typing import Annotated
 
@@ -127,8 +128,15 @@ def run(
         progress.update(tasks[cable], completed=done)
 
     try:
-        with progress:
-            result = simulate(sc, mode=mode, progress=on_progress)
+        with progress, warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            try:
+                result = simulate(sc, mode=mode, progress=on_progress)
+            finally:
+                for w in caught:  # one line each, without the source line
+                    err_console.print(
+                        f"warning: {w.message}", markup=False, highlight=False, soft_wrap=True
+                    )
     except (SceneError, SignalError) as err:
         raise fail(str(err)) from None
     except SimulationError as err:
