@@ -231,19 +231,26 @@ def test_local_cluster_study_writes_the_summary_table_and_reruns_nothing(tmp_pat
 
 
 def test_a_failing_variant_is_reported_and_the_others_finish(tmp_path):
-    # 1.0 m of cable cannot reach the clips: that variant fails in its simulation.
+    # 1.0 m of cable must stretch far beyond the strain validity range to reach the clips:
+    # with simulation.strain_limit = "error" that variant fails in its simulation.
+    scene = tmp_path / "scene.toml"
+    text = SCENE.read_text()
+    scene.write_text(text.replace("[simulation]\n", '[simulation]\nstrain_limit = "error"\n', 1))
+    assert 'strain_limit = "error"' in scene.read_text()
+    study = write_study(tmp_path, "[0.0]", "[1.0, 1.25]")
+    study.write_text(study.read_text().replace(SCENE.as_posix(), scene.as_posix()))
     out = tmp_path / "out"
-    outcome = run_study(write_study(tmp_path, "[0.0]", "[1.0, 1.25]"), out, workers=1)
+    outcome = run_study(study, out, workers=1)
     assert list(outcome.failed) == ["shift=0_length=1"]
-    assert "too short" in outcome.failed["shift=0_length=1"]
+    assert "exceeds the model's validity range" in outcome.failed["shift=0_length=1"]
     table = outcome.table.set_index("variant")
     assert table.loc["shift=0_length=1.25", "status"] == "ok"
     assert table.loc["shift=0_length=1", "status"] == "failed"
     assert pd.isna(table.loc["shift=0_length=1", "rank"])
     error = json.loads((out / "variants" / "shift=0_length=1" / "error.json").read_text())
-    assert error["stage"] == "simulation" and "too short" in error["error"]
+    assert error["stage"] == "simulation" and "axial strain" in error["error"]
     # the next run retries the failed variant only
-    rerun = run_study(write_study(tmp_path, "[0.0]", "[1.0, 1.25]"), out, workers=1)
+    rerun = run_study(study, out, workers=1)
     assert rerun.computed == ["shift=0_length=1"] and rerun.skipped == ["shift=0_length=1.25"]
 
 

@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 from typing import Annotated
 
@@ -56,6 +57,24 @@ def print_summary(result: Result) -> None:
             "min bend radius",
             f"{s['min_bend_radius']:.4g} m at s = {s['min_bend_radius_s']:.3f} m",
         )
+        for key, label in (
+            ("max_axial_strain", "max axial strain Γ3"),
+            ("max_shear_strain", "max shear strain |Γ1, Γ2|"),
+        ):
+            v = s[key]
+            t.add_row(label, f"{100 * v['value']:.3g} % at s = {v['s']:.3f} m, t = {v['t']:.4g} s")
+        if s["prestrain"] > 0:
+            t.add_row(
+                "span pre-strain (clips farther apart than the cable)",
+                f"{100 * s['prestrain']:.3g} %",
+            )
+        if s["unstable_steps"]:
+            t.add_row("unstable static states", f"{s['unstable_steps']}")
+        for snap in s["snap_throughs"]:
+            t.add_row(
+                "snap-through",
+                f"t = {snap['t']:.4g} s, jump {snap['jump']:.3g} m at s = {snap['s']:.3f} m",
+            )
         t.add_row(
             "Newton iterations per step",
             f"mean {s['newton_iterations_mean']:.1f}, max {s['newton_iterations_max']}",
@@ -125,8 +144,15 @@ def run(
         progress.update(tasks[cable], completed=done)
 
     try:
-        with progress:
-            result = simulate(sc, mode=mode, progress=on_progress)
+        with progress, warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            try:
+                result = simulate(sc, mode=mode, progress=on_progress)
+            finally:
+                for w in caught:  # one line each, without the source line
+                    err_console.print(
+                        f"warning: {w.message}", markup=False, highlight=False, soft_wrap=True
+                    )
     except (SceneError, SignalError) as err:
         raise fail(str(err)) from None
     except SimulationError as err:

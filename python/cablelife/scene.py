@@ -390,6 +390,8 @@ class Simulation(_Model):
     newton_tolerance: Annotated[float, Strict(), Field(gt=0.0, lt=1.0)] = (
         _core.DEFAULT_NEWTON_TOLERANCE
     )
+    # Strains outside the model's validity range (docs/solver.md): a warning, or an error.
+    strain_limit: Literal["warn", "error"] = "warn"
 
 
 class Scene(_Model):

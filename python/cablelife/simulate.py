@@ -332,6 +332,7 @@ def _run_cable(
         real_time_factor=wall / simulated if simulated > 0 else float("nan"),
         error=out["error"] or "",
     )
+    solver.update(_stability_info(out, saved[:n], core.arc_length, cable.name))
     energies = {"elastic_energy": out["elastic_energy"]}
     if mode == "dynamic":
         energies.update(
@@ -353,6 +354,51 @@ def _run_cable(
         energies=energies,
     )
     return res, out["error"]
+
+
+def _stability_info(out: dict, times: np.ndarray, arc: np.ndarray, name: str) -> dict:
+    """Solver entries on stability and mounting: ``unstable`` (T,) negative eigenvalues of
+    the tangent stiffness per saved step (0: stable; −1: dynamic step, not checked), the
+    snap-throughs (time, arc length and size of the largest jump), the largest span pre-strain;
+    warnings for unstable states, snap-throughs and stretched spans."""
+    from cablelife import validity
+
+    info = {"unstable": np.asarray(out["unstable"])}
+    info.update(
+        validity.snap_events(
+            times, arc, out["snap_fraction"], out["snap_jump"], np.asarray(out["snap_node"])
+        )
+    )
+    spans = out.get("spans", [])
+    info["prestrain"] = max((chord / length - 1.0 for _, _, chord, length in spans), default=0.0)
+    messages = []
+    bad = np.flatnonzero(info["unstable"] > 0)
+    if bad.size:
+        messages.append(
+            f"cable '{name}': {bad.size} saved static state(s) are unstable (first at "
+            f"t = {times[bad[0]]:.4g} s, {info['unstable'][bad[0]]} negative stiffness "
+            "eigenvalue(s)) and no stable equilibrium was found from them"
+        )
+    for t, s_, jump in zip(info["snap_time"], info["snap_s"], info["snap_jump"], strict=True):
+        messages.append(
+            f"cable '{name}': snap-through at t = {t:.4g} s: the equilibrium became unstable "
+            f"and the cable jumped to a stable one, by up to {jump:.3g} m at s = {s_:.3f} m"
+        )
+    validity.report(messages, validity.StabilityWarning)
+    validity.report(validity.prestrain_messages(name, spans), validity.PrestrainWarning)
+    return info
+
+
+def _check_strains(scene: Scene, cables) -> list[str]:
+    """Strains outside the model's validity range: warnings, or errors with
+    ``simulation.strain_limit = "error"`` (docs/solver.md)."""
+    from cablelife import validity
+
+    messages = [m for c in cables for m in validity.strain_violations(c)]
+    if scene.simulation.strain_limit == "error":
+        return messages
+    validity.report(messages, validity.StrainLimitWarning)
+    return []
 
 
 def simulate(scene: Scene, mode: str | None = None, progress: Progress | None = None) -> Result:
@@ -378,6 +424,7 @@ def simulate(scene: Scene, mode: str | None = None, progress: Progress | None = 
         outcomes = [f.result() for f in futures]
     cables = {res.name: res for res, _ in outcomes}
     errors = [f"cable '{res.name}': {err}" for res, err in outcomes if err]
+    errors += _check_strains(scene, cables.values())
     result = Result(
         mode=mode,
         cables=cables,

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from cablelife.results import CableResult
+from cablelife.validity import strain_extremes
 
 
 def cable_summary(c: CableResult) -> dict:
@@ -22,6 +23,9 @@ def cable_summary(c: CableResult) -> dict:
         for name, r in c.clips.items()
     }
     iters = np.asarray(c.solver.get("iterations", [0]))
+    strain = strain_extremes(c)
+    unstable = np.asarray(c.solver.get("unstable", []))
+    snap_t = np.atleast_1d(c.solver.get("snap_time", []))
     return {
         "steps": c.n_steps,
         "segments": int(c.arc_length.size - 1),
@@ -37,4 +41,18 @@ def cable_summary(c: CableResult) -> dict:
         "newton_iterations_mean": float(iters.mean()) if iters.size else 0.0,
         "newton_iterations_max": int(iters.max()) if iters.size else 0,
         "wall_time": float(c.solver.get("wall_time", float("nan"))),
+        "max_axial_strain": strain["axial"],
+        "max_compressive_strain": strain["compression"],
+        "max_shear_strain": strain["shear"],
+        "prestrain": float(c.solver.get("prestrain", 0.0)),
+        "unstable_steps": int((unstable > 0).sum()),
+        "snap_throughs": [
+            {"t": float(t), "s": float(s_), "jump": float(j)}
+            for t, s_, j in zip(
+                snap_t,
+                np.atleast_1d(c.solver.get("snap_s", [])),
+                np.atleast_1d(c.solver.get("snap_jump", [])),
+                strict=True,
+            )
+        ],
     }

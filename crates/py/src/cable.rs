@@ -53,6 +53,13 @@ struct Record {
     iterations: Vec<i64>,
     substeps: Vec<i64>,
     residual: Vec<f64>,
+    /// Negative eigenvalues of the tangent stiffness (−1: not checked: dynamic steps, dead
+    /// moments).
+    unstable: Vec<i64>,
+    /// Snap-through in the step: fraction of the step, largest jump (m) and its node.
+    snap_fraction: Vec<f64>,
+    snap_jump: Vec<f64>,
+    snap_node: Vec<i64>,
     elastic_energy: Vec<f64>,
     kinetic_energy: Vec<f64>,
     load_potential: Vec<f64>,
@@ -74,6 +81,10 @@ impl Record {
             iterations: Vec::with_capacity(n),
             substeps: Vec::with_capacity(n),
             residual: Vec::with_capacity(n),
+            unstable: Vec::with_capacity(n),
+            snap_fraction: Vec::with_capacity(n),
+            snap_jump: Vec::with_capacity(n),
+            snap_node: Vec::with_capacity(n),
             elastic_energy: Vec::with_capacity(n),
             kinetic_energy: Vec::with_capacity(n),
             load_potential: Vec::with_capacity(n),
@@ -103,6 +114,19 @@ impl Record {
         self.iterations.push(stats.iterations as i64);
         self.substeps.push(stats.substeps as i64);
         self.residual.push(stats.residual);
+        self.unstable.push(stats.unstable.map_or(-1, |n| n as i64));
+        let snap = stats.snap.unwrap_or(rod::Snap {
+            fraction: f64::NAN,
+            jump: 0.0,
+            node: 0,
+        });
+        self.snap_fraction.push(snap.fraction);
+        self.snap_jump.push(snap.jump);
+        self.snap_node.push(if stats.snap.is_some() {
+            snap.node as i64
+        } else {
+            -1
+        });
         self.elastic_energy.push(ws.elastic_energy);
         self.load_potential.push(ws.load_potential);
     }
@@ -140,6 +164,10 @@ impl Record {
         d.set_item("iterations", PyArray1::from_vec(py, self.iterations))?;
         d.set_item("substeps", PyArray1::from_vec(py, self.substeps))?;
         d.set_item("residual", PyArray1::from_vec(py, self.residual))?;
+        d.set_item("unstable", PyArray1::from_vec(py, self.unstable))?;
+        d.set_item("snap_fraction", PyArray1::from_vec(py, self.snap_fraction))?;
+        d.set_item("snap_jump", PyArray1::from_vec(py, self.snap_jump))?;
+        d.set_item("snap_node", PyArray1::from_vec(py, self.snap_node))?;
         for (key, values) in [
             ("elastic_energy", self.elastic_energy),
             ("kinetic_energy", self.kinetic_energy),
@@ -174,12 +202,37 @@ fn read_poses(
     Ok(poses)
 }
 
+/// (clip a, clip b, chord, cable length between them) of each span.
+type SpanTuple = (String, String, f64, f64);
+
 /// One cable: mesh, state and solver.
 #[pyclass(module = "cablelife._core")]
 pub struct Cable {
     rod: Rod,
     state: Option<State>,
     solver: Statics,
+}
+
+impl Cable {
+    /// The spans between consecutive clips at the clip poses of the first step.
+    fn spans(&self, poses: Option<&Vec<Pose>>) -> Vec<SpanTuple> {
+        let Some(poses) = poses else {
+            return vec![];
+        };
+        let clips = &self.rod.spec.clips;
+        rod::routing::span_stretches(&self.rod, poses)
+            .into_iter()
+            .map(|sp| {
+                let (a, b) = sp.clips;
+                (
+                    clips[a].name.clone(),
+                    clips[b].name.clone(),
+                    sp.chord,
+                    sp.length,
+                )
+            })
+            .collect()
+    }
 }
 
 #[pymethods]
@@ -306,11 +359,11 @@ impl Cable {
             )));
         }
         let poses = read_poses(&pos, &qs)?;
+        let spans = self.spans(poses.first());
         let rod = &self.rod;
         let solver = &mut self.solver;
         let state_slot = &mut self.state;
         let mut poller = Poller::new(stop.as_ref(), progress, progress_every, poses.len());
-        // Routing problems (a cable too short between two clips) are input errors.
         let initial = route(rod, poses.first().map(|p| p.as_slice()))
             .map_err(|e| PyValueError::new_err(e.0))?;
         let (record, error) = py.detach(move || {
@@ -344,6 +397,7 @@ impl Cable {
         });
         let d = record.into_dict(py, self.rod.arc.len(), n_clips)?;
         d.set_item("error", error)?;
+        d.set_item("spans", spans)?;
         Ok(d)
     }
 
@@ -438,6 +492,7 @@ impl Cable {
         };
         let initial = route(&self.rod, poses.first().map(|p| p.as_slice()))
             .map_err(|e| PyValueError::new_err(e.0))?;
+        let spans = self.spans(poses.first());
         let rod = &self.rod;
         let solver = &mut self.solver;
         let state_slot = &mut self.state;
@@ -468,6 +523,7 @@ impl Cable {
                                 iterations: s.iterations,
                                 residual: s.residual,
                                 substeps: s.substeps - 1,
+                                ..Default::default()
                             };
                             rec.push(rod, &st, &dy.ws, &stats);
                             rec.push_energies(&dy.energies);
@@ -491,6 +547,7 @@ impl Cable {
         });
         let d = record.into_dict(py, self.rod.arc.len(), n_clips)?;
         d.set_item("error", error)?;
+        d.set_item("spans", spans)?;
         Ok(d)
     }
 

@@ -62,4 +62,14 @@ fn main() {
     time("forward/back substitution", &mut || {
         jac.solve_factored(&mut rhs)
     });
+    // The stability check after a converged solve: the inertia of the symmetric tangent.
+    let mut check = rod::stability::StabilityCheck::new(n + 1);
+    let inertia = check.inertia(&ws.jac, 0..n + 1);
+    time("stability check (LDLᵀ inertia)", &mut || {
+        check.inertia(&ws.jac, 0..n + 1);
+    });
+    println!(
+        "  (negative pivots at the routed shape: {})",
+        inertia.negative
+    );
 }

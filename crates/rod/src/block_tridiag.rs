@@ -106,7 +106,14 @@ impl BlockTridiag {
             if b > r.start {
                 d -= self.lower[b] * self.elim[b - 1];
             }
-            let (piv, inv_diag) = lu_in_place(&mut d).map_err(|_| Singular { block: b })?;
+            // Pivots are judged against their column of D_n before the elimination: a stiffness
+            // small against the others of the block (EI ≪ GA Δs²) is not a singularity, a
+            // pivot cancelled to round-off by the elimination (a free mode) is.
+            let mut scale = [0.0; 6];
+            for (k, c) in scale.iter_mut().enumerate() {
+                *c = self.diag[b].column(k).amax();
+            }
+            let (piv, inv_diag) = lu_in_place(&mut d, &scale).map_err(|_| Singular { block: b })?;
             let mut inv = Block::identity();
             lu_solve_matrix(&d, &piv, &inv_diag, &mut inv);
             self.inv[b] = inv;
@@ -178,14 +185,16 @@ fn mat_vec(m: &Block, x: &Vector6<f64>) -> Vector6<f64> {
     Vector6::from(a)
 }
 
+/// Relative size of a pivot against its column's scale below which the block is singular.
+const SINGULAR_PIVOT: f64 = 1e-13;
+
 /// LU factorisation of a 6×6 block in place (partial pivoting): returns the row interchanges and
-/// the reciprocals of U's diagonal; a pivot below 1e-14 of the largest (or not finite) is an
-/// error.
+/// the reciprocals of U's diagonal; a pivot below `SINGULAR_PIVOT` of its column's `scale` (or
+/// not finite) is an error.
 #[inline]
-fn lu_in_place(a: &mut Block) -> Result<([u8; 6], [f64; 6]), ()> {
+fn lu_in_place(a: &mut Block, scale: &[f64; 6]) -> Result<([u8; 6], [f64; 6]), ()> {
     let mut piv = [0u8; 6];
     let mut inv = [0.0; 6];
-    let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
     for k in 0..6 {
         let mut p = k;
         let mut max = a[(k, k)].abs();
@@ -201,9 +210,7 @@ fn lu_in_place(a: &mut Block) -> Result<([u8; 6], [f64; 6]), ()> {
             a.swap_rows(k, p);
         }
         let d = a[(k, k)];
-        lo = lo.min(d.abs());
-        hi = hi.max(d.abs());
-        if d == 0.0 || !d.is_finite() {
+        if d.abs() <= SINGULAR_PIVOT * scale[k] || !d.is_finite() {
             return Err(());
         }
         let r = 1.0 / d;
@@ -217,9 +224,6 @@ fn lu_in_place(a: &mut Block) -> Result<([u8; 6], [f64; 6]), ()> {
                 a[(i, j)] -= a[(i, k)] * akj;
             }
         }
-    }
-    if lo.is_nan() || lo <= 1e-14 * hi || !hi.is_finite() {
-        return Err(());
     }
     Ok((piv, inv))
 }

@@ -11,10 +11,11 @@ pub mod model;
 pub mod rotation;
 pub mod routing;
 pub mod shear;
+pub mod stability;
 pub mod state;
 pub mod statics;
 
 pub use dynamics::{ClipMotion, DynamicOptions, Dynamics, Energies, GenAlpha, StepStats};
 pub use model::{CableSpec, ClipKind, ClipSpec, PointLoad, Pose, Rod, Section, SpecError};
 pub use state::State;
-pub use statics::{NewtonOptions, SolveError, SolveStats, Statics};
+pub use statics::{NewtonOptions, Snap, SolveError, SolveStats, Statics};

@@ -60,34 +60,31 @@ pub fn route(rod: &Rod, poses: Option<&[Pose]>) -> Result<State, SpecError> {
         let (ta, tb) = (ra * Vector3::z(), rb * Vector3::z());
         let span = rod.arc[nb] - rod.arc[na];
         let chord = (b - a).norm();
-        if chord > span * (1.0 + 1e-9) {
-            return Err(SpecError(format!(
-                "the cable is too short between clip '{}' (s = {} m) and clip '{}' (s = {} m): \
-                 the clips are {:.6} m apart but the cable between them is {:.6} m long",
-                spec.clips[ca].name,
-                spec.clips[ca].s,
-                spec.clips[cb].name,
-                spec.clips[cb].s,
-                chord,
-                span
-            )));
-        }
-        let sag = sag_direction(&a, &b, &ta, &tb, &spec.gravity);
-        let curve = SpanCurve::fit(a, b, ta, tb, sag, span);
-        let pts: Vec<Vector3<f64>> = (0..=SAMPLES)
-            .map(|i| curve.at(i as f64 / SAMPLES as f64))
-            .collect();
-        let mut cum = vec![0.0; pts.len()];
-        for i in 1..pts.len() {
-            cum[i] = cum[i - 1] + (pts[i] - pts[i - 1]).norm();
-        }
-        let total = cum[SAMPLES];
-        for n in na + 1..nb {
-            let target = (rod.arc[n] - rod.arc[na]) / span * total;
-            let i = cum.partition_point(|&c| c < target).clamp(1, SAMPLES);
-            let t = (target - cum[i - 1]) / (cum[i] - cum[i - 1]).max(1e-300);
-            x[n] = pts[i - 1] + (pts[i] - pts[i - 1]) * t;
-            done[n] = true;
+        if chord > span {
+            // Pre-tensioned: the clips are farther apart than the cable between them is long;
+            // the span starts straight and uniformly stretched (see `span_stretches`).
+            for n in na + 1..nb {
+                x[n] = a + (b - a) * ((rod.arc[n] - rod.arc[na]) / span);
+                done[n] = true;
+            }
+        } else {
+            let sag = sag_direction(&a, &b, &ta, &tb, &spec.gravity);
+            let curve = SpanCurve::fit(a, b, ta, tb, sag, span);
+            let pts: Vec<Vector3<f64>> = (0..=SAMPLES)
+                .map(|i| curve.at(i as f64 / SAMPLES as f64))
+                .collect();
+            let mut cum = vec![0.0; pts.len()];
+            for i in 1..pts.len() {
+                cum[i] = cum[i - 1] + (pts[i] - pts[i - 1]).norm();
+            }
+            let total = cum[SAMPLES];
+            for n in na + 1..nb {
+                let target = (rod.arc[n] - rod.arc[na]) / span * total;
+                let i = cum.partition_point(|&c| c < target).clamp(1, SAMPLES);
+                let t = (target - cum[i - 1]) / (cum[i] - cum[i - 1]).max(1e-300);
+                x[n] = pts[i - 1] + (pts[i] - pts[i - 1]) * t;
+                done[n] = true;
+            }
         }
         // Frames: parallel transport from clip a, then spread the twist mismatch at clip b.
         let mut frame = poses[ca].orientation;
@@ -137,6 +134,43 @@ pub fn route(rod: &Rod, poses: Option<&[Pose]>) -> Result<State, SpecError> {
         ghost,
         clip_pose: poses,
     })
+}
+
+/// One span between consecutive clips: the distance of the held ends (chord) against the cable
+/// length between them.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SpanStretch {
+    pub clips: (usize, usize),
+    pub chord: f64,
+    pub length: f64,
+}
+
+impl SpanStretch {
+    /// The axial strain of the span if it were straight: chord/length − 1 (> 0: pre-tensioned).
+    pub fn strain(&self) -> f64 {
+        self.chord / self.length - 1.0
+    }
+}
+
+/// The spans between consecutive clips (by arc length) at the given clip poses.
+pub fn span_stretches(rod: &Rod, poses: &[Pose]) -> Vec<SpanStretch> {
+    let mut order: Vec<usize> = (0..rod.spec.clips.len()).collect();
+    order.sort_by(|&a, &b| rod.spec.clips[a].s.total_cmp(&rod.spec.clips[b].s));
+    order
+        .windows(2)
+        .map(|w| {
+            let (ca, cb) = (w[0], w[1]);
+            let na = *rod.clip_nodes[ca].last().unwrap();
+            let nb = rod.clip_nodes[cb][0];
+            let a = rod.clip_node_position(ca, na, &poses[ca]);
+            let b = rod.clip_node_position(cb, nb, &poses[cb]);
+            SpanStretch {
+                clips: (ca, cb),
+                chord: (b - a).norm(),
+                length: rod.arc[nb] - rod.arc[na],
+            }
+        })
+        .collect()
 }
 
 /// Signed angle about the common d3 axis that takes frame `a` to frame `b`.

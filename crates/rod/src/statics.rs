@@ -2,10 +2,11 @@
 //! search on the scaled residual, load continuation when plain Newton fails, and sub-stepped
 //! clip motions for sequences of equilibria.
 use crate::assembly::{KinkAt, Workspace};
-use crate::model::{Pose, Rod};
+use crate::model::{NodeKind, Pose, Rod};
 use crate::rotation::slerp;
+use crate::stability::{free_rigid_motions, Inertia, StabilityCheck};
 use crate::state::State;
-use nalgebra::Vector6;
+use nalgebra::{Vector3, Vector6};
 use std::fmt;
 
 #[derive(Clone, Debug)]
@@ -44,6 +45,35 @@ pub struct SolveStats {
     pub residual: f64,
     /// Number of continuation or sub-steps used (0: plain Newton worked).
     pub substeps: usize,
+    /// Negative eigenvalues of the tangent stiffness at the returned state (0: stable; None:
+    /// not checked — dead moments make the loads non-conservative, see `ensure_stable`).
+    pub unstable: Option<usize>,
+    /// Unstable equilibria met and left on the way (see `Statics::ensure_stable`).
+    pub escapes: usize,
+    /// The largest jump to another stable branch in a quasistatic step, if any.
+    pub snap: Option<Snap>,
+}
+
+/// A snap-through: the equilibrium branch ended (or became unstable) inside a step and the
+/// cable jumped to another stable equilibrium.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Snap {
+    /// Fraction of the step's clip motion at which it happened.
+    pub fraction: f64,
+    /// Largest node displacement of the jump, m, and that node.
+    pub jump: f64,
+    pub node: usize,
+}
+
+impl SolveStats {
+    /// Keeps the larger snap of two.
+    fn merge_snap(&mut self, other: Option<Snap>) {
+        if let Some(o) = other {
+            if self.snap.is_none_or(|s| o.jump > s.jump) {
+                self.snap = Some(o);
+            }
+        }
+    }
 }
 
 #[derive(Clone, Debug)]
@@ -55,6 +85,13 @@ pub enum SolveError {
     Singular {
         node: usize,
         s: f64,
+    },
+    /// The clips leave a rigid-body motion of a part of the cable free.
+    RigidBody {
+        /// The clips holding that part, and the free motion (translation, rotation).
+        clips: String,
+        translation: Vector3<f64>,
+        rotation: Vector3<f64>,
     },
     NotConverged {
         iterations: usize,
@@ -73,9 +110,32 @@ impl fmt::Display for SolveError {
             ),
             SolveError::Singular { node, s } => write!(
                 f,
-                "the stiffness matrix is singular near node {node} (s = {s:.4} m): the clips \
-                 leave a rigid-body motion of the cable free (add a fixed clip or a constraint)"
+                "the stiffness matrix is singular near node {node} (s = {s:.4} m), although the \
+                 clips hold the cable against every rigid-body motion: a section stiffness is \
+                 zero or too small to resolve against the others (check the section and \
+                 material), or the state is at a bifurcation"
             ),
+            SolveError::RigidBody {
+                clips,
+                translation,
+                rotation,
+            } => {
+                let what = if rotation.norm() > 1e-6 {
+                    let a = rotation.normalize();
+                    format!(
+                        "a rotation about the axis ({:.3}, {:.3}, {:.3})",
+                        a.x, a.y, a.z
+                    )
+                } else {
+                    let t = translation.normalize();
+                    format!("a translation along ({:.3}, {:.3}, {:.3})", t.x, t.y, t.z)
+                };
+                write!(
+                    f,
+                    "the stiffness matrix is singular: the clips {clips} leave a rigid-body \
+                     motion of the cable free ({what}); add a fixed clip or hold it otherwise"
+                )
+            }
             SolveError::NotConverged {
                 iterations,
                 residual,
@@ -93,6 +153,14 @@ impl std::error::Error for SolveError {}
 /// Initial damping of the pseudo-transient path relative to the stiffest diagonal entry.
 const PTC_START: f64 = 1e-3;
 
+/// Bisection depth of a quasistatic step from which a failed sub-step is relaxed by energy
+/// descent (the branch may end in a fold there).
+const SNAP_DEPTH: usize = 6;
+
+/// A jump of a node by more than this fraction of the cable length within a sub-step of
+/// 2⁻⁶ of a step is reported as a snap-through.
+const SNAP_JUMP: f64 = 0.01;
+
 /// A static/quasistatic solver for one cable: the workspace and options.
 pub struct Statics {
     pub ws: Workspace,
@@ -107,6 +175,10 @@ pub struct Statics {
     prev: State,
     has_prev: bool,
     force_scale: f64,
+    /// Stability check (block LDLᵀ inertia) and the state before an escape.
+    pub stability: StabilityCheck,
+    before: State,
+    relax_start: State,
 }
 
 impl Statics {
@@ -133,6 +205,9 @@ impl Statics {
             prev: State::empty(),
             has_prev: false,
             force_scale: weight.max(loads).max(bend).max(1e-12),
+            stability: StabilityCheck::new(rod.n_edges() + 1),
+            before: State::empty(),
+            relax_start: State::empty(),
         }
     }
 
@@ -326,8 +401,52 @@ impl Statics {
     /// Static equilibrium: plain Newton; then pseudo-transient continuation; then load
     /// continuation from the unloaded routed shape (gravity and loads ramped), with plain and
     /// then damped Newton steps.
+    ///
+    /// The equilibrium found is checked for stability and, if unstable, left for a stable one
+    /// (`ensure_stable`); a singular system is diagnosed (a rigid-body motion the clips leave
+    /// free, or a zero stiffness).
     pub fn solve(&mut self, rod: &Rod, st: &mut State) -> Result<SolveStats, SolveError> {
         self.has_prev = false; // a new sequence starts here
+        self.check_held(rod, st)?;
+        let mut stats = self.solve_any(rod, st)?;
+        self.ensure_stable(rod, st, &mut stats, 0.0)?;
+        stats.snap = None; // leaving an unstable first solution is no jump of the cable
+        Ok(stats)
+    }
+
+    /// Fails with `RigidBody` if the clips leave a rigid-body motion of a part free.
+    pub fn check_held(&self, rod: &Rod, st: &State) -> Result<(), SolveError> {
+        for seg in &rod.segments {
+            let fixed = seg
+                .clips
+                .iter()
+                .any(|&c| rod.spec.clips[c].kind == crate::model::ClipKind::Fixed);
+            if fixed {
+                continue;
+            }
+            if let (n, Some((t, w))) = free_rigid_motions(rod, &seg.clips, &st.clip_pose) {
+                debug_assert!(n > 0);
+                let names: Vec<String> = seg
+                    .clips
+                    .iter()
+                    .map(|&c| format!("'{}'", rod.spec.clips[c].name))
+                    .collect();
+                return Err(SolveError::RigidBody {
+                    clips: if names.is_empty() {
+                        "(none)".into()
+                    } else {
+                        names.join(", ")
+                    },
+                    translation: t,
+                    rotation: w,
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// Any equilibrium: plain Newton, pseudo-transient, load continuation (see `solve`).
+    fn solve_any(&mut self, rod: &Rod, st: &mut State) -> Result<SolveStats, SolveError> {
         let start = st.clone();
         // Plain Newton converges in a handful of iterations from a good guess; a slow start
         // means a poor guess, for which the pseudo-transient path is the better use of time.
@@ -360,6 +479,419 @@ impl Statics {
             }
         }
         Err(last)
+    }
+
+    /// Inertia of the tangent stiffness at `st` (the Jacobian assembled there: after a
+    /// converged solve it already is, `assemble` false).
+    pub fn inertia(
+        &mut self,
+        rod: &Rod,
+        st: &State,
+        assemble: bool,
+    ) -> Result<Inertia, SolveError> {
+        if assemble {
+            self.ws
+                .assemble_static(rod, st, 1.0, true)
+                .map_err(|k| Self::kink_err(rod, k))?;
+        }
+        Ok(self.stability.inertia(&self.ws.jac, 0..rod.arc.len()))
+    }
+
+    /// Checks the equilibrium `st` (just converged: the Jacobian is assembled there) for
+    /// stability; an unstable one is left along a direction of negative curvature (both signs
+    /// tried, the lower energy kept) and relaxed (`relax`: pseudo-transient continuation) into a stable one, with larger
+    /// perturbations if that lands on an unstable state again. `stats.unstable` is the count
+    /// of negative eigenvalues at the state returned (0 unless no stable state was found);
+    /// `stats.snap` the jump if there was an escape (at `fraction` of a quasistatic step).
+    pub fn ensure_stable(
+        &mut self,
+        rod: &Rod,
+        st: &mut State,
+        stats: &mut SolveStats,
+        fraction: f64,
+    ) -> Result<(), SolveError> {
+        if rod.edge_moment.iter().any(|m| *m != Vector3::zeros()) {
+            // A dead moment is not conservative on the rotation group: the symmetric part of
+            // the tangent is then no stability criterion (that needs the dynamics).
+            stats.unstable = None;
+            return Ok(());
+        }
+        let mut inertia = self.inertia(rod, st, false)?;
+        stats.unstable = Some(inertia.negative);
+        if inertia.negative == 0 {
+            return Ok(());
+        }
+        self.before.clone_from(st);
+        let l = rod.spec.length;
+        for attempt in 0..4 {
+            if !self.unstable_mode(rod) {
+                break;
+            }
+            // Scale: 0.1 rad of rotation or 2 % of the length, whichever comes first.
+            let (mut dx, mut dth) = (0.0f64, 0.0f64);
+            for (b, d) in self.trial.iter().enumerate() {
+                for k in 0..6 {
+                    if rod.mask[b][k] {
+                        if k < 3 {
+                            dx = dx.max(d[k].abs());
+                        } else {
+                            dth = dth.max(d[k].abs());
+                        }
+                    }
+                }
+            }
+            let amp = f64::from(1u32 << attempt) / (dth / 0.1).max(dx / (0.02 * l)).max(1e-300);
+            let mut best = (f64::INFINITY, 0.0);
+            for sign in [1.0, -1.0] {
+                st.clone_from(&self.before);
+                st.apply_increment(rod, &self.trial, sign * amp);
+                if self.ws.assemble_static(rod, st, 1.0, false).is_ok() {
+                    let e = self.ws.elastic_energy + self.ws.load_potential;
+                    if e < best.0 {
+                        best = (e, sign);
+                    }
+                }
+            }
+            if best.1 == 0.0 {
+                break;
+            }
+            st.clone_from(&self.before);
+            st.apply_increment(rod, &self.trial, best.1 * amp);
+            let found = self.relax(rod, st, true);
+            if std::env::var_os("ROD_DEBUG").is_some() {
+                eprintln!("escape {attempt}: amp {amp:.3e} dx {dx:.3e} dth {dth:.3e} -> {found:?}");
+            }
+            match found {
+                Ok(s) => {
+                    stats.iterations += s.iterations;
+                    stats.residual = s.residual;
+                    inertia = self.inertia(rod, st, false)?;
+                    if inertia.negative == 0 {
+                        stats.unstable = Some(0);
+                        stats.escapes += 1;
+                        stats.merge_snap(Some(self.jump_from_before(rod, st, fraction)));
+                        return Ok(());
+                    }
+                }
+                Err(SolveError::Singular { .. }) | Err(SolveError::NotConverged { .. }) => {}
+                Err(e) => return Err(e),
+            }
+            // Not stable: try again from the unstable state with a larger perturbation.
+            st.clone_from(&self.before);
+            self.inertia(rod, st, true)?;
+        }
+        // No stable state found: return the unstable equilibrium, flagged.
+        st.clone_from(&self.before);
+        inertia = self.inertia(rod, st, true)?;
+        stats.unstable = Some(inertia.negative);
+        if std::env::var_os("ROD_DEBUG").is_some() {
+            eprintln!("no stable state found: {inertia:?}");
+        }
+        Ok(())
+    }
+
+    /// The mode of the most negative eigenvalue of H φ = λ D φ (H the symmetric tangent
+    /// stiffness assembled in the workspace, D the damping diagonal of `pseudo_transient`), in
+    /// `self.trial`: a direction of negative curvature from the block LDLᵀ, refined by inverse
+    /// iteration with H shifted below that eigenvalue (the shift raised until the shifted
+    /// matrix is positive definite). The workspace Jacobian is left as it was.
+    fn unstable_mode(&mut self, rod: &Rod) -> bool {
+        let nb = rod.arc.len();
+        if !self.stability.negative_direction(0..nb, &mut self.trial) {
+            return false;
+        }
+        let damping = |b: usize, k: usize| -> f64 {
+            if k < 3 {
+                rod.ds_node[b]
+            } else {
+                rod.ds_edge[b.min(nb - 2)].powi(3) / 12.0
+            }
+        };
+        let d_norm = |z: &[Vector6<f64>]| -> f64 {
+            let mut sum = 0.0;
+            for (b, v) in z.iter().enumerate() {
+                for k in 0..6 {
+                    if rod.mask[b][k] {
+                        sum += damping(b, k) * v[k] * v[k];
+                    }
+                }
+            }
+            sum
+        };
+        // Rayleigh quotient zᵀHz / zᵀDz (the skew part of J drops out of zᵀJz).
+        self.ws.jac.mul(&self.trial, &mut self.delta);
+        let zhz: f64 = self
+            .trial
+            .iter()
+            .zip(&self.delta)
+            .map(|(a, b)| a.dot(b))
+            .sum();
+        let rho = zhz / d_norm(&self.trial).max(1e-300);
+        if !(rho < 0.0 && rho.is_finite()) {
+            return true; // keep the LDLᵀ direction
+        }
+        let shift = |jac: &mut crate::block_tridiag::BlockTridiag, mu: f64| {
+            for b in 0..nb {
+                for k in 0..6 {
+                    if rod.mask[b][k] {
+                        jac.diag[b][(k, k)] -= mu * damping(b, k);
+                    }
+                }
+            }
+        };
+        let mut mu = 1.5 * rho;
+        let mut ok = false;
+        for _ in 0..30 {
+            shift(&mut self.ws.jac, mu);
+            let inertia = self.stability.inertia(&self.ws.jac, 0..nb);
+            if inertia.negative == 0 && inertia.zero == 0 && self.ws.jac.factor().is_ok() {
+                ok = true;
+                break;
+            }
+            shift(&mut self.ws.jac, -mu);
+            mu *= 1.5;
+        }
+        if !ok {
+            return true;
+        }
+        let iterate = |ws: &mut Workspace, z: &mut [Vector6<f64>], count: usize| {
+            for _ in 0..count {
+                for (b, v) in z.iter_mut().enumerate() {
+                    for k in 0..6 {
+                        v[k] *= if rod.mask[b][k] { damping(b, k) } else { 0.0 };
+                    }
+                }
+                ws.jac.solve_factored(z);
+                let n = d_norm(z).sqrt().max(1e-300);
+                z.iter_mut().for_each(|v| *v /= n);
+            }
+        };
+        iterate(&mut self.ws, &mut self.trial, 8);
+        shift(&mut self.ws.jac, -mu);
+        // Nearly equal negative eigenvalues (a round section: one per bending plane, split
+        // only by imperfections) need a shift close to the eigenvalue to separate: shift by
+        // the Rayleigh quotient less 1 % (10 % if that is not below the spectrum).
+        self.ws.jac.mul(&self.trial, &mut self.delta);
+        let zhz: f64 = self
+            .trial
+            .iter()
+            .zip(&self.delta)
+            .map(|(a, b)| a.dot(b))
+            .sum();
+        let rho = zhz / d_norm(&self.trial).max(1e-300);
+        for gap in [0.01, 0.1] {
+            let mu = rho * (1.0 + gap);
+            shift(&mut self.ws.jac, mu);
+            let inertia = self.stability.inertia(&self.ws.jac, 0..nb);
+            let pd = inertia.negative == 0 && inertia.zero == 0 && self.ws.jac.factor().is_ok();
+            if pd {
+                iterate(&mut self.ws, &mut self.trial, 40);
+            }
+            shift(&mut self.ws.jac, -mu);
+            if pd {
+                break;
+            }
+        }
+        true
+    }
+
+    /// From a perturbed (or no longer equilibrated) state into a stable equilibrium: energy
+    /// descent (`descend`); if that fails, pseudo-transient continuation finished by plain
+    /// Newton where a nearly neutral mode (e.g. the plane of a buckled round section) makes it
+    /// creep near the solution.
+    fn relax(
+        &mut self,
+        rod: &Rod,
+        st: &mut State,
+        newton_shortcut: bool,
+    ) -> Result<SolveStats, SolveError> {
+        self.relax_start.clone_from(st);
+        let found = self.descend(rod, st, 20 * self.opts.max_iterations, newton_shortcut);
+        if let Ok(s) = found {
+            return Ok(s);
+        }
+        st.clone_from(&self.relax_start);
+        let found = self.pseudo_transient(rod, st, 1.0, 20 * self.opts.max_iterations);
+        match found {
+            Err(SolveError::NotConverged { iterations, .. }) => {
+                let mut s = self.newton(rod, st, 1.0, false)?;
+                s.iterations += iterations;
+                Ok(s)
+            }
+            other => other,
+        }
+    }
+
+    /// Energy descent into a stable equilibrium: steps (J + σD)Δ = −r with σ ≥ 0 the least
+    /// (of a geometric sequence) that makes the symmetric part of J + σD positive definite, so
+    /// Δ is a descent direction and a saddle cannot attract the iteration; backtracking on the
+    /// potential energy (Armijo), or, near the minimum where the energy's round-off hides the
+    /// decrease, on the natural monotonicity test. σ is lowered after each step; it ends as
+    /// Newton at a minimum. Dead moments are not conservative: then only the monotonicity test.
+    /// With `newton_shortcut`, plain Newton is tried wherever J is positive definite (it may
+    /// jump to a farther stable state: for escapes from unstable states, not for following a
+    /// branch).
+    pub fn descend(
+        &mut self,
+        rod: &Rod,
+        st: &mut State,
+        max_iterations: usize,
+        newton_shortcut: bool,
+    ) -> Result<SolveStats, SolveError> {
+        let h = rod.mean_ds();
+        let l = rod.spec.length;
+        let nb = rod.arc.len();
+        let conservative = rod.edge_moment.iter().all(|m| *m == Vector3::zeros());
+        let damping = |b: usize, k: usize| -> f64 {
+            if k < 3 {
+                rod.ds_node[b]
+            } else {
+                rod.ds_edge[b.min(nb - 2)].powi(3) / 12.0
+            }
+        };
+        let add_damping = |jac: &mut crate::block_tridiag::BlockTridiag, sigma: f64| {
+            for b in 0..nb {
+                for k in 0..6 {
+                    if rod.mask[b][k] {
+                        jac.diag[b][(k, k)] += sigma * damping(b, k);
+                    }
+                }
+            }
+        };
+        self.ws
+            .assemble_static(rod, st, 1.0, true)
+            .map_err(|k| Self::kink_err(rod, k))?;
+        let mut energy = self.ws.elastic_energy + self.ws.load_potential;
+        let (_, mut rinf) = self.ws.residual_norms(h);
+        let mut sigma_ref = 0.0f64;
+        for b in 0..nb {
+            for k in 0..6 {
+                if rod.mask[b][k] {
+                    sigma_ref = sigma_ref.max(self.ws.jac.diag[b][(k, k)].abs() / damping(b, k));
+                }
+            }
+        }
+        let floor = 1e-12 * sigma_ref;
+        let mut sigma = 0.0f64;
+        let mut next_newton = 0;
+        let mut stats = SolveStats::default();
+        for it in 0..max_iterations {
+            stats.iterations = it + 1;
+            if rinf <= self.opts.residual_tolerance * self.force_scale {
+                stats.iterations = it;
+                stats.residual = rinf;
+                return Ok(stats);
+            }
+            // The least σ (0, then 10× steps) that makes J + σD positive definite.
+            let mut pd = false;
+            for _ in 0..40 {
+                add_damping(&mut self.ws.jac, sigma);
+                let inertia = self.stability.inertia(&self.ws.jac, 0..nb);
+                if inertia.negative == 0 && inertia.zero == 0 && self.ws.factor(rod).is_ok() {
+                    pd = true;
+                    break;
+                }
+                add_damping(&mut self.ws.jac, -sigma);
+                sigma = (sigma * 10.0).max(floor);
+            }
+            if !pd {
+                break;
+            }
+            let (dx, dth) = self.ws.newton_correction(&mut self.delta);
+            let step = (dx / l).max(dth);
+            if !step.is_finite() {
+                break;
+            }
+            // Directional derivative of the energy along Δ: rᵀΔ < 0.
+            let slope: f64 = self
+                .ws
+                .rhs
+                .iter()
+                .zip(&self.delta)
+                .map(|(r, d)| r.dot(d))
+                .sum();
+            let norm0 = scaled_norm(&self.delta, l);
+            let mut alpha = 1.0f64.min(self.opts.max_rotation_step / dth.max(1e-300));
+            self.base.clone_from(st);
+            let mut accepted = false;
+            for _ in 0..30 {
+                st.apply_increment(rod, &self.delta, alpha);
+                if self.ws.assemble_static(rod, st, 1.0, false).is_ok() {
+                    let e = self.ws.elastic_energy + self.ws.load_potential;
+                    let armijo = conservative && e <= energy + 1e-4 * alpha * slope;
+                    for (d, r) in self.trial.iter_mut().zip(&self.ws.rhs) {
+                        *d = -r;
+                    }
+                    self.ws.jac.solve_factored(&mut self.trial);
+                    let theta = scaled_norm(&self.trial, l) / norm0.max(1e-300);
+                    if e.is_finite() && (armijo || theta <= 1.0 - 0.25 * alpha) {
+                        energy = e;
+                        accepted = true;
+                        break;
+                    }
+                }
+                st.clone_from(&self.base);
+                alpha *= 0.5;
+            }
+            if !accepted {
+                sigma = (sigma * 10.0).max(floor);
+                self.ws
+                    .assemble_static(rod, st, 1.0, true)
+                    .map_err(|k| Self::kink_err(rod, k))?;
+                continue;
+            }
+            self.ws
+                .assemble_static(rod, st, 1.0, true)
+                .map_err(|k| Self::kink_err(rod, k))?;
+            (_, rinf) = self.ws.residual_norms(h);
+            if std::env::var_os("ROD_DEBUG").is_some() {
+                eprintln!("descend {it} sigma {sigma:.3e} alpha {alpha:.3e} E {energy:.9e} rinf {rinf:.3e}");
+            }
+            if sigma == 0.0 && alpha == 1.0 && step < self.opts.step_tolerance {
+                stats.residual = rinf;
+                return Ok(stats);
+            }
+            if newton_shortcut && sigma == 0.0 && it >= next_newton {
+                // Positive definite: Newton from here, which does not creep along a nearly
+                // neutral direction as the backtracking does; kept if it ends stable.
+                self.base.clone_from(st);
+                if let Ok(s) = self.newton(rod, st, 1.0, false) {
+                    stats.iterations += s.iterations;
+                    if self.stability.inertia(&self.ws.jac, 0..nb).negative == 0 {
+                        stats.residual = s.residual;
+                        return Ok(stats);
+                    }
+                }
+                next_newton = it + 10;
+                st.clone_from(&self.base);
+                self.ws
+                    .assemble_static(rod, st, 1.0, true)
+                    .map_err(|k| Self::kink_err(rod, k))?;
+            }
+            sigma = if sigma <= floor { 0.0 } else { 0.1 * sigma };
+        }
+        Err(SolveError::NotConverged {
+            iterations: stats.iterations,
+            residual: rinf,
+            load_factor: 1.0,
+        })
+    }
+
+    /// The largest node displacement from `self.before` to `st`.
+    fn jump_from_before(&self, rod: &Rod, st: &State, fraction: f64) -> Snap {
+        let mut snap = Snap {
+            fraction,
+            jump: 0.0,
+            node: 0,
+        };
+        for (n, (a, b)) in self.before.x.iter().zip(&st.x).enumerate() {
+            let d = (a - b).norm();
+            if rod.node_kind[n] == NodeKind::Free && d > snap.jump {
+                snap.jump = d;
+                snap.node = n;
+            }
+        }
+        snap
     }
 
     fn continuation(
@@ -407,7 +939,10 @@ impl Statics {
         self.saved.clone_from(st);
         st.set_clip_poses(rod, target);
         match self.newton(rod, st, 1.0, false) {
-            Ok(s) => return Ok(s),
+            Ok(mut s) => {
+                self.ensure_stable(rod, st, &mut s, 1.0)?;
+                return Ok(s);
+            }
             Err(e @ SolveError::Singular { .. }) => return Err(e),
             Err(_) => st.clone_from(&self.saved),
         }
@@ -427,10 +962,14 @@ impl Statics {
             self.saved.clone_from(st);
             st.set_clip_poses(rod, &poses);
             match self.newton(rod, st, 1.0, false) {
-                Ok(s) => {
+                Ok(mut s) => {
+                    self.ensure_stable(rod, st, &mut s, f)?;
                     total.iterations += s.iterations;
                     total.residual = s.residual;
                     total.substeps += 1;
+                    total.unstable = s.unstable;
+                    total.escapes += s.escapes;
+                    total.merge_snap(s.snap);
                     done = f;
                     if depth > 1 {
                         depth -= 1;
@@ -439,6 +978,40 @@ impl Statics {
                 }
                 Err(e) => {
                     st.clone_from(&self.saved);
+                    if depth >= SNAP_DEPTH {
+                        // The branch may end here (a fold): relax into a stable equilibrium at
+                        // these clip poses or, where the landscape is too flat for that next to
+                        // the fold, at the step's target; a large jump is a snap-through at f.
+                        for (to, poses_to) in [(f, &poses), (1.0, &target.to_vec())] {
+                            st.clone_from(&self.saved);
+                            st.set_clip_poses(rod, poses_to);
+                            let relaxed = self.relax(rod, st, true);
+                            if std::env::var_os("ROD_DEBUG").is_some() {
+                                eprintln!("fold? f {f} → {to}, depth {depth}: {relaxed:?}");
+                            }
+                            let Ok(mut s) = relaxed else { continue };
+                            self.ensure_stable(rod, st, &mut s, f)?;
+                            if s.unstable.unwrap_or(0) != 0 {
+                                continue;
+                            }
+                            total.iterations += s.iterations;
+                            total.residual = s.residual;
+                            total.substeps += 1;
+                            total.unstable = s.unstable;
+                            self.before.clone_from(&self.saved);
+                            let snap = self.jump_from_before(rod, st, f);
+                            if snap.jump > SNAP_JUMP * rod.spec.length {
+                                total.escapes += 1;
+                                total.merge_snap(Some(snap));
+                            }
+                            done = to;
+                            break;
+                        }
+                        if done >= f {
+                            continue;
+                        }
+                        st.clone_from(&self.saved);
+                    }
                     df *= 0.5;
                     depth += 1;
                     if depth > self.opts.max_substep_depth {
