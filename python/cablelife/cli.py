@@ -142,8 +142,11 @@ def modes(
         t.add_column("mode", justify="right")
         t.add_column("f [Hz]", justify="right")
         t.add_column("ω [rad/s]", justify="right")
+        t.add_column("type")
+        t.add_column("energy share", justify="right")
         for i, (f, w) in enumerate(zip(m.frequencies, m.omega, strict=True), start=1):
-            t.add_row(str(i), f"{f:.4g}", f"{w:.4g}")
+            share = f"{100 * m.shares[i - 1].max():.0f} %"
+            t.add_row(str(i), f"{f:.4g}", f"{w:.4g}", m.kind[i - 1], share)
         console.print(t)
 
 

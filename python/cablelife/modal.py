@@ -1,20 +1,24 @@
 """Modal analysis of the mounted cable: natural frequencies and mode shapes, linearised about
-the static equilibrium (the tangent stiffness of the solver and the lumped masses).
+the static equilibrium at the clip poses of t = 0 (the tangent stiffness of the solver with
+the geometric stiffness of the current loads, and the lumped masses).
 
-The massless unknowns (the free twists of swivel clips) are condensed out statically (exact for
-massless degrees of freedom); the generalized symmetric eigenproblem K φ = ω² M φ is solved with
-LAPACK for the lowest modes.
+The eigenproblem K φ = ω² M φ is solved in Rust on the block-tridiagonal structure
+(``rod::modal``: shift-invert subspace iteration with a block LDLᵀ and its Sturm count, O(N)
+memory); massless unknowns (swivel twists) need no condensation. ``cable_modes_dense`` is the
+former dense LAPACK solver, kept for comparison (tests, benchmarks).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.linalg
 
 from cablelife.scene import Cable, Scene, SceneError
 from cablelife.simulate import build_cable, clip_poses
+
+#: The modal energy shares, in the order of ``Modes.shares``.
+SHARE_NAMES = ("bending d1", "bending d2", "torsion", "axial")
 
 
 @dataclass
@@ -26,6 +30,10 @@ class Modes:
     shapes: np.ndarray  # (k, N+1, 3) node displacements, mass-normalised, global frame
     arc_length: np.ndarray  # (N+1,)
     equilibrium: np.ndarray  # (N+1, 3) node positions of the static equilibrium
+    rotations: np.ndarray | None = None  # (k, N, 3) edge rotations, global frame
+    #: (k, 4) shares of the modal energy: bending d1, bending d2, torsion, axial
+    shares: np.ndarray | None = None
+    kind: list[str] = field(default_factory=list)  # dominant share of each mode
 
     @property
     def frequencies(self) -> np.ndarray:
@@ -33,19 +41,49 @@ class Modes:
         return self.omega / (2 * np.pi)
 
 
-def cable_modes(scene: Scene, cable: Cable, count: int = 6) -> Modes:
-    """The ``count`` lowest modes of ``cable`` mounted at its clips in the reference
-    configuration (bodies at rest)."""
-    if count < 1:
-        raise SceneError(f"count = {count}: ask for at least 1 mode")
+def _equilibrium(scene: Scene, cable: Cable):
+    """The solver object at the static equilibrium with the clip poses of t = 0."""
     core = build_cable(scene, cable)
-    pos, quat = clip_poses(scene, cable, np.array([0.0]), with_motion=False)
+    pos, quat = clip_poses(scene, cable, np.array([0.0]), with_motion=True)
     try:
         out = core.run_sequence(pos, quat)
     except ValueError as err:
         raise SceneError(f"cable '{cable.name}': {err}") from None
     if out["error"]:
         raise SceneError(f"cable '{cable.name}': no static equilibrium: {out['error']}")
+    return core, out
+
+
+def cable_modes(scene: Scene, cable: Cable, count: int = 6) -> Modes:
+    """The ``count`` lowest modes of ``cable`` at its static equilibrium with the clip poses
+    of t = 0 (the banded Rust solver)."""
+    if count < 1:
+        raise SceneError(f"count = {count}: ask for at least 1 mode")
+    core, out = _equilibrium(scene, cable)
+    try:
+        found = core.modes(count)
+    except ValueError as err:
+        raise SceneError(f"cable '{cable.name}': {err}") from None
+    return Modes(
+        cable=cable.name,
+        omega=found["omega"],
+        shapes=found["displacements"],
+        arc_length=core.arc_length,
+        equilibrium=out["positions"][0],
+        rotations=found["rotations"],
+        shares=found["shares"],
+        kind=list(found["kind"]),
+    )
+
+
+def cable_modes_dense(scene: Scene, cable: Cable, count: int = 6) -> Modes:
+    """The former dense solver (LAPACK on the (6N)² matrices, static condensation of the
+    massless unknowns): O(N²) memory, O(N³) time. For comparison only."""
+    import scipy.linalg
+
+    if count < 1:
+        raise SceneError(f"count = {count}: ask for at least 1 mode")
+    core, out = _equilibrium(scene, cable)
     lin = core.linearize()
     k = lin["stiffness"]
     k = 0.5 * (k + k.T)  # symmetric at equilibrium up to round-off (and dead moments)

@@ -366,11 +366,12 @@ mod tests {
                         // and sample n−1 differ in the last bit), counted as a cycle of its
                         // own ~1e-16 range
                         let c = count(&s, Residue::Repeated);
-                        let swings: Vec<&Cycle> =
-                            c.iter().filter(|c| c.range > 1e-12).collect();
+                        let swings: Vec<&Cycle> = c.iter().filter(|c| c.range > 1e-12).collect();
                         assert_eq!(swings.len(), periods, "{case}: {c:?}");
                         assert!(
-                            swings.iter().all(|c| c.count == 1.0 && c.range > 1.4 * peak),
+                            swings
+                                .iter()
+                                .all(|c| c.count == 1.0 && c.range > 1.4 * peak),
                             "{case}: {c:?}"
                         );
                         // a gate above round-off: exactly the periods
@@ -391,7 +392,10 @@ mod tests {
         let total: f64 = c.iter().map(|c| c.count).sum();
         let ranges: f64 = c.iter().map(|c| c.count * c.range).sum();
         assert!((ranges - 10.0).abs() < 1e-9, "{c:?}");
-        assert!((total - 5.5).abs() < 1e-12 || (total - 6.0).abs() < 1e-12, "{c:?}");
+        assert!(
+            (total - 5.5).abs() < 1e-12 || (total - 6.0).abs() < 1e-12,
+            "{c:?}"
+        );
     }
 
     #[test]

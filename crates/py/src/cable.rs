@@ -507,6 +507,53 @@ impl Cable {
         Ok(d)
     }
 
+    /// The `count` lowest natural modes about the state of the last run (a static
+    /// equilibrium), by the banded shift-invert solver (`rod::modal`). Returns `omega` (k,)
+    /// rad/s, `displacements` (k, N+1, 3) and `rotations` (k, N, 3) mass-normalised (global
+    /// frame), `shares` (k, 4) modal energy shares (bending d1, bending d2, torsion, axial)
+    /// and `kind` (k,) names. An unstable equilibrium is a ValueError.
+    fn modes<'py>(&mut self, py: Python<'py>, count: usize) -> PyResult<Bound<'py, PyDict>> {
+        let st = self
+            .state
+            .as_ref()
+            .ok_or_else(|| PyValueError::new_err("run a static solve (run_sequence) first"))?;
+        let rod = &self.rod;
+        let modes = py
+            .detach(|| rod::modal::lowest_modes(rod, st, count))
+            .map_err(|e| PyValueError::new_err(e.to_string()))?;
+        let k = modes.len();
+        let (nodes, edges) = (rod.arc.len(), rod.n_edges());
+        let mut omega = Vec::with_capacity(k);
+        let mut disp = Vec::with_capacity(k * nodes * 3);
+        let mut rot = Vec::with_capacity(k * edges * 3);
+        let mut shares = Vec::with_capacity(k * 4);
+        let mut kinds = Vec::with_capacity(k);
+        for m in &modes {
+            omega.push(m.omega);
+            for u in m.displacements(rod) {
+                disp.extend_from_slice(u.as_slice());
+            }
+            for r in m.rotations(st) {
+                rot.extend_from_slice(r.as_slice());
+            }
+            shares.extend_from_slice(&m.shares);
+            kinds.push(m.kind.name());
+        }
+        let d = PyDict::new(py);
+        d.set_item("omega", PyArray1::from_vec(py, omega))?;
+        d.set_item(
+            "displacements",
+            PyArray1::from_vec(py, disp).reshape([k, nodes, 3])?,
+        )?;
+        d.set_item(
+            "rotations",
+            PyArray1::from_vec(py, rot).reshape([k, edges, 3])?,
+        )?;
+        d.set_item("shares", PyArray1::from_vec(py, shares).reshape([k, 4])?)?;
+        d.set_item("kind", kinds)?;
+        Ok(d)
+    }
+
     /// Linearisation about the state of the last run (a static equilibrium): the tangent
     /// stiffness K (n × n, dense, active unknowns only), the diagonal mass (n,), and for each
     /// unknown its (block, slot); slots 0–2 node displacement, 3–5 edge rotation (body frame).
