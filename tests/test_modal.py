@@ -48,8 +48,12 @@ def test_modes_are_taken_at_the_clip_poses_of_t0(scene_dict):
             "motion": [
                 {
                     "channel": "x",
-                    "signal": {"type": "sine", "amplitude": 0.05, "frequency": 1.0,
-                               "phase": np.pi / 2},
+                    "signal": {
+                        "type": "sine",
+                        "amplitude": 0.05,
+                        "frequency": 1.0,
+                        "phase": np.pi / 2,
+                    },
                 }
             ],
         }
@@ -94,3 +98,118 @@ def test_bad_count_is_an_error(count):
     scene = load_scene(EXAMPLE)
     with pytest.raises(SceneError, match="count"):
         cable_modes(scene, scene.cables[0], count)
+
+
+def _measured(scene_dict, **extra):
+    cable = scene_dict["cables"][0]
+    cable.pop("section")
+    cable.pop("material")
+    cable["stiffness"] = {
+        "EA": 1e5,
+        "GA": 1e5,
+        "EI": 50.0,
+        "GJ": 0.01,
+        "mass_per_length": 0.2,
+        "radius": 0.005,
+        **extra,
+    }
+    scene_dict["simulation"]["gravity"] = [0.0, 0.0, 0.0]
+    cable["clips"][1]["position"] = [1.0, 0.0, 0.0]
+    return scene_from_dict(scene_dict)
+
+
+def test_polar_rotary_inertia_sets_the_torsion_frequency(scene_dict):
+    # Stiff in bending, soft in torsion: the lowest mode is torsion, ω = π/L √(GJ/ρI₃).
+    plain = _measured(copy.deepcopy(scene_dict), rotary_inertia=1e-6)
+    assert plain.cables[0].properties().rotary_inertia == (1e-6, 1e-6, 2e-6)
+    scene = _measured(copy.deepcopy(scene_dict), rotary_inertia=1e-6, polar_rotary_inertia=8e-6)
+    assert scene.cables[0].properties().rotary_inertia == (1e-6, 1e-6, 8e-6)
+    for sc, j3 in ((plain, 2e-6), (scene, 8e-6)):
+        m = cable_modes(sc, sc.cables[0], 1)
+        assert m.kind[0] == "torsion"
+        exact = np.pi * np.sqrt(0.01 / j3)
+        assert abs(m.omega[0] / exact - 1) < (np.pi / 40) ** 2  # 40 segments, O(h²)
+
+
+@pytest.mark.parametrize("value", [0.0, -1e-6, "big"])
+def test_bad_polar_rotary_inertia_is_named(scene_dict, value):
+    from cablelife.scene import SceneError
+
+    with pytest.raises(SceneError, match="polar_rotary_inertia"):
+        _measured(scene_dict, polar_rotary_inertia=value)
+
+
+def test_default_damping_is_critical_on_bending_and_material_like_elsewhere(scene_dict):
+    from cablelife.modal import DEFAULT_LOSS_FACTOR, lowest_frequencies, retardation_times
+
+    scene = scene_from_dict(scene_dict)
+    cable = scene.cables[0]
+    shear, bend, info = retardation_times(scene, cable)
+    tau = 2.0 / info["omega1"]
+    assert bend[:2] == [tau, tau]
+    p = cable.properties()
+    w_ax = np.pi / 1.0 * np.sqrt(p.shear_stiffness[2] / p.mass_per_length)  # span 1 m
+    w = lowest_frequencies(cable)
+    assert w["extension"] == pytest.approx(w_ax)
+    assert shear[2] == pytest.approx(DEFAULT_LOSS_FACTOR / w_ax)
+    assert shear[0] == pytest.approx(DEFAULT_LOSS_FACTOR / w["shear"])
+    assert bend[2] == pytest.approx(DEFAULT_LOSS_FACTOR / w["torsion"])
+    assert max(shear + [bend[2]]) < 0.01 * tau
+    # a given retardation time still applies to every mode
+    scene_dict["cables"][0]["damping"] = {"retardation_time": 0.01}
+    scene = scene_from_dict(scene_dict)
+    shear, bend, _ = retardation_times(scene, scene.cables[0])
+    assert shear + bend == [0.01] * 6
+
+
+def _step_start(scene_dict, damping=None):
+    scene_dict["simulation"].update(mode="dynamic", duration=0.1, time_step=0.001)
+    scene_dict["bodies"] = [
+        {
+            "name": "engine",
+            "origin": [0.8, 0.2, 0.0],
+            "motion": [
+                {"channel": "x", "signal": {"type": "sine", "amplitude": 0.024, "frequency": 2.0}}
+            ],
+        }
+    ]
+    cable = scene_dict["cables"][0]
+    cable["segments"] = 20
+    cable["clips"][1]["body"] = "engine"
+    if damping:
+        cable["damping"] = damping
+    return scene_from_dict(scene_dict)
+
+
+def test_summary_reports_and_warns_about_the_viscous_share(scene_dict, capsys):
+    import warnings
+
+    from cablelife.cli import print_summary
+    from cablelife.simulate import simulate
+    from cablelife.summary import VISCOUS_SHARE_WARNING, cable_summary
+
+    # A clip starting at 0.3 m/s: τ = 2/ω₁ on every mode (the former default) makes the
+    # viscous forces most of the start-up loads; the default keeps the tension an order lower.
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        new = simulate(_step_start(copy.deepcopy(scene_dict)))
+        w1 = cable_modes(scene_from_dict(scene_dict), scene_from_dict(scene_dict).cables[0], 1)
+        old = simulate(_step_start(scene_dict, {"retardation_time": 2 / w1.omega[0]}))
+    s_new, s_old = cable_summary(new.cable), cable_summary(old.cable)
+    assert s_old["viscous_share"].max() > VISCOUS_SHARE_WARNING
+    assert s_new["max_tension"] < 0.1 * s_old["max_tension"]
+    assert s_new["max_shear"] < 0.1 * s_old["max_shear"]
+    print_summary(old)
+    out = capsys.readouterr().out
+    assert "viscous share" in out and "warning" in out and "damping" in out
+    assert static_share_is_none(scene_dict)
+
+
+def static_share_is_none(scene_dict) -> bool:
+    from cablelife.simulate import simulate
+    from cablelife.summary import cable_summary
+
+    scene_dict["simulation"]["mode"] = "static"
+    scene_dict.pop("bodies", None)
+    scene_dict["cables"][0]["clips"][1].pop("body", None)
+    return cable_summary(simulate(scene_from_dict(scene_dict)).cable)["viscous_share"] is None

@@ -8,6 +8,7 @@ from typing import Annotated
 
 import typer
 from rich.console import Console
+from rich.markup import escape
 from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 from rich.table import Table
 
@@ -15,7 +16,7 @@ from cablelife.results import Result
 from cablelife.scene import SceneError, json_schema, load_scene
 from cablelife.signals.errors import SignalError
 from cablelife.simulate import SimulationError, simulate
-from cablelife.summary import cable_summary
+from cablelife.summary import VISCOUS_SHARE_WARNING, cable_summary
 
 app = typer.Typer(
     help="cablelife: digital mock-up of cables and hoses (Cosserat rod simulation, fatigue).",
@@ -68,7 +69,32 @@ def print_summary(result: Result) -> None:
                 )
             else:
                 t.add_row("damping", f"τ = {tau[0]:.4g} s (given)")
+            ts = c.solver.get("tau_shear")
+            if ts is not None and tau is not None:
+                t.add_row(
+                    "τ extension, shear, torsion",
+                    f"{ts[2]:.3g} s, {ts[0]:.3g} s, {tau[2]:.3g} s",
+                )
+        share = s.get("viscous_share")
+        if share is not None:
+            t.add_row(
+                "viscous share of peak F3, |F1,F2|, |M1,M2|, M3",
+                ", ".join(f"{100 * v:.0f} %" for v in share),
+            )
         console.print(t)
+        if share is not None and share.max() > VISCOUS_SHARE_WARNING:
+            names = ("tension", "shear force", "bending moment", "torsion")
+            big = ", ".join(
+                f"{n} {100 * v:.0f} %"
+                for n, v in zip(names, share, strict=True)
+                if v > VISCOUS_SHARE_WARNING
+            )
+            console.print(
+                f"[yellow]warning:[/yellow] cable '{escape(name)}': the viscous damping part "
+                f"of the peak section loads is large ({big} > "
+                f"{100 * VISCOUS_SHARE_WARNING:.0f} %): the damping model sets these loads "
+                "(and the fatigue result); check the damping (docs/dynamics.md)"
+            )
         ct = Table(title="clip reactions (max over time)", title_justify="left")
         ct.add_column("clip")
         ct.add_column("s [m]", justify="right")

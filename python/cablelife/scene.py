@@ -103,7 +103,8 @@ class MeasuredStiffness(_Model):
     GJ: PositiveFloat  # N m²
     mass_per_length: PositiveFloat  # kg/m
     radius: PositiveFloat  # m, outer radius (contact, pictures, stresses)
-    rotary_inertia: PositiveFloat | None = None  # kg m (ρI per length)
+    rotary_inertia: PositiveFloat | None = None  # kg m (ρI per length, about d1 and d2)
+    polar_rotary_inertia: PositiveFloat | None = None  # kg m (ρI₃ about the axis d3)
 
     @model_validator(mode="after")
     def _bending(self):
@@ -233,7 +234,15 @@ class Cable(_Model):
             ei1 = k.EI if k.EI is not None else k.EI1
             ei2 = k.EI if k.EI is not None else k.EI2
             return from_measured(
-                k.EA, k.GA, ei1, ei2, k.GJ, k.mass_per_length, k.radius, k.rotary_inertia
+                k.EA,
+                k.GA,
+                ei1,
+                ei2,
+                k.GJ,
+                k.mass_per_length,
+                k.radius,
+                k.rotary_inertia,
+                k.polar_rotary_inertia,
             )
         sec, mat = self.section, self.material
         if sec.shape == "circle":

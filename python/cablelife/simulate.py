@@ -267,6 +267,7 @@ def _run_cable(scene: Scene, cable: Cable, times: np.ndarray, mode: str, progres
     )
     energies = {"elastic_energy": out["elastic_energy"]}
     if mode == "dynamic":
+        solver["viscous_peak"] = np.asarray(out["viscous_peak"])
         energies.update(
             kinetic_energy=out["kinetic_energy"],
             dissipated_energy=out["dissipated_energy"],

@@ -56,6 +56,9 @@ struct Record {
     kinetic_energy: Vec<f64>,
     load_potential: Vec<f64>,
     dissipated_energy: Vec<f64>,
+    /// Peaks over the recorded steps of the viscous section loads: |F3|, |F1, F2|, |M1, M2|,
+    /// |M3| (body frame).
+    viscous_peak: [f64; 4],
 }
 
 impl Record {
@@ -77,6 +80,7 @@ impl Record {
             kinetic_energy: Vec::with_capacity(n),
             load_potential: Vec::with_capacity(n),
             dissipated_energy: Vec::with_capacity(n),
+            viscous_peak: [0.0; 4],
         }
     }
 
@@ -104,6 +108,19 @@ impl Record {
         self.residual.push(stats.residual);
         self.elastic_energy.push(ws.elastic_energy);
         self.load_potential.push(ws.load_potential);
+    }
+
+    /// Updates the peaks of the viscous section loads (dynamic runs).
+    fn push_viscous(&mut self, ws: &Workspace) {
+        let p = &mut self.viscous_peak;
+        for f in &ws.edge_force_viscous {
+            p[0] = p[0].max(f.z.abs());
+            p[1] = p[1].max(f.x.hypot(f.y));
+        }
+        for m in &ws.node_moment_viscous {
+            p[2] = p[2].max(m.x.hypot(m.y));
+            p[3] = p[3].max(m.z.abs());
+        }
     }
 
     fn push_energies(&mut self, e: &rod::Energies) {
@@ -147,6 +164,7 @@ impl Record {
         ] {
             d.set_item(key, PyArray1::from_vec(py, values))?;
         }
+        d.set_item("viscous_peak", self.viscous_peak.to_vec())?;
         d.set_item("steps", t)?;
         Ok(d)
     }
@@ -481,6 +499,7 @@ impl Cable {
                                 substeps: s.substeps - 1,
                             };
                             rec.push(rod, &st, &dy.ws, &stats);
+                            rec.push_viscous(&dy.ws);
                             rec.push_energies(&dy.energies);
                         }
                     }
