@@ -356,7 +356,7 @@ mod tests {
         for period in [4, 5, 7, 10, 13, 40, 41, 100] {
             for periods in [1, 2, 3, 5, 8, 21] {
                 for k in 0..12 {
-                    let phase = k as f64 * 0.5236 + 0.01 * period as f64;
+                    let phase = k as f64 * 0.53 + 0.01 * period as f64;
                     for closed in [false, true] {
                         let s = sine(period, periods, phase, closed);
                         let peak = s.iter().fold(0.0f64, |a, x| a.max(x.abs()));

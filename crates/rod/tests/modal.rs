@@ -104,7 +104,7 @@ fn clamped_torsion_and_axial_frequencies_converge_with_order_two() {
         let modes = lowest_modes(&rod, &st, 4).unwrap();
         let t = of_kind(&modes, ModeKind::Torsion);
         let a = of_kind(&modes, ModeKind::Axial);
-        assert!(t.len() >= 2 && a.len() >= 1, "{modes:?}");
+        assert!(t.len() >= 2 && !a.is_empty(), "{modes:?}");
         let wt = PI / l * (gj / j3).sqrt();
         let wa = PI / l * (ea / mass).sqrt();
         e_t.push((t[0] - wt).abs() / wt);
