@@ -88,8 +88,9 @@ pub struct DynamicOptions {
     /// Converged when the Newton correction (|δx|/L, |δθ|, max over the segment) is below this
     /// fraction of the estimated local time-discretisation error of the step,
     /// |β − 1/6| h² |v̇_{n+1} − v̇_n| (the leading term of the Newmark/generalized-α local
-    /// error, Zienkiewicz & Xie 1991; max over the cable, scaled as the corrections) … or below
-    /// `TOLERANCE_FLOOR` of the step's own increment h|Δq| (round-off) … (0.1: the iteration
+    /// error, Zienkiewicz & Xie 1991; max over the cable, scaled as the corrections), at most
+    /// `STALL_TOLERANCE` of the step's own increment h|Δq| (max over the cable) … or below
+    /// `TOLERANCE_FLOOR` of it (round-off) … (0.1: the iteration
     /// error then stays well below the time-discretisation error whatever the cable, its
     /// damping and the excitation; measured in docs/dynamics.md)
     pub tolerance: f64,
@@ -121,6 +122,13 @@ impl Default for DynamicOptions {
 /// fraction of the step's own increment h|Δq| (far below any time-discretisation error, above
 /// round-off).
 pub const TOLERANCE_FLOOR: f64 = 1e-8;
+
+/// The Newton tolerance is at most this fraction of the step's increment (the former fixed
+/// tolerance: in a shock — a clip starting with a velocity — the error estimate exceeds the
+/// increment and alone would accept a poor iterate). A Newton iteration that stops contracting
+/// (a correction with a fresh matrix no smaller than the last) keeps its iterate when the
+/// correction that led there was below it too; otherwise the step is split.
+pub const STALL_TOLERANCE: f64 = 5e-3;
 
 /// What one step did.
 #[derive(Clone, Copy, Debug, Default)]
@@ -509,6 +517,7 @@ impl Dynamics {
         let mut stats = StepStats::default();
         let mut last_norm = f64::INFINITY;
         let mut last_fresh_norm = f64::INFINITY;
+        let mut last_applied = f64::INFINITY;
         for it in 0..self.opts.max_iterations {
             let f = self.factors[k];
             let refactor = !f.valid || f.h != h;
@@ -532,6 +541,20 @@ impl Dynamics {
             // last one with a fresh matrix (Newton does not contract: give up early, the step
             // is split).
             if !norm.is_finite() || (refactor && norm >= last_fresh_norm) {
+                // … unless the correction that led to the current iterate was already below
+                // `STALL_TOLERANCE` of the step's increment (the former fixed tolerance): the
+                // iteration has reached what it can (round-off, or the strongly non-linear
+                // viscous forces of a large retardation time) and that iterate is kept.
+                let scale = self.increments.iter().cloned().fold(0.0, f64::max);
+                if it > 0 && last_applied < STALL_TOLERANCE * scale {
+                    stats.residual = self
+                        .ws
+                        .residual_norms_range(seg.blocks.clone(), rod.mean_ds())
+                        .1;
+                    self.powers[k] = self.ws.dissipation;
+                    self.resting[k] = false;
+                    return Ok(stats);
+                }
                 return Err(SolveError::NotConverged {
                     iterations: it + 1,
                     residual: self
@@ -545,11 +568,13 @@ impl Dynamics {
                 last_fresh_norm = norm;
             }
             self.increments[k] = self.apply_correction(rod, st, h, c_mass, seg);
+            last_applied = norm;
             self.local_errors[k] = self.local_error(seg.blocks.clone());
             stats.iterations = it + 1;
             let scale = self.increments.iter().cloned().fold(0.0, f64::max);
             let error = self.local_errors.iter().cloned().fold(0.0, f64::max);
             let tolerance = (self.opts.tolerance * error)
+                .min(STALL_TOLERANCE * scale)
                 .max(TOLERANCE_FLOOR * scale)
                 .max(self.opts.abs_tolerance);
             if norm < tolerance {
