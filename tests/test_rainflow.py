@@ -97,6 +97,26 @@ def test_repeated_residue_equals_counting_a_repeated_history():
     assert d_rep == pytest.approx(per_period, rel=1e-12)
 
 
+@pytest.mark.parametrize("period", [4, 7, 40, 41])
+@pytest.mark.parametrize("periods", [1, 3, 5])
+@pytest.mark.parametrize("phase", [0.0, 0.3, 1.1, 2.9])
+def test_repeated_residue_counts_the_periods_of_a_sine(period, periods, phase):
+    """k periods of a sampled sine are k cycles (the residue once repeated, not the whole ASTM
+    stack doubled; the old count depended on round-off)."""
+    t = np.arange(period * periods + 1)
+    x = np.sin(2 * np.pi * t / period + phase)
+    c = rainflow_cycles(x, residue="repeated", hysteresis=1e-9)
+    assert c.count.sum() == periods
+    assert c.range.min() > 1.4 * np.abs(x).max()
+
+
+def test_repeated_residue_reported_cases():
+    x = np.sin(2 * np.pi * np.arange(201) / 40)
+    assert rainflow_cycles(x, residue="repeated").count.sum() == 5
+    c = rainflow_cycles(np.array([0.0, 1, -1, 1, -1, 1, -1, 0]), residue="repeated")
+    assert histogram(c) == [(2.0, 3.0)]
+
+
 def test_hysteresis_gate_drops_small_cycles():
     x = np.array([0.0, 10.0, 9.5, 10.5, 0.2, 0.6, -1.0, 8.0])
     c = rainflow_cycles(x, hysteresis=1.0)

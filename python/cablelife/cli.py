@@ -19,7 +19,7 @@ from cablelife.results import Result
 from cablelife.scene import SceneError, json_schema, load_scene
 from cablelife.signals.errors import SignalError
 from cablelife.simulate import SimulationError, simulate
-from cablelife.summary import cable_summary
+from cablelife.summary import VISCOUS_SHARE_WARNING, cable_summary
 
 app = typer.Typer(
     help="cablelife: digital mock-up of cables and hoses (Cosserat rod simulation, fatigue).",
@@ -93,7 +93,32 @@ def print_summary(result: Result) -> None:
                 )
             else:
                 t.add_row("damping", f"τ = {tau[0]:.4g} s (given)")
+            ts = c.solver.get("tau_shear")
+            if ts is not None and tau is not None:
+                t.add_row(
+                    "τ extension, shear, torsion",
+                    f"{ts[2]:.3g} s, {ts[0]:.3g} s, {tau[2]:.3g} s",
+                )
+        share = s.get("viscous_share")
+        if share is not None:
+            t.add_row(
+                "viscous share of peak F3, |F1,F2|, |M1,M2|, M3",
+                ", ".join(f"{100 * v:.0f} %" for v in share),
+            )
         console.print(t)
+        if share is not None and share.max() > VISCOUS_SHARE_WARNING:
+            names = ("tension", "shear force", "bending moment", "torsion")
+            big = ", ".join(
+                f"{n} {100 * v:.0f} %"
+                for n, v in zip(names, share, strict=True)
+                if v > VISCOUS_SHARE_WARNING
+            )
+            console.print(
+                f"[yellow]warning:[/yellow] cable '{escape(name)}': the viscous damping part "
+                f"of the peak section loads is large ({big} > "
+                f"{100 * VISCOUS_SHARE_WARNING:.0f} %): the damping model sets these loads "
+                "(and the fatigue result); check the damping (docs/dynamics.md)"
+            )
         ct = Table(title="clip reactions (max over time)", title_justify="left")
         ct.add_column("clip")
         ct.add_column(escape("s [m]"), justify="right")
@@ -196,8 +221,11 @@ def modes(
         t.add_column("mode", justify="right")
         t.add_column(escape("f [Hz]"), justify="right")
         t.add_column(escape("ω [rad/s]"), justify="right")
+        t.add_column("type")
+        t.add_column("energy share", justify="right")
         for i, (f, w) in enumerate(zip(m.frequencies, m.omega, strict=True), start=1):
-            t.add_row(str(i), f"{f:.4g}", f"{w:.4g}")
+            share = f"{100 * m.shares[i - 1].max():.0f} %"
+            t.add_row(str(i), f"{f:.4g}", f"{w:.4g}", m.kind[i - 1], share)
         console.print(t)
 
 

@@ -1,20 +1,25 @@
 """Modal analysis of the mounted cable: natural frequencies and mode shapes, linearised about
-the static equilibrium (the tangent stiffness of the solver and the lumped masses).
+the static equilibrium at the clip poses of t = 0 (the tangent stiffness of the solver with
+the geometric stiffness of the current loads, and the lumped masses).
 
-The massless unknowns (the free twists of swivel clips) are condensed out statically (exact for
-massless degrees of freedom); the generalized symmetric eigenproblem K φ = ω² M φ is solved with
-LAPACK for the lowest modes.
+The eigenproblem K φ = ω² M φ is solved in Rust on the block-tridiagonal structure
+(``rod::modal``: shift-invert subspace iteration with a block LDLᵀ and its Sturm count, O(N)
+memory); massless unknowns (swivel twists) need no condensation. ``cable_modes_dense`` is the
+former dense LAPACK solver, kept for comparison (tests, benchmarks).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import math
+from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.linalg
 
 from cablelife.scene import Cable, Scene, SceneError
 from cablelife.simulate import build_cable, clip_poses
+
+#: The modal energy shares, in the order of ``Modes.shares``.
+SHARE_NAMES = ("bending d1", "bending d2", "torsion", "axial")
 
 
 @dataclass
@@ -26,6 +31,10 @@ class Modes:
     shapes: np.ndarray  # (k, N+1, 3) node displacements, mass-normalised, global frame
     arc_length: np.ndarray  # (N+1,)
     equilibrium: np.ndarray  # (N+1, 3) node positions of the static equilibrium
+    rotations: np.ndarray | None = None  # (k, N, 3) edge rotations, global frame
+    #: (k, 4) shares of the modal energy: bending d1, bending d2, torsion, axial
+    shares: np.ndarray | None = None
+    kind: list[str] = field(default_factory=list)  # dominant share of each mode
 
     @property
     def frequencies(self) -> np.ndarray:
@@ -33,19 +42,49 @@ class Modes:
         return self.omega / (2 * np.pi)
 
 
-def cable_modes(scene: Scene, cable: Cable, count: int = 6) -> Modes:
-    """The ``count`` lowest modes of ``cable`` mounted at its clips in the reference
-    configuration (bodies at rest)."""
-    if count < 1:
-        raise SceneError(f"count = {count}: ask for at least 1 mode")
+def _equilibrium(scene: Scene, cable: Cable):
+    """The solver object at the static equilibrium with the clip poses of t = 0."""
     core = build_cable(scene, cable)
-    pos, quat = clip_poses(scene, cable, np.array([0.0]), with_motion=False)
+    pos, quat = clip_poses(scene, cable, np.array([0.0]), with_motion=True)
     try:
         out = core.run_sequence(pos, quat)
     except ValueError as err:
         raise SceneError(f"cable '{cable.name}': {err}") from None
     if out["error"]:
         raise SceneError(f"cable '{cable.name}': no static equilibrium: {out['error']}")
+    return core, out
+
+
+def cable_modes(scene: Scene, cable: Cable, count: int = 6) -> Modes:
+    """The ``count`` lowest modes of ``cable`` at its static equilibrium with the clip poses
+    of t = 0 (the banded Rust solver)."""
+    if count < 1:
+        raise SceneError(f"count = {count}: ask for at least 1 mode")
+    core, out = _equilibrium(scene, cable)
+    try:
+        found = core.modes(count)
+    except ValueError as err:
+        raise SceneError(f"cable '{cable.name}': {err}") from None
+    return Modes(
+        cable=cable.name,
+        omega=found["omega"],
+        shapes=found["displacements"],
+        arc_length=core.arc_length,
+        equilibrium=out["positions"][0],
+        rotations=found["rotations"],
+        shares=found["shares"],
+        kind=list(found["kind"]),
+    )
+
+
+def cable_modes_dense(scene: Scene, cable: Cable, count: int = 6) -> Modes:
+    """The former dense solver (LAPACK on the (6N)² matrices, static condensation of the
+    massless unknowns): O(N²) memory, O(N³) time. For comparison only."""
+    import scipy.linalg
+
+    if count < 1:
+        raise SceneError(f"count = {count}: ask for at least 1 mode")
+    core, out = _equilibrium(scene, cable)
     lin = core.linearize()
     k = lin["stiffness"]
     k = 0.5 * (k + k.T)  # symmetric at equilibrium up to round-off (and dead moments)
@@ -87,10 +126,50 @@ def modes(scene: Scene, count: int = 6) -> dict[str, Modes]:
     return {c.name: cable_modes(scene, c, count) for c in scene.cables}
 
 
+#: Loss factor η = ωτ of the default damping of extension, torsion and shear on their lowest
+#: mode (ζ = η/2 = 0.05): a typical polymer's (cable insulation, hose rubber: 0.05 … 0.3).
+DEFAULT_LOSS_FACTOR = 0.1
+
+
+def longest_span(cable: Cable) -> float:
+    """The effective length of the longest free span: between two consecutive clips, or twice
+    a span from a clip to a free end (a cantilever's lowest axial and torsion mode is a
+    quarter wave)."""
+    s = sorted(c.s for c in cable.clips)
+    spans = [b - a for a, b in zip(s, s[1:], strict=False)]
+    ends = [s[0], cable.length - s[-1]] if s else [cable.length]
+    return max(spans + [2 * e for e in ends] + [0.0]) or cable.length
+
+
+def lowest_frequencies(cable: Cable) -> dict[str, float]:
+    """Estimates (rad/s) of the lowest extension, torsion and shear modes of the mounted cable,
+    from the continuous rod on its longest free span ``L``: ω = π/L √(EA/ρA) and
+    π/L √(GJ/ρI₃) (waves along the span); the shear branch starts at its cut-off frequency
+    √(GA/ρI) (Timoshenko's second spectrum)."""
+    p = cable.properties()
+    span = longest_span(cable)
+    ga, ea = p.shear_stiffness[0], p.shear_stiffness[2]
+    gj = p.bend_stiffness[2]
+    rho_i, rho_i3 = p.rotary_inertia[0], p.rotary_inertia[2]
+    inf = float("inf")
+    return {
+        "extension": math.pi / span * math.sqrt(ea / p.mass_per_length),
+        "torsion": math.pi / span * math.sqrt(gj / rho_i3) if rho_i3 > 0 else inf,
+        "shear": math.sqrt(ga / rho_i) if rho_i > 0 else inf,
+    }
+
+
 def retardation_times(scene: Scene, cable: Cable) -> tuple[list[float], list[float], dict]:
     """Kelvin–Voigt retardation times (GA₁, GA₂, EA) and (EI₁, EI₂, GJ) of a cable, with how
-    they were set: τ = 2ζ/ω₁ from the first natural mode for a damping ratio ζ (the default
-    ζ = 1, critical), or the given τ; per-mode values override."""
+    they were set.
+
+    Default (``ratio`` ζ, 1 unless given): bending gets τ = 2ζ/ω₁ from the first natural mode
+    of the mounted cable (ζ = 1: critical); extension, torsion and shear get a material-like
+    damping: the loss factor η = ``DEFAULT_LOSS_FACTOR`` on their own lowest mode,
+    τ_i = min(τ, η/ω_i) (``lowest_frequencies``). One τ = 2ζ/ω₁ on all modes would damp
+    extension, torsion and shear hundreds of times over-critically and let the viscous forces
+    dominate the section loads (docs/dynamics.md). A given ``retardation_time`` applies to all
+    modes. Per-mode values override either."""
     from cablelife.scene import DEFAULT_DAMPING_RATIO
 
     d = cable.damping
@@ -98,13 +177,17 @@ def retardation_times(scene: Scene, cable: Cable) -> tuple[list[float], list[flo
     if d.retardation_time is not None:
         tau = d.retardation_time
         info["source"] = "retardation_time"
+        own = {"extension": tau, "torsion": tau, "shear": tau}
     else:
         zeta = d.ratio if d.ratio is not None else DEFAULT_DAMPING_RATIO
         omega1 = float(cable_modes(scene, cable, 1).omega[0])
         tau = 2 * zeta / omega1 if omega1 > 0 else 0.0
         info.update(source="ratio", ratio=zeta, omega1=omega1)
+        own = {k: min(tau, DEFAULT_LOSS_FACTOR / w) for k, w in lowest_frequencies(cable).items()}
     info["tau"] = tau
-    pick = lambda v: tau if v is None else v  # noqa: E731
-    shear = [pick(d.shear), pick(d.shear), pick(d.extension)]
-    bend = [pick(d.bending), pick(d.bending), pick(d.torsion)]
-    return shear, bend, info
+    pick = lambda v, default: default if v is None else v  # noqa: E731
+    t_ext = pick(d.extension, own["extension"])
+    t_shear = pick(d.shear, own["shear"])
+    t_bend = pick(d.bending, tau)
+    t_tors = pick(d.torsion, own["torsion"])
+    return [t_shear, t_shear, t_ext], [t_bend, t_bend, t_tors], info

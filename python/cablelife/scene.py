@@ -132,7 +132,8 @@ class MeasuredStiffness(_Model):
     GJ: BendingStiffness  # N m²
     mass_per_length: _bounded("mass_per_length")  # kg/m
     radius: Radius  # m, outer radius (contact, pictures, stresses)
-    rotary_inertia: _bounded("rotary_inertia") | None = None  # kg m (ρI per length)
+    rotary_inertia: _bounded("rotary_inertia") | None = None  # kg m (ρI per length, about d1 and d2)
+    polar_rotary_inertia: _bounded("rotary_inertia") | None = None  # kg m (ρI₃ about the axis d3)
 
     @model_validator(mode="after")
     def _bending(self):
@@ -284,7 +285,15 @@ class Cable(_Model):
             ei1 = k.EI if k.EI is not None else k.EI1
             ei2 = k.EI if k.EI is not None else k.EI2
             return from_measured(
-                k.EA, k.GA, ei1, ei2, k.GJ, k.mass_per_length, k.radius, k.rotary_inertia
+                k.EA,
+                k.GA,
+                ei1,
+                ei2,
+                k.GJ,
+                k.mass_per_length,
+                k.radius,
+                k.rotary_inertia,
+                k.polar_rotary_inertia,
             )
         sec, mat = self.section, self.material
         if sec.shape == "circle":

@@ -91,13 +91,16 @@ def from_measured(
     mass_per_length: float,
     radius: float,
     rotary_inertia: float | None = None,
+    polar_rotary_inertia: float | None = None,
 ) -> SectionProperties:
     """Effective measured stiffnesses (as cable suppliers give them) on a round section of
     ``radius`` (used for stresses and pictures: the equivalent homogeneous circle).
 
     Without GA, GA is that of the equivalent homogeneous circle: G = GJ/J and the shear
     coefficient at the equivalent Poisson ratio ν = EA/(2·G·A) − 1 (clipped to [0, 0.5]).
-    Without ``rotary_inertia`` (ρI per length, kg m) it is that of a homogeneous circle, m r²/4.
+    Without ``rotary_inertia`` (ρI per length, kg m) it is that of a homogeneous circle, m r²/4;
+    without ``polar_rotary_inertia`` (ρI₃ about the axis) it is twice ``rotary_inertia`` (a
+    round section: I₃ = I₁ + I₂).
     """
     area = math.pi * radius * radius
     polar = math.pi * radius**4 / 2
@@ -107,6 +110,7 @@ def from_measured(
     if GA is None:
         GA = shear_coefficient(nu) * g_eq * area
     rho_i = rotary_inertia if rotary_inertia is not None else mass_per_length * radius**2 / 4
+    rho_i3 = polar_rotary_inertia if polar_rotary_inertia is not None else 2 * rho_i
     return SectionProperties(
         EA=EA,
         GA1=GA,
@@ -115,7 +119,7 @@ def from_measured(
         EI2=EI2,
         GJ=GJ,
         mass_per_length=mass_per_length,
-        rotary_inertia=(rho_i, rho_i, 2 * rho_i),
+        rotary_inertia=(rho_i, rho_i, rho_i3),
         shape="circle",
         outer_radius=radius,
         inner_radius=0.0,

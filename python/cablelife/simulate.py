@@ -335,6 +335,7 @@ def _run_cable(
     solver.update(_stability_info(out, saved[:n], core.arc_length, cable.name))
     energies = {"elastic_energy": out["elastic_energy"]}
     if mode == "dynamic":
+        solver["viscous_peak"] = np.asarray(out["viscous_peak"])
         energies.update(
             kinetic_energy=out["kinetic_energy"],
             dissipated_energy=out["dissipated_energy"],

@@ -7,6 +7,30 @@ import numpy as np
 from cablelife.results import CableResult
 from cablelife.validity import strain_extremes
 
+#: The run summary warns when the viscous part of a peak section load exceeds this share of it:
+#: the damping model, not the stiffness, then sets that load (docs/dynamics.md).
+VISCOUS_SHARE_WARNING = 0.5
+
+
+def viscous_share(c: CableResult) -> np.ndarray | None:
+    """Peak of the viscous (Kelvin–Voigt) part of |F3|, |F1, F2|, |M1, M2|, |M3| over the
+    saved steps of a dynamic run, as a share of the peak of the whole load (None for static
+    runs)."""
+    peak = c.solver.get("viscous_peak")
+    if peak is None:
+        return None
+    f, m = c.forces, c.moments
+    total = np.array(
+        [
+            np.abs(f[..., 2]).max(),
+            np.hypot(f[..., 0], f[..., 1]).max(),
+            np.hypot(m[..., 0], m[..., 1]).max(),
+            np.abs(m[..., 2]).max(),
+        ]
+    )
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(total > 0, np.asarray(peak) / total, 0.0)
+
 
 def cable_summary(c: CableResult) -> dict:
     """Maxima over time and arc length, the smallest bend radius, clip reaction maxima and the
@@ -55,4 +79,5 @@ def cable_summary(c: CableResult) -> dict:
                 strict=True,
             )
         ],
+        "viscous_share": viscous_share(c),
     }

@@ -14,13 +14,18 @@
 //! - `Half` (ASTM default): each range of the residue counts 0.5 cycles.
 //! - `Discard`: the residue is ignored (only closed hysteresis loops count; unconservative).
 //! - `Full`: each range of the residue counts 1.0 cycle (conservative upper bound).
-//! - `Repeated`: the history is taken as periodic: the residue is concatenated with itself and
-//!   counted again with the four-point rule (cycle B–C of A, B, C, D closes when
-//!   |C−B| ≤ |B−A| and |C−B| ≤ |D−C|); the cycles it closes count 1.0 each and its own
-//!   residue is dropped. This is the usual "four-point method with the residue repeated" for
-//!   block loading; it gives more damage than `Half` because large ranges pair up across the
-//!   block boundary. From/to indices of these cycles refer to the residue samples in the
-//!   original series.
+//! - `Repeated`: the history is taken as periodic (block loading). The ASTM residue is first
+//!   reduced with the four-point rule (cycle B–C of A, B, C, D closes when |C−B| ≤ |B−A| and
+//!   |C−B| ≤ |D−C|): ASTM's start-rule half cycles may still form closed loops (a constant
+//!   amplitude history leaves all its ranges there), which count 1.0 each, once. The
+//!   four-point residue R that remains closes no loop by itself; R followed by R is counted
+//!   with the four-point rule and the loops it closes (those spanning the junction of two
+//!   repetitions) count 1.0 each; its own residue (R again) is dropped. This equals counting
+//!   the history rotated to start at its absolute extreme: a history of k periods of a
+//!   constant-amplitude wave gives exactly k cycles, whatever its phase and round-off.
+//!   It gives more damage than `Half` because large ranges pair up across the block
+//!   boundary. From/to indices of these cycles refer to the residue samples in the original
+//!   series (a cycle across the junction may have `to` < `from`).
 
 use crate::turning::TurningPoints;
 use crate::FatigueError;
@@ -169,9 +174,19 @@ impl Rainflow {
                 }
             }
             Residue::Repeated => {
-                let mut tp = TurningPoints::new_unchecked(gate);
+                // 1. The ASTM residue still holds closed loops (its start-rule half cycles
+                //    are not a four-point residue): close them once, as full cycles.
                 let scratch = &mut self.scratch;
                 scratch.clear();
+                for &p in self.stack.iter() {
+                    four_point_push(scratch, p, sink);
+                }
+                // 2. The four-point residue R has no closed loop of its own; counting R R
+                //    closes exactly the loops that span the junction of two repetitions
+                //    (its own residue is R again and is dropped).
+                std::mem::swap(&mut self.stack, scratch);
+                scratch.clear();
+                let mut tp = TurningPoints::new_unchecked(gate);
                 for _ in 0..2 {
                     for &(i, x) in self.stack.iter() {
                         tp.push(i, x, |j, v| four_point_push(scratch, (j, v), sink));
@@ -320,6 +335,66 @@ mod tests {
         assert_eq!(
             histogram(&count(&[0.0, 2.0, -1.0], Residue::Repeated)),
             vec![(3.0, 1.0)]
+        );
+    }
+
+    /// k periods of sin(2π t/P + φ) sampled at t = 0 … n−1.
+    fn sine(period: usize, periods: usize, phase: f64, closed: bool) -> Vec<f64> {
+        let n = period * periods + usize::from(closed);
+        (0..n)
+            .map(|t| (2.0 * std::f64::consts::PI * t as f64 / period as f64 + phase).sin())
+            .collect()
+    }
+
+    #[test]
+    fn repeated_residue_counts_periods_of_a_constant_amplitude_wave() {
+        // the reported cases: 5 periods of 40 samples, and a square wave of 3 periods
+        let c = count(&sine(40, 5, 0.0, true), Residue::Repeated);
+        assert_eq!(c.iter().map(|c| c.count).sum::<f64>(), 5.0);
+        let c = count(&[0., 1., -1., 1., -1., 1., -1., 0.], Residue::Repeated);
+        assert_eq!(histogram(&c), vec![(2.0, 3.0)]);
+        for period in [4, 5, 7, 10, 13, 40, 41, 100] {
+            for periods in [1, 2, 3, 5, 8, 21] {
+                for k in 0..12 {
+                    let phase = k as f64 * 0.53 + 0.01 * period as f64;
+                    for closed in [false, true] {
+                        let s = sine(period, periods, phase, closed);
+                        let peak = s.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+                        let case = format!("P {period} × {periods}, φ {phase}, closed {closed}");
+                        // gate 0: the full swings are exactly the periods; a closed series
+                        // may also hold a round-off reversal where its ends meet (sample 0
+                        // and sample n−1 differ in the last bit), counted as a cycle of its
+                        // own ~1e-16 range
+                        let c = count(&s, Residue::Repeated);
+                        let swings: Vec<&Cycle> = c.iter().filter(|c| c.range > 1e-12).collect();
+                        assert_eq!(swings.len(), periods, "{case}: {c:?}");
+                        assert!(
+                            swings
+                                .iter()
+                                .all(|c| c.count == 1.0 && c.range > 1.4 * peak),
+                            "{case}: {c:?}"
+                        );
+                        // a gate above round-off: exactly the periods
+                        let o = CountOptions::new(Residue::Repeated, 1e-9).unwrap();
+                        let c = count_cycles(&s, &o).unwrap();
+                        assert_eq!(c.iter().map(|c| c.count).sum::<f64>(), periods as f64);
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn half_residue_of_a_sine_is_astm() {
+        // 0 1 -1 1 -1 … 0 (5 periods): ASTM counts ranges 1 (twice) and 2 as half cycles only
+        // where they are not closed; total range·count is the same whatever the round-off
+        let c = count(&sine(40, 5, 0.0, true), Residue::Half);
+        let total: f64 = c.iter().map(|c| c.count).sum();
+        let ranges: f64 = c.iter().map(|c| c.count * c.range).sum();
+        assert!((ranges - 10.0).abs() < 1e-9, "{c:?}");
+        assert!(
+            (total - 5.5).abs() < 1e-12 || (total - 6.0).abs() < 1e-12,
+            "{c:?}"
         );
     }
 

@@ -64,6 +64,9 @@ struct Record {
     kinetic_energy: Vec<f64>,
     load_potential: Vec<f64>,
     dissipated_energy: Vec<f64>,
+    /// Peaks over the recorded steps of the viscous section loads: |F3|, |F1, F2|, |M1, M2|,
+    /// |M3| (body frame).
+    viscous_peak: [f64; 4],
 }
 
 impl Record {
@@ -89,6 +92,7 @@ impl Record {
             kinetic_energy: Vec::with_capacity(n),
             load_potential: Vec::with_capacity(n),
             dissipated_energy: Vec::with_capacity(n),
+            viscous_peak: [0.0; 4],
         }
     }
 
@@ -129,6 +133,19 @@ impl Record {
         });
         self.elastic_energy.push(ws.elastic_energy);
         self.load_potential.push(ws.load_potential);
+    }
+
+    /// Updates the peaks of the viscous section loads (dynamic runs).
+    fn push_viscous(&mut self, ws: &Workspace) {
+        let p = &mut self.viscous_peak;
+        for f in &ws.edge_force_viscous {
+            p[0] = p[0].max(f.z.abs());
+            p[1] = p[1].max(f.x.hypot(f.y));
+        }
+        for m in &ws.node_moment_viscous {
+            p[2] = p[2].max(m.x.hypot(m.y));
+            p[3] = p[3].max(m.z.abs());
+        }
     }
 
     fn push_energies(&mut self, e: &rod::Energies) {
@@ -176,6 +193,7 @@ impl Record {
         ] {
             d.set_item(key, PyArray1::from_vec(py, values))?;
         }
+        d.set_item("viscous_peak", self.viscous_peak.to_vec())?;
         d.set_item("steps", t)?;
         Ok(d)
     }
@@ -526,6 +544,7 @@ impl Cable {
                                 ..Default::default()
                             };
                             rec.push(rod, &st, &dy.ws, &stats);
+                            rec.push_viscous(&dy.ws);
                             rec.push_energies(&dy.energies);
                         }
                     }
@@ -548,6 +567,53 @@ impl Cable {
         let d = record.into_dict(py, self.rod.arc.len(), n_clips)?;
         d.set_item("error", error)?;
         d.set_item("spans", spans)?;
+        Ok(d)
+    }
+
+    /// The `count` lowest natural modes about the state of the last run (a static
+    /// equilibrium), by the banded shift-invert solver (`rod::modal`). Returns `omega` (k,)
+    /// rad/s, `displacements` (k, N+1, 3) and `rotations` (k, N, 3) mass-normalised (global
+    /// frame), `shares` (k, 4) modal energy shares (bending d1, bending d2, torsion, axial)
+    /// and `kind` (k,) names. An unstable equilibrium is a ValueError.
+    fn modes<'py>(&mut self, py: Python<'py>, count: usize) -> PyResult<Bound<'py, PyDict>> {
+        let st = self
+            .state
+            .as_ref()
+            .ok_or_else(|| PyValueError::new_err("run a static solve (run_sequence) first"))?;
+        let rod = &self.rod;
+        let modes = py
+            .detach(|| rod::modal::lowest_modes(rod, st, count))
+            .map_err(|e| PyValueError::new_err(e.to_string()))?;
+        let k = modes.len();
+        let (nodes, edges) = (rod.arc.len(), rod.n_edges());
+        let mut omega = Vec::with_capacity(k);
+        let mut disp = Vec::with_capacity(k * nodes * 3);
+        let mut rot = Vec::with_capacity(k * edges * 3);
+        let mut shares = Vec::with_capacity(k * 4);
+        let mut kinds = Vec::with_capacity(k);
+        for m in &modes {
+            omega.push(m.omega);
+            for u in m.displacements(rod) {
+                disp.extend_from_slice(u.as_slice());
+            }
+            for r in m.rotations(st) {
+                rot.extend_from_slice(r.as_slice());
+            }
+            shares.extend_from_slice(&m.shares);
+            kinds.push(m.kind.name());
+        }
+        let d = PyDict::new(py);
+        d.set_item("omega", PyArray1::from_vec(py, omega))?;
+        d.set_item(
+            "displacements",
+            PyArray1::from_vec(py, disp).reshape([k, nodes, 3])?,
+        )?;
+        d.set_item(
+            "rotations",
+            PyArray1::from_vec(py, rot).reshape([k, edges, 3])?,
+        )?;
+        d.set_item("shares", PyArray1::from_vec(py, shares).reshape([k, 4])?)?;
+        d.set_item("kind", kinds)?;
         Ok(d)
     }
 

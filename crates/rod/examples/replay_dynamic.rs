@@ -5,7 +5,7 @@
 //! `cargo run --release -p cablelife-rod --example replay_dynamic -- FILE [REPS] [OUT]`
 //! (FILE from `python3 benchmarks/bench_dynamic.py --dump N DURATION FILE`; OUT: the largest
 //! bending moments and forces per node/edge and the moments of every saved step, f64 LE).
-//! Environment: TOL (relative Newton tolerance), RATE (refactor rate), MAXIT; FDCHECK=k
+//! Environment: TOL (Newton tolerance: fraction of the local time-error estimate), RATE (refactor rate), MAXIT; FDCHECK=k
 //! compares the iteration matrix with finite differences after step k (EPS: the step);
 //! PIECES=1 times residual, matrix, factorisation and substitution at step 300.
 use nalgebra::{Quaternion, Vector3};

@@ -29,6 +29,9 @@ pub struct Workspace {
     pub edge_force: Vec<Vector3<f64>>,
     /// Section moments on nodes, material frame (average of the two half cells at a clip).
     pub node_moment: Vec<Vector3<f64>>,
+    /// The viscous (Kelvin–Voigt) parts of `edge_force` and `node_moment` (outputs, with rates).
+    pub edge_force_viscous: Vec<Vector3<f64>>,
+    pub node_moment_viscous: Vec<Vector3<f64>>,
     node_moment_count: Vec<u8>,
     pub elastic_energy: f64,
     /// Dissipated power of the viscous damping, W (with rates).
@@ -113,6 +116,8 @@ impl Workspace {
             ghost_grad: vec![Vector3::zeros(); rod.ghosts.len()],
             edge_force: vec![Vector3::zeros(); n],
             node_moment: vec![Vector3::zeros(); n + 1],
+            edge_force_viscous: vec![Vector3::zeros(); n],
+            node_moment_viscous: vec![Vector3::zeros(); n + 1],
             node_moment_count: vec![0; n + 1],
             elastic_energy: 0.0,
             dissipation: 0.0,
@@ -135,6 +140,9 @@ impl Workspace {
                 self.edge_grad.iter_mut().for_each(|v| v.fill(0.0));
                 self.ghost_grad.iter_mut().for_each(|v| v.fill(0.0));
                 self.node_moment.iter_mut().for_each(|v| v.fill(0.0));
+                self.node_moment_viscous
+                    .iter_mut()
+                    .for_each(|v| v.fill(0.0));
                 self.node_moment_count.iter_mut().for_each(|c| *c = 0);
             }
             Part::Segment(seg) => {
@@ -214,7 +222,9 @@ impl Workspace {
                 }
                 for n in 0..self.node_moment.len() {
                     if self.node_moment_count[n] > 1 {
-                        self.node_moment[n] /= self.node_moment_count[n] as f64;
+                        let w = 1.0 / self.node_moment_count[n] as f64;
+                        self.node_moment[n] *= w;
+                        self.node_moment_viscous[n] *= w;
                     }
                 }
             }
@@ -290,6 +300,7 @@ impl Workspace {
         }
         if outputs {
             self.edge_force[e] = f;
+            self.edge_force_viscous[e] = f - f_el;
         }
         let rf = kin.r * f;
         self.node_grad[e] -= rf;
@@ -369,6 +380,7 @@ impl Workspace {
         }
         if outputs {
             self.node_moment[t.node] += m;
+            self.node_moment_viscous[t.node] += m - m_el;
             self.node_moment_count[t.node] += 1;
         }
         let g = kin.forces(&m);

@@ -127,6 +127,45 @@ impl BlockTridiag {
         Ok(())
     }
 
+    /// Symmetric block LDLᵀ factorisation of the blocks `r` and its inertia: the number of
+    /// negative eigenvalues of the (symmetric) matrix of these blocks. The matrix must be
+    /// symmetric (`lower[b] = upper[b−1]ᵀ`, `diag[b]` symmetric; only `diag` and `upper` are
+    /// read for the pivots' symmetry). The pivot blocks D'_b = D_b − L_b D'_{b−1}⁻¹ U_{b−1} are
+    /// those of `factor_range`, and by Sylvester's law of inertia (A = L D Lᵀ with D block
+    /// diagonal) the inertia of A is the sum of the inertias of the pivots, read from their
+    /// symmetric eigenvalues. Afterwards `solve_range` solves with this factorisation. With
+    /// A = K − σM this is the Sturm count: the number of eigenvalues of K φ = λ M φ below σ.
+    /// A pivot eigenvalue below 1e-14 of the pivot's largest is `Singular` (σ on or next to an
+    /// eigenvalue: shift it).
+    pub fn inertia(&mut self, r: Range<usize>) -> Result<usize, Singular> {
+        let mut negative = 0;
+        for b in r.clone() {
+            let mut d = self.diag[b];
+            if b > r.start {
+                d -= self.lower[b] * self.elim[b - 1];
+            }
+            let d = 0.5 * (d + d.transpose());
+            let eig = d.symmetric_eigen();
+            let top = eig.eigenvalues.amax();
+            if !(top.is_finite() && top > 0.0)
+                || eig.eigenvalues.iter().any(|mu| mu.abs() <= 1e-14 * top)
+            {
+                return Err(Singular { block: b });
+            }
+            negative += eig.eigenvalues.iter().filter(|&&mu| mu < 0.0).count();
+            let v = &eig.eigenvectors;
+            let inv = v * Block::from_diagonal(&eig.eigenvalues.map(|mu| 1.0 / mu)) * v.transpose();
+            self.inv[b] = inv;
+            if b > r.start {
+                self.inv_lower[b] = inv * self.lower[b];
+            }
+            if b + 1 < r.end {
+                self.elim[b] = inv * self.upper[b];
+            }
+        }
+        Ok(negative)
+    }
+
     /// Solves J x = rhs in place with the current factorisation.
     pub fn solve_factored(&self, rhs: &mut [Vector6<f64>]) {
         self.solve_range(0..self.n_blocks(), rhs);
@@ -256,6 +295,58 @@ fn lu_solve_matrix(lu: &Block, piv: &[u8; 6], inv: &[f64; 6], x: &mut Block) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn inertia_counts_the_negative_eigenvalues() {
+        // A symmetric block-tridiagonal matrix with known spectrum: the 1D Laplacian (2, −1)
+        // of size 6n in blocks, eigenvalues 2 − 2 cos(kπ/(6n+1)), shifted by σ.
+        let n = 5;
+        let size = 6 * n;
+        let mut j = BlockTridiag::new(n);
+        for i in 0..size {
+            let (b, k) = (i / 6, i % 6);
+            j.diag[b][(k, k)] = 2.0;
+            if i + 1 < size {
+                let (c, l) = ((i + 1) / 6, (i + 1) % 6);
+                if c == b {
+                    j.diag[b][(k, l)] = -1.0;
+                    j.diag[b][(l, k)] = -1.0;
+                } else {
+                    j.upper[b][(k, l)] = -1.0;
+                    j.lower[c][(l, k)] = -1.0;
+                }
+            }
+        }
+        let eig: Vec<f64> = (1..=size)
+            .map(|k| 2.0 - 2.0 * (k as f64 * std::f64::consts::PI / (size as f64 + 1.0)).cos())
+            .collect();
+        for sigma in [-0.5, 0.005, 0.3, 1.0, 1.77, 2.5, 3.99, 4.5] {
+            let mut a = j.clone();
+            for b in 0..n {
+                a.diag[b] -= Block::identity() * sigma;
+            }
+            let expected = eig.iter().filter(|&&l| l < sigma).count();
+            assert_eq!(a.inertia(0..n).unwrap(), expected, "σ = {sigma}");
+            // and the factorisation solves
+            let x: Vec<Vector6<f64>> = (0..n)
+                .map(|b| Vector6::from_fn(|k, _| (b * 6 + k) as f64))
+                .collect();
+            let mut rhs = vec![Vector6::zeros(); n];
+            a.mul(&x, &mut rhs);
+            a.solve_range(0..n, &mut rhs);
+            for b in 0..n {
+                assert!(
+                    (rhs[b] - x[b]).norm() < 1e-9 * x[b].norm().max(1.0),
+                    "σ = {sigma}"
+                );
+            }
+        }
+        // σ on an eigenvalue of a pivot: singular
+        let mut a = BlockTridiag::new(1);
+        a.diag[0] = Block::identity();
+        a.diag[0][(2, 2)] = 0.0;
+        assert_eq!(a.inertia(0..1), Err(Singular { block: 0 }));
+    }
 
     #[test]
     fn solves_a_random_system() {

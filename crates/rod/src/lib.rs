@@ -7,6 +7,7 @@ pub mod block_tridiag;
 pub mod dynamics;
 #[cfg(test)]
 mod fd_check;
+pub mod modal;
 pub mod model;
 pub mod rotation;
 pub mod routing;
