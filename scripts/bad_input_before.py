@@ -16,6 +16,7 @@ import sys
 
 root, py = sys.argv[1], sys.argv[2]
 files = [
+    "tests/test_bad_input_generated.py",
     "tests/test_bad_input_scenes.py",
     "tests/test_bad_input_files.py",
     "tests/test_bad_input_more.py",

@@ -77,6 +77,20 @@ def _forged_steps(f):
             clip.create_dataset(key, shape=(big, 3), dtype="f8", chunks=True)
 
 
+def _more_nodes(f):
+    """Consistent shapes, but 60 segments where the stored scene asked for 8."""
+    g = f[CABLE]
+    t = g["time"].shape[0]
+    for key, shape in (
+        ("arc_length", (61,)),
+        ("positions", (t, 61, 3)),
+        ("quaternions", (t, 60, 4)),
+        ("forces", (t, 60, 3)),
+        ("moments", (t, 61, 3)),
+    ):
+        _replace(f, f"{CABLE}/{key}", data=np.zeros(shape))
+
+
 # (id, change of an open copy of the good result, expected message parts)
 RESULT_DEFECTS = [
     ("no-format", lambda f: f.attrs.__delitem__("format"), ("not a cablelife result",)),
@@ -131,6 +145,7 @@ RESULT_DEFECTS = [
         lambda f: f.__delitem__(f"{CABLE}/clips/b/reaction_moment"),
         ("clip 'b'", "dataset 'reaction_moment' is missing"),
     ),
+    ("more-nodes", _more_nodes, ("'arc_length' has 61 nodes", "8 segments give at most")),
     ("bad-mode", lambda f: f.attrs.__setitem__("mode", "fast"), ("attribute 'mode' is 'fast'",)),
     (
         "bad-scene-toml",

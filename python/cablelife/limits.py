@@ -23,6 +23,9 @@ LIMITS: dict[str, tuple[float, float]] = {
     "acceleration": (-1e4, 1e4),  # m/s², gravity (1000 g)
     "force": (-1e9, 1e9),  # N, dead loads
     "moment": (-1e9, 1e9),  # N m, dead loads
+    "direction": (-1e6, 1e6),  # 1, components of direction and normal vectors (any length)
+    "damping_ratio": (0.0, 1e3),  # 1, fraction of critical damping
+    "time": (0.0, 1e6),  # s, retardation times, fades (11 days)
 }
 
 # Segments of one cable. Fewer than MIN_SEGMENTS cannot represent a cable bent between two

@@ -16,7 +16,7 @@ import warnings
 import h5py
 import numpy as np
 
-from cablelife.limits import MAX_RUN_BYTES, human_bytes
+from cablelife.limits import MAX_RUN_BYTES, MIN_SEGMENTS, human_bytes
 
 
 class ResultFileError(ValueError):
@@ -88,6 +88,20 @@ def _expected_steps(scene: dict, mode: str) -> int | None:
         return None
 
 
+def _stored_segments(cable: dict) -> int | None:
+    """The segments a stored cable asked for (segments, max_segment_length or the default)."""
+    seg = cable.get("segments")
+    if isinstance(seg, int) and not isinstance(seg, bool):
+        return seg
+    try:
+        if cable.get("max_segment_length") is not None:
+            ratio = float(cable["length"]) / float(cable["max_segment_length"])
+            return max(MIN_SEGMENTS, math.ceil(ratio))
+    except (KeyError, TypeError, ValueError, ZeroDivisionError, OverflowError):
+        return None
+    return 50
+
+
 def check_result_file(f: h5py.File, path) -> None:
     """Checks an open result file (format attribute already checked) before it is read."""
     where = repr(str(path))
@@ -125,7 +139,7 @@ def check_result_file(f: h5py.File, path) -> None:
                 f"{max_steps}"
             )
         spec = stored.get(name, {})
-        seg = spec.get("segments") if isinstance(spec, dict) else None
+        seg = _stored_segments(spec) if isinstance(spec, dict) and spec else None
         clips = spec.get("clips", []) if isinstance(spec, dict) else []
         loads = spec.get("loads", []) if isinstance(spec, dict) else []
         if isinstance(seg, int) and not isinstance(seg, bool):

@@ -56,6 +56,9 @@ Curvature = _bounded("curvature")  # 1/m
 Acceleration = _bounded("acceleration")  # m/s²
 Force = _bounded("force")  # N
 Moment = _bounded("moment")  # N m
+Component = _bounded("direction")  # 1
+Direction = tuple[Component, Component, Component]
+Time = _bounded("time")  # s
 # Cable, clip and body names: HDF5 group names and table entries (limits.check_name).
 Name = Annotated[str, Strict(), Field(min_length=1), AfterValidator(check_name)]
 
@@ -151,17 +154,20 @@ class Clip(_Model):
     s: NonNegativeFloat  # m
     body: Annotated[str, Strict()] = "world"
     position: Point  # m
-    direction: Vec3  # cable tangent d3 at the clip
-    normal: Vec3 | None = None  # d1 at the clip (fixes the twist); default: any normal
+    direction: Direction  # cable tangent d3 at the clip
+    normal: Direction | None = None  # d1 at the clip (fixes the twist); default: any normal
     type: Literal["fixed", "swivel", "ball"] = "fixed"
     length: NonNegativeFloat = 0.0  # held length; 0 = point clip
     frame: Literal["global", "body"] = "global"  # frame of position/direction/normal
 
-    @field_validator("direction")
+    @field_validator("direction", "normal")
     @classmethod
-    def _nonzero(cls, v):
-        if math.hypot(*v) == 0:
-            raise ValueError("direction must not be the zero vector")
+    def _nonzero(cls, v, info):
+        if v is not None and math.hypot(*v) < 1e-9:
+            raise ValueError(
+                f"{info.field_name} must not be the zero vector; allowed: a length of at least "
+                "1e-9 (its length does not matter otherwise)"
+            )
         return v
 
     @model_validator(mode="after")
@@ -197,12 +203,12 @@ class Damping(_Model):
     damping of the mounted cable's first mode: τ = 2ζ/ω₁; ζ = 1 is critical, the default) or
     ``retardation_time`` τ directly; the per-mode times override τ for that deformation mode."""
 
-    ratio: PositiveFloat | None = None
-    retardation_time: NonNegativeFloat | None = None  # s
-    extension: NonNegativeFloat | None = None  # s, τ of EA
-    shear: NonNegativeFloat | None = None  # s, τ of GA₁, GA₂
-    bending: NonNegativeFloat | None = None  # s, τ of EI₁, EI₂
-    torsion: NonNegativeFloat | None = None  # s, τ of GJ
+    ratio: Annotated[float, Strict(), Field(gt=0, le=LIMITS["damping_ratio"][1])] | None = None
+    retardation_time: Time | None = None  # s
+    extension: Time | None = None  # s, τ of EA
+    shear: Time | None = None  # s, τ of GA₁, GA₂
+    bending: Time | None = None  # s, τ of EI₁, EI₂
+    torsion: Time | None = None  # s, τ of GJ
 
     @model_validator(mode="after")
     def _one(self):

@@ -16,7 +16,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from cablelife import _core, interrupt
-from cablelife.limits import MAX_RUN_BYTES, human_bytes, run_bytes
+from cablelife.limits import LIMITS, MAX_RUN_BYTES, human_bytes, run_bytes
 from cablelife.results import CableResult, ClipReaction, Result
 from cablelife.scene import Cable, Scene, SceneError
 from cablelife.signals import body_motion, time_grid
@@ -169,9 +169,28 @@ def clip_kinematics(
         out["angular_velocities"][:, j] = w
         out["angular_accelerations"][:, j] = alpha
         frames[:, j] = rot @ local
+    _check_clip_motion(cable, times, out)
     quats = Rotation.from_matrix(frames.reshape(-1, 3, 3)).as_quat(scalar_first=True)
     out["quaternions"] = quats.reshape(n_t, n_c, 4)
     return out
+
+
+def _check_clip_motion(cable: Cable, times: np.ndarray, kin: dict[str, np.ndarray]) -> None:
+    """The body motions keep every clip finite and inside the coordinate range (a signal of
+    1e300 m, or a unit mistake, fails here with names instead of in the solver)."""
+    lo, hi = LIMITS["coordinate"]
+    for key in ("positions", "velocities", "accelerations", "angular_velocities"):
+        a = kin[key]
+        bad = ~np.isfinite(a) | ((a < lo) | (a > hi) if key == "positions" else False)
+        if bad.any():
+            t, j, _ = np.argwhere(bad)[0]
+            clip = cable.clips[j]
+            raise SceneError(
+                f"cable '{cable.name}', clip '{clip.name}' (body '{clip.body}'): the body "
+                f"motion gives {key} {a[t, j].tolist()} at t = {times[min(t, times.size - 1)]:g} "
+                f"s; allowed: finite values, positions within {lo:g} … {hi:g} m (check the "
+                "motion's amplitude and unit)"
+            )
 
 
 def clip_poses(

@@ -32,6 +32,8 @@ ROTATIONS = ("rx", "ry", "rz")
 Real = Annotated[float, Strict()]
 PositiveFloat = Annotated[float, Strict(), Field(gt=0)]
 NonNegativeFloat = Annotated[float, Strict(), Field(ge=0)]
+# Fades and sweep durations: at most 1e6 s (11 days; longer overflows the ramp polynomials).
+Seconds = Annotated[float, Strict(), Field(ge=0, le=1e6)]
 
 
 class _Spec(BaseModel):
@@ -69,7 +71,7 @@ class SineSignal(_Spec):
     offset: Real = 0.0  # m or rad
     quantity: Quantity = "displacement"
     unit: str | None = None  # of amplitude; default SI (m, m/s, m/s² or rad, ...)
-    fade_in: NonNegativeFloat = 0.0  # s
+    fade_in: Seconds = 0.0  # s
 
     @model_validator(mode="after")
     def _check(self) -> SineSignal:
@@ -95,12 +97,12 @@ class SweepSignal(_Spec):
     f1: PositiveFloat  # Hz
     law: Literal["linear", "log"] = "log"
     octaves_per_minute: PositiveFloat | None = None
-    duration: PositiveFloat | None = None  # s
+    duration: Annotated[float, Strict(), Field(gt=0, le=1e6)] | None = None  # s
     amplitude: NonNegativeFloat
     quantity: Quantity = "displacement"
     unit: str | None = None
     phase: Real = 0.0  # rad
-    fade: NonNegativeFloat = 0.0  # s, at start and end
+    fade: Seconds = 0.0  # s, at start and end
 
     @model_validator(mode="after")
     def _check(self) -> SweepSignal:
@@ -157,7 +159,7 @@ class PsdSignal(_Spec):
     seed: Annotated[int, Strict(), Field(ge=0)] = 0
     f_low: PositiveFloat | None = None  # Hz
     f_high: PositiveFloat | None = None  # Hz
-    fade_in: NonNegativeFloat = 0.0  # s
+    fade_in: Seconds = 0.0  # s
 
     @model_validator(mode="after")
     def _check(self) -> PsdSignal:
