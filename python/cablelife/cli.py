@@ -4,18 +4,16 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 from rich.console import Console
-from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
-from rich.table import Table
 
-from cablelife.results import Result
-from cablelife.scene import SceneError, json_schema, load_scene
-from cablelife.signals.errors import SignalError
-from cablelife.simulate import SimulationError, simulate
-from cablelife.summary import cable_summary
+if TYPE_CHECKING:
+    from cablelife.results import Result
+
+# Heavy modules (numpy, pydantic, h5py, scipy, matplotlib, plotly, pandas, dask) are imported
+# inside the commands that use them: `cablelife --help` stays fast (benchmarks/bench_startup.py).
 
 app = typer.Typer(
     help="cablelife: digital mock-up of cables and hoses (Cosserat rod simulation, fatigue).",
@@ -33,6 +31,10 @@ def fail(message: str, code: int = 2) -> typer.Exit:
 
 def print_summary(result: Result) -> None:
     """Prints the run summary table of every cable."""
+    from rich.table import Table
+
+    from cablelife.summary import cable_summary
+
     for name, c in result.cables.items():
         s = cable_summary(c)
         t = Table(
@@ -89,6 +91,12 @@ def run(
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="no progress bar")] = False,
 ) -> None:
     """Simulate a scene and print a summary; with -o, save the result (HDF5)."""
+    from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
+
+    from cablelife.scene import SceneError, load_scene
+    from cablelife.signals.errors import SignalError
+    from cablelife.simulate import SimulationError, simulate
+
     try:
         sc = load_scene(scene)
     except SceneError as err:
@@ -130,7 +138,11 @@ def modes(
     count: Annotated[int, typer.Option("--count", "-n", help="number of modes")] = 6,
 ) -> None:
     """Natural frequencies of each mounted cable about its static equilibrium."""
+    from rich.table import Table
+
     from cablelife.modal import modes as compute_modes
+    from cablelife.scene import SceneError, load_scene
+    from cablelife.signals.errors import SignalError
 
     try:
         sc = load_scene(scene)
@@ -153,6 +165,8 @@ def schema(
 ) -> None:
     """Print (or write) the JSON schema of the scene format."""
     import json
+
+    from cablelife.scene import json_schema
 
     text = json.dumps(json_schema(), indent=2)
     if output is None:

@@ -22,11 +22,14 @@ from __future__ import annotations
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-import h5py
 import numpy as np
 
 from cablelife.h5files import atomic_h5, open_h5, plain
+
+if TYPE_CHECKING:
+    import h5py
 
 FORMAT = "cablelife-result"
 FORMAT_VERSION = 1

@@ -8,7 +8,7 @@ from typing import Annotated
 
 import typer
 
-from cablelife.lda.planes import DEFAULT_PLANE_STEP_DEG
+from cablelife.lda.defaults import DEFAULT_PLANE_STEP_DEG
 
 
 def lda_command(
