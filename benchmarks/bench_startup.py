@@ -21,7 +21,11 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 BIN = Path(sys.executable).parent
-CLI = [str(BIN / "cablelife")] if (BIN / "cablelife").exists() else [sys.executable, "-m", "cablelife"]
+CLI = (
+    [str(BIN / "cablelife")]
+    if (BIN / "cablelife").exists()
+    else [sys.executable, "-m", "cablelife"]
+)
 
 CASES = {
     "import cablelife": [sys.executable, "-c", "import cablelife"],

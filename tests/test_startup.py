@@ -86,9 +86,8 @@ def test_lazy_names_resolve_like_eager_imports():
 
 
 def test_rotations_match_scipy():
-    from scipy.spatial.transform import Rotation
-
     from cablelife.rotations import euler_matrix, matrix_quaternions
+    from scipy.spatial.transform import Rotation
 
     rng = np.random.default_rng(3)
     angles = rng.uniform(-np.pi, np.pi, (50, 3))
