@@ -89,6 +89,10 @@ def run(
     ] = None,
     output: Annotated[Path | None, typer.Option("-o", "--output", help="result HDF5 file")] = None,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="no progress bar")] = False,
+    precision: Annotated[
+        str | None,
+        typer.Option(help="float64 | float32: saved histories (overrides the scene)"),
+    ] = None,
 ) -> None:
     """Simulate a scene and print a summary; with -o, save the result (HDF5)."""
     from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
@@ -97,10 +101,14 @@ def run(
     from cablelife.signals.errors import SignalError
     from cablelife.simulate import SimulationError, simulate
 
+    if precision not in (None, "float64", "float32"):
+        raise fail(f"--precision {precision!r}: allowed are float64, float32")
     try:
         sc = load_scene(scene)
     except SceneError as err:
         raise fail(str(err)) from None
+    if precision is not None:
+        sc.simulation.output_precision = precision
     progress = Progress(
         TextColumn("{task.description}"),
         BarColumn(),

@@ -321,6 +321,8 @@ class Simulation(_Model):
     # Dynamic Newton iteration: converged when the correction is below this fraction of the
     # step's increment (docs/dynamics.md: the error it leaves vs the time-step error).
     newton_tolerance: Annotated[float, Field(gt=0.0, lt=1.0)] = _core.DEFAULT_NEWTON_TOLERANCE
+    # Precision of the saved histories in the result file (docs/results.md): float32 halves it.
+    output_precision: Literal["float64", "float32"] = "float64"
 
 
 class Scene(_Model):

@@ -307,6 +307,7 @@ def simulate(scene: Scene, mode: str | None = None, progress: Progress | None = 
         scene_toml=scene.to_toml(),
         complete=not errors,
         message="; ".join(errors),
+        precision=scene.simulation.output_precision,
     )
     if errors:
         raise SimulationError(result.message, result)
