@@ -93,7 +93,7 @@ def run_demo(
     duration: float | None = None,
     quasistatic: bool = True,
     report: bool = True,
-    report_frames: int = 40,
+    report_frames: int = 24,
     workers: int | None = None,
     on_stage: Callable[[str, str], None] | None = None,
 ) -> DemoOutcome:
@@ -138,13 +138,14 @@ def run_demo(
         if on_stage is not None:
             on_stage("report", "report")
         t1 = time.perf_counter()
-        path = _write_report(out, runs, report_frames)
+        step = None if on_stage is None else (lambda what: on_stage("report", what))
+        path = _write_report(out, runs, report_frames, step)
         times["report"] = time.perf_counter() - t1
     times["total"] = time.perf_counter() - t0
     return DemoOutcome(out, rows, dynamic, qs, path, times)
 
 
-def _write_report(out: Path, runs: list[Variant], frames: int) -> Path:
+def _write_report(out: Path, runs: list[Variant], frames: int, on_step=None) -> Path:
     from cablelife.lda.io import load_damage
     from cablelife.report.html import ReportRun, write_report
     from cablelife.results import load_result
@@ -157,4 +158,4 @@ def _write_report(out: Path, runs: list[Variant], frames: int) -> Path:
         )
         for v in runs
     ]
-    return write_report(out / "report.html", report_runs, frames=frames)
+    return write_report(out / "report.html", report_runs, frames=frames, on_step=on_step)

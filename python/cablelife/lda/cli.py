@@ -88,7 +88,8 @@ def compare_command(
     labels: Annotated[str | None, typer.Option(help="Comma-separated labels [file names].")] = None,
     hot_spots: Annotated[int, typer.Option(help="Hot spots per variant.")] = 1,
     force: Annotated[
-        bool, typer.Option(help="Compare even if the Wöhler curves or settings differ.")
+        bool,
+        typer.Option(help="Compare even if the Wöhler curves, settings or run modes differ."),
     ] = False,
 ) -> None:
     """Rank variants by maximum pseudo-damage, with ratios to the best and hot spots."""
@@ -99,7 +100,9 @@ def compare_command(
     console = Console()
     try:
         names = None if labels is None else [s.strip() for s in labels.split(",")]
-        cmp = compare(files, names, check_settings=not force, n_hot_spots=hot_spots)
+        cmp = compare(
+            files, names, check_settings=not force, check_modes=not force, n_hot_spots=hot_spots
+        )
     except (ValueError, FileNotFoundError, TypeError) as e:
         console.print(f"[red]error:[/] {e}", soft_wrap=True)
         raise typer.Exit(1) from e

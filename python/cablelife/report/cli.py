@@ -93,7 +93,7 @@ def report_command(
     color_by: Annotated[
         str, typer.Option(help="tube colour: shear, tension, bending or torsion")
     ] = "bending",
-    frames: Annotated[int, typer.Option(help="animation frames of the 3D view")] = 40,
+    frames: Annotated[int, typer.Option(help="animation frames of the 3D view")] = 24,
     voxel: Annotated[str, typer.Option(help="voxel of the motion volumes ('none': skip)")] = "4mm",
     bend_factor: Annotated[
         float, typer.Option(help="bend radius rule: at least this × the diameter")
