@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
@@ -125,7 +126,8 @@ def run(
         progress.update(tasks[cable], completed=done)
 
     try:
-        with progress:
+        with progress, warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
             result = simulate(sc, mode=mode, progress=on_progress)
     except (SceneError, SignalError) as err:
         raise fail(str(err)) from None
@@ -134,6 +136,10 @@ def run(
             err.result.save(output)
             err_console.print(f"partial result (steps before the failure) saved to {output}")
         raise fail(str(err), code=1) from None
+    from cablelife.hints import run_hints
+
+    for message in [*dict.fromkeys(str(w.message) for w in caught), *run_hints(sc, result)]:
+        err_console.print(f"[yellow]warning:[/] {message}", highlight=False, soft_wrap=True)
     print_summary(result)
     if output is not None:
         result.save(output)

@@ -14,6 +14,7 @@ import html
 import os
 import re
 from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -302,32 +303,44 @@ def _comparison(page: Page, runs: list[ReportRun], volumes: dict, voxel: float, 
             )
 
 
-def _frequencies(page: Page, res: Result, name: str, cache: dict, run_label: str = "") -> None:
-    """Natural frequencies of the mounted cable (about its static equilibrium, bodies at rest)
-    over the acceleration PSD at its clips on moving bodies; the excited band from the signal
-    definitions (:func:`cablelife.report.scene_data.excited_band`). Computed once per scene
-    (the runs of one variant in several modes share them: ``cache``)."""
+def _scene_key(res: Result, name: str) -> tuple[str, str]:
+    """Runs of one scene in several modes share their modes and excitation."""
+    return (re.sub(r'(?m)^mode = "\w+"$', "", res.scene_toml), name)
+
+
+def frequency_data(res: Result, name: str):
+    """(natural frequencies, excitation PSD or the reason it is missing, excited band) of a
+    cable of a run, or the exception that stopped it."""
     from cablelife.modal import cable_modes
     from cablelife.report.scene_data import excitation_psd, excited_band, result_scene
     from cablelife.scene import SceneError
     from cablelife.signals import SignalError
 
-    key = (re.sub(r'(?m)^mode = "\w+"$', "", res.scene_toml), name)
+    try:
+        scene = result_scene(res.scene_toml)
+        spec = next(c for c in scene.cables if c.name == name)
+        fn = cable_modes(scene, spec, N_MODES).frequencies
+    except (SceneError, SignalError, StopIteration, ValueError) as e:
+        return e or ValueError("cable not in the scene")
+    try:
+        mode = "dynamic" if res.mode == "static" else res.mode
+        exc = excitation_psd(scene, name, mode)
+        band = excited_band(scene, name, exc)
+    except (SceneError, SignalError, ValueError, OSError) as e:
+        exc, band = e, None
+    return fn, exc, band
+
+
+def _frequencies(page: Page, res: Result, name: str, cache: dict, run_label: str = "") -> None:
+    """Natural frequencies of the mounted cable (about its static equilibrium, bodies at rest)
+    over the acceleration PSD at its clips on moving bodies; the excited band from the signal
+    definitions (:func:`cablelife.report.scene_data.excited_band`). Computed once per scene
+    (``cache``: scene key → the future of :func:`frequency_data`)."""
+    key = _scene_key(res, name)
     if key not in cache:
-        try:
-            scene = result_scene(res.scene_toml)
-            spec = next(c for c in scene.cables if c.name == name)
-            fn = cable_modes(scene, spec, N_MODES).frequencies
-        except (SceneError, SignalError, StopIteration, ValueError) as e:
-            cache[key] = e or ValueError("cable not in the scene")
-        else:
-            try:
-                mode = "dynamic" if res.mode == "static" else res.mode
-                exc = excitation_psd(scene, name, mode)
-                band = excited_band(scene, name, exc)
-            except (SceneError, SignalError, ValueError, OSError) as e:
-                exc, band = e, None
-            cache[key] = (fn, exc, band)
+        cache[key] = frequency_data(res, name)
+    if hasattr(cache[key], "result"):
+        cache[key] = cache[key].result()
     got = cache[key]
     shown = cache.setdefault("shown", {})
     if key in shown:
@@ -549,13 +562,26 @@ def build_report(
     if len(set(labels)) != len(labels):
         raise ValueError(f"run labels must be unique, got {labels}")
     step = on_step or (lambda what: None)
+    # In the background (the modal solves, signal synthesis and volume kernels release the
+    # GIL): the natural frequencies and excitation per scene, the motion volumes per run.
+    pool = ThreadPoolExecutor(max_workers=max(1, min(4, os.cpu_count() or 1)))
+
+    def volume(r):
+        n = next(iter(r.result.cables.values())).n_steps
+        every = slice(None, None, max(1, -(-n // VOLUME_STEPS)))
+        return motion_volume(r.result, voxel, steps=every)
+
+    pending = {r.label: pool.submit(volume, r) for r in runs} if voxel is not None else {}
+    cache: dict = {}
+    for r in runs:
+        for name in r.result.cables:
+            key = _scene_key(r.result, name)
+            if key not in cache:
+                cache[key] = pool.submit(frequency_data, r.result, name)
     volumes = {}
-    if voxel is not None:
-        for r in runs:
-            step(f"motion volume of {r.label}")
-            n = next(iter(r.result.cables.values())).n_steps
-            every = slice(None, None, max(1, -(-n // VOLUME_STEPS)))
-            volumes[r.label] = motion_volume(r.result, voxel, steps=every)
+    for label, f in pending.items():
+        step(f"motion volume of {label}")
+        volumes[label] = f.result()
     page = Page()
     stamp = _dt.datetime.now().strftime("%Y-%m-%d %H:%M")
     page.h(1, title)
@@ -567,10 +593,10 @@ def build_report(
     if len(runs) > 1:
         step("comparison")
         _comparison(page, runs, volumes, voxel or 0.004, bend_factor)
-    cache: dict = {}
     for k, run in enumerate(runs):
         step(f"run {run.label}")
         _run_section(page, k, run, volumes, color_by, frames, bend_factor, cache, len(runs) == 1)
+    pool.shutdown()
     step("page")
     return page.html(title, CSS)
 
