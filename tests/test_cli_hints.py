@@ -4,9 +4,8 @@ file:line format): an unfaded sine and a time step that does not resolve the fir
 import re
 from pathlib import Path
 
-from typer.testing import CliRunner
-
 from cablelife.cli import app
+from typer.testing import CliRunner
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -108,9 +108,12 @@ def run_demo(
     t0 = time.perf_counter()
     n = workers or min(len(runs), os.cpu_count() or 1)
 
+    # the report computes the motion volumes it draws: not twice
+    volume = study.volume.model_copy(update={"voxel": 0.0}) if report else study.volume
+
     def one(v: Variant) -> dict:
         cb = None if on_stage is None else (lambda stage, _n=v.name: on_stage(_n, stage))
-        row = run_variant(v, out, study.lda, study.volume, 1, on_stage=cb)
+        row = run_variant(v, out, study.lda, volume, 1, on_stage=cb)
         if on_stage is not None:
             on_stage(v.name, row["status"])
         return row
