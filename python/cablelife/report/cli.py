@@ -108,10 +108,17 @@ def report_command(
     err = Console(stderr=True)
     try:
         h = None if voxel.strip().lower() == "none" else parse_length(voxel)
-        runs = report_runs(files)
-        path = write_report(
-            output, runs, color_by=color_by, frames=frames, voxel=h, bend_factor=bend_factor
-        )
+        with err.status("reading the runs") as status:
+            runs = report_runs(files)
+            path = write_report(
+                output,
+                runs,
+                color_by=color_by,
+                frames=frames,
+                voxel=h,
+                bend_factor=bend_factor,
+                on_step=lambda what: status.update(f"report: {what}"),
+            )
     except (ValueError, FileNotFoundError) as e:
         err.print(f"[bold red]error:[/] {e}", highlight=False, soft_wrap=True)
         raise typer.Exit(2) from None
