@@ -118,7 +118,7 @@ def compare(
             "the runs were simulated in different modes ("
             + ", ".join(f"{n}: {m}" for n, m in modes.items())
             + "): rank the variants within one mode (their dynamic/quasistatic ratio is the "
-            "inertia factor); force to rank them anyway"
+            "inertia factor); cablelife compare --force (check_modes=False) ranks them anyway"
         )
     if check_settings:
         ref = _signature(loaded[0][1])
