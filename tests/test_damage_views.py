@@ -91,10 +91,10 @@ def test_damage_at_90_degrees_shows_on_the_d2_side(sign, tmp_path):
     vertices = np.column_stack([mesh.x, mesh.y, mesh.z])
     direction = hottest_direction(vertices, mesh.intensity, cable)
     np.testing.assert_allclose(direction, sign * d2, atol=1e-6)
-    label = next(t for t in fig.data if t.name == "hot spots")
+    label = next(t for t in fig.data if t.name.startswith("hot spot #1"))
     marker = np.array([label.x[0], label.y[0], label.z[0]]) - cable.positions[0, 4]
     np.testing.assert_allclose(marker / np.linalg.norm(marker), sign * d2, atol=1e-6)
-    assert "s=0.400 m" in label.text[0] and "near a (400 mm)" in label.text[0]
+    assert "s = 0.400 m" in label.hovertext[0] and "near a (400 mm)" in label.hovertext[0]
 
     # ParaView: the tube part of step 0 carries the map per vertex and per triangle.
     pvd = write_paraview(cable, tmp_path / "pv.pvd", damage=analysis.cables["hose"], steps=[0])

@@ -5,21 +5,19 @@ from __future__ import annotations
 
 import warnings
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 from rich.console import Console
 from rich.markup import escape
-from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
-from rich.table import Table
 
-from cablelife.interrupt import interrupted
 from cablelife.paths import ALLOW_OUTSIDE_HELP
-from cablelife.results import Result
-from cablelife.scene import SceneError, json_schema, load_scene
-from cablelife.signals.errors import SignalError
-from cablelife.simulate import SimulationError, simulate
-from cablelife.summary import VISCOUS_SHARE_WARNING, cable_summary
+
+if TYPE_CHECKING:
+    from cablelife.results import Result
+
+# Heavy modules (numpy, pydantic, h5py, scipy, matplotlib, plotly, pandas, dask) are imported
+# inside the commands that use them: `cablelife --help` stays fast (benchmarks/bench_startup.py).
 
 app = typer.Typer(
     help="cablelife: digital mock-up of cables and hoses (Cosserat rod simulation, fatigue).",
@@ -38,6 +36,10 @@ def fail(message: str, code: int = 2) -> typer.Exit:
 
 def print_summary(result: Result) -> None:
     """Prints the run summary table of every cable."""
+    from rich.table import Table
+
+    from cablelife.summary import VISCOUS_SHARE_WARNING, cable_summary
+
     for name, c in result.cables.items():
         s = cable_summary(c)
         t = Table(
@@ -142,8 +144,22 @@ def run(
     allow_outside_files: Annotated[
         bool, typer.Option("--allow-outside-files", help=ALLOW_OUTSIDE_HELP)
     ] = False,
+    precision: Annotated[
+        str | None,
+        typer.Option(help="float64 | float32: saved histories (overrides the scene)"),
+    ] = None,
 ) -> None:
     """Simulate a scene and print a summary; with -o, save the result (HDF5)."""
+    from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
+
+    from cablelife.clitext import print_warning
+    from cablelife.interrupt import interrupted
+    from cablelife.scene import SceneError, load_scene
+    from cablelife.signals.errors import SignalError
+    from cablelife.simulate import SimulationError, simulate
+
+    if precision not in (None, "float64", "float32"):
+        raise fail(f"--precision {precision!r}: allowed are float64, float32")
     try:
         sc = load_scene(scene)
     except SceneError as err:
@@ -153,6 +169,8 @@ def run(
     if output is not None and (output.is_dir() or not output.parent.is_dir()):
         why = "is a directory" if output.is_dir() else "is in a folder that does not exist"
         raise fail(f"--output {str(output)!r} {why}; give a file in an existing folder")
+    if precision is not None:
+        sc.simulation.output_precision = precision
     progress = Progress(
         TextColumn("{task.description}"),
         BarColumn(),
@@ -174,19 +192,15 @@ def run(
             try:
                 result = simulate(sc, mode=mode, progress=on_progress)
             finally:
-                for w in caught:  # one line each, without the source line
-                    err_console.print(
-                        f"warning: {w.message}", markup=False, highlight=False, soft_wrap=True
-                    )
+                for message in dict.fromkeys(str(w.message) for w in caught):
+                    print_warning(err_console, message)  # one line each, no source line
     except (SceneError, SignalError) as err:
         raise fail(str(err)) from None
     except SimulationError as err:
         what = "interruption" if err.interrupted else "failure"
         if output is not None:
             err.result.save(output)
-            err_console.print(
-                escape(f"partial result (steps before the {what}) saved to {output}")
-            )
+            err_console.print(escape(f"partial result (steps before the {what}) saved to {output}"))
         if err.interrupted:
             raise interrupted(
                 "the run stopped early" + ("" if output else " (nothing saved)")
@@ -198,6 +212,10 @@ def run(
         except OSError as err:
             print_summary(result)
             raise fail(f"--output {str(output)!r} cannot be written ({err})") from None
+    from cablelife.hints import run_hints
+
+    for message in run_hints(sc, result):
+        print_warning(err_console, message)
     print_summary(result)
     if output is not None:
         console.print(escape(f"result saved to {output}"))
@@ -209,7 +227,11 @@ def modes(
     count: Annotated[int, typer.Option("--count", "-n", help="number of modes")] = 6,
 ) -> None:
     """Natural frequencies of each mounted cable about its static equilibrium."""
+    from rich.table import Table
+
     from cablelife.modal import modes as compute_modes
+    from cablelife.scene import SceneError, load_scene
+    from cablelife.signals.errors import SignalError
 
     try:
         sc = load_scene(scene)
@@ -235,6 +257,8 @@ def schema(
 ) -> None:
     """Print (or write) the JSON schema of the scene format."""
     import json
+
+    from cablelife.scene import json_schema
 
     text = json.dumps(json_schema(), indent=2)
     if output is None:

@@ -99,7 +99,7 @@ def run_demo(
     duration: float | None = None,
     quasistatic: bool = True,
     report: bool = True,
-    report_frames: int = 40,
+    report_frames: int = 24,
     workers: int | None = None,
     on_stage: Callable[[str, str], None] | None = None,
     allow_outside_files: bool = False,
@@ -115,9 +115,12 @@ def run_demo(
     t0 = time.perf_counter()
     n = workers or min(len(runs), os.cpu_count() or 1)
 
+    # the report computes the motion volumes it draws: not twice
+    volume = study.volume.model_copy(update={"voxel": 0.0}) if report else study.volume
+
     def one(v: Variant) -> dict:
         cb = None if on_stage is None else (lambda stage, _n=v.name: on_stage(_n, stage))
-        row = run_variant(v, out, study.lda, study.volume, 1, on_stage=cb)
+        row = run_variant(v, out, study.lda, volume, 1, on_stage=cb)
         if on_stage is not None:
             on_stage(v.name, row["status"])
         return row
@@ -155,13 +158,14 @@ def run_demo(
         if on_stage is not None:
             on_stage("report", "report")
         t1 = time.perf_counter()
-        path = _write_report(out, runs, report_frames)
+        step = None if on_stage is None else (lambda what: on_stage("report", what))
+        path = _write_report(out, runs, report_frames, step)
         times["report"] = time.perf_counter() - t1
     times["total"] = time.perf_counter() - t0
     return DemoOutcome(out, rows, dynamic, qs, path, times)
 
 
-def _write_report(out: Path, runs: list[Variant], frames: int) -> Path:
+def _write_report(out: Path, runs: list[Variant], frames: int, on_step=None) -> Path:
     from cablelife.lda.io import load_damage
     from cablelife.report.html import ReportRun, write_report
     from cablelife.results import load_result
@@ -174,4 +178,4 @@ def _write_report(out: Path, runs: list[Variant], frames: int) -> Path:
         )
         for v in runs
     ]
-    return write_report(out / "report.html", report_runs, frames=frames)
+    return write_report(out / "report.html", report_runs, frames=frames, on_step=on_step)

@@ -7,17 +7,22 @@ import os
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-import h5py
 import numpy as np
 
 from cablelife.atomic import atomic_path
+
+if TYPE_CHECKING:
+    import h5py
 
 
 @contextmanager
 def atomic_h5(path: str | os.PathLike) -> Iterator[h5py.File]:
     """An ``h5py.File`` on a temporary file that replaces ``path`` on success and is removed on
     failure."""
+    import h5py
+
     with atomic_path(path) as tmp, h5py.File(tmp, "w") as f:
         yield f
 
@@ -25,6 +30,8 @@ def atomic_h5(path: str | os.PathLike) -> Iterator[h5py.File]:
 @contextmanager
 def open_h5(path: str | os.PathLike, fmt: str, what: str) -> Iterator[h5py.File]:
     """Opens a cablelife file for reading; clear errors when it is missing or of another kind."""
+    import h5py
+
     path = Path(path)
     if path.is_dir():
         raise ValueError(f"{what} file {str(path)!r} is a directory; give an HDF5 file")

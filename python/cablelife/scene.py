@@ -135,7 +135,7 @@ class MeasuredStiffness(_Model):
     GJ: BendingStiffness  # N m²
     mass_per_length: _bounded("mass_per_length")  # kg/m
     radius: Radius  # m, outer radius (contact, pictures, stresses)
-    rotary_inertia: _bounded("rotary_inertia") | None = None  # kg m (ρI per length, about d1 and d2)
+    rotary_inertia: _bounded("rotary_inertia") | None = None  # kg m (ρI per length, d1 and d2)
     polar_rotary_inertia: _bounded("rotary_inertia") | None = None  # kg m (ρI₃ about the axis d3)
 
     @model_validator(mode="after")
@@ -407,6 +407,8 @@ class Simulation(_Model):
     )
     # Strains outside the model's validity range (docs/solver.md): a warning, or an error.
     strain_limit: Literal["warn", "error"] = "warn"
+    # Precision of the saved histories in the result file (docs/results.md): float32 halves it.
+    output_precision: Literal["float64", "float32"] = "float64"
 
 
 class Scene(_Model):

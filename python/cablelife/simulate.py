@@ -13,11 +13,11 @@ from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from cablelife import _core, interrupt
 from cablelife.limits import LIMITS, MAX_RUN_BYTES, human_bytes, run_bytes
 from cablelife.results import CableResult, ClipReaction, Result
+from cablelife.rotations import euler_matrix, matrix_quaternions
 from cablelife.scene import Cable, Scene, SceneError
 from cablelife.signals import body_motion, time_grid
 
@@ -49,11 +49,6 @@ def frame_matrix(direction, normal=None) -> np.ndarray:
     d1 = n - d3 * n.dot(d3)
     d1 /= np.linalg.norm(d1)
     return np.column_stack([d1, np.cross(d3, d1), d3])
-
-
-def euler_matrix(angles) -> np.ndarray:
-    """R = Rz(rz) Ry(ry) Rx(rx) (rotations about the global axes, x first)."""
-    return Rotation.from_euler("xyz", angles).as_matrix()
 
 
 def _grid_steps(duration: float, time_step: float) -> float:
@@ -170,7 +165,7 @@ def clip_kinematics(
         out["angular_accelerations"][:, j] = alpha
         frames[:, j] = rot @ local
     _check_clip_motion(cable, times, out)
-    quats = Rotation.from_matrix(frames.reshape(-1, 3, 3)).as_quat(scalar_first=True)
+    quats = matrix_quaternions(frames.reshape(-1, 3, 3))
     out["quaternions"] = quats.reshape(n_t, n_c, 4)
     return out
 
@@ -451,6 +446,7 @@ def simulate(scene: Scene, mode: str | None = None, progress: Progress | None = 
         scene_toml=scene.to_toml(),
         complete=not errors,
         message=interrupt.INTERRUPTED if errors and stop.is_set else "; ".join(errors),
+        precision=scene.simulation.output_precision,
     )
     if errors:
         raise SimulationError(result.message, result)

@@ -1,6 +1,11 @@
 """Files for other tools: ParaView time series (.vtp + .pvd), STL and PLY meshes."""
 
-from cablelife.export.mesh_files import read_ply, read_stl, write_ply, write_stl
-from cablelife.export.paraview import write_paraview
+from cablelife._lazy import lazy_package
 
-__all__ = ["read_ply", "read_stl", "write_paraview", "write_ply", "write_stl"]
+__all__ = lazy_package(
+    __name__,
+    {
+        "cablelife.export.mesh_files": ["read_ply", "read_stl", "write_ply", "write_stl"],
+        "cablelife.export.paraview": ["write_paraview"],
+    },
+)

@@ -7,50 +7,30 @@ a Wöhler curve in RANGES (:mod:`.damage`, Rust kernel) → damage map, hot spot
 (:mod:`.io`) → ranking of variants (:mod:`.compare`). See docs/lda.md.
 """
 
-from cablelife.lda.compare import Comparison, compare
-from cablelife.lda.damage import damage, damage_combined, equivalent_range
-from cablelife.lda.io import load_damage, save_damage
-from cablelife.lda.pipeline import CableDamage, DamageAnalysis, HotSpot, analyse
-from cablelife.lda.planes import plane_angles, plane_weights, section_series
-from cablelife.lda.rainflow import (
-    Cycles,
-    from_to_matrix,
-    rainflow_cycles,
-    range_mean_matrix,
-    turning_points,
-)
-from cablelife.lda.sampling import SamplingWarning, check_sampling
-from cablelife.lda.spectral import dirlik_damage_rate, gaussian_signal, narrow_band_damage_rate
-from cablelife.lda.stress import CircularSection, surface_angles
-from cablelife.lda.wohler import WohlerCurve, pseudo_damage_curve
+from cablelife._lazy import lazy_package
 
-__all__ = [
-    "CableDamage",
-    "CircularSection",
-    "Comparison",
-    "Cycles",
-    "DamageAnalysis",
-    "HotSpot",
-    "SamplingWarning",
-    "WohlerCurve",
-    "analyse",
-    "check_sampling",
-    "compare",
-    "damage",
-    "damage_combined",
-    "dirlik_damage_rate",
-    "equivalent_range",
-    "from_to_matrix",
-    "gaussian_signal",
-    "load_damage",
-    "narrow_band_damage_rate",
-    "plane_angles",
-    "plane_weights",
-    "pseudo_damage_curve",
-    "rainflow_cycles",
-    "range_mean_matrix",
-    "save_damage",
-    "section_series",
-    "surface_angles",
-    "turning_points",
-]
+__all__ = lazy_package(
+    __name__,
+    {
+        "cablelife.lda.compare": ["Comparison", "compare"],
+        "cablelife.lda.damage": ["damage", "damage_combined", "equivalent_range"],
+        "cablelife.lda.io": ["load_damage", "save_damage"],
+        "cablelife.lda.pipeline": ["CableDamage", "DamageAnalysis", "HotSpot", "analyse"],
+        "cablelife.lda.planes": ["plane_angles", "plane_weights", "section_series"],
+        "cablelife.lda.rainflow": [
+            "Cycles",
+            "from_to_matrix",
+            "rainflow_cycles",
+            "range_mean_matrix",
+            "turning_points",
+        ],
+        "cablelife.lda.sampling": ["SamplingWarning", "check_sampling"],
+        "cablelife.lda.spectral": [
+            "dirlik_damage_rate",
+            "gaussian_signal",
+            "narrow_band_damage_rate",
+        ],
+        "cablelife.lda.stress": ["CircularSection", "surface_angles"],
+        "cablelife.lda.wohler": ["WohlerCurve", "pseudo_damage_curve"],
+    },
+)

@@ -8,7 +8,7 @@ from typing import Annotated
 
 import typer
 
-from cablelife.lda.planes import DEFAULT_PLANE_STEP_DEG
+from cablelife.lda.defaults import DEFAULT_PLANE_STEP_DEG
 
 
 def lda_command(
@@ -94,7 +94,8 @@ def compare_command(
     labels: Annotated[str | None, typer.Option(help="Comma-separated labels [file names].")] = None,
     hot_spots: Annotated[int, typer.Option(help="Hot spots per variant.")] = 1,
     force: Annotated[
-        bool, typer.Option(help="Compare even if the Wöhler curves or settings differ.")
+        bool,
+        typer.Option(help="Compare even if the Wöhler curves, settings or run modes differ."),
     ] = False,
 ) -> None:
     """Rank variants by maximum pseudo-damage, with ratios to the best and hot spots."""
@@ -108,7 +109,9 @@ def compare_command(
             raise ValueError(f"--hot-spots = {hot_spots}: allowed: 0 or more")
         names = None if labels is None else [s.strip() for s in labels.split(",")]
         with printed_warnings(console):  # partial results, sampling
-            cmp = compare(files, names, check_settings=not force, n_hot_spots=hot_spots)
+            cmp = compare(
+                files, names, check_settings=not force, check_modes=not force, n_hot_spots=hot_spots
+            )
     except (ValueError, FileNotFoundError, TypeError, OSError) as e:
         print_error(console, e)
         raise typer.Exit(2) from None

@@ -59,9 +59,16 @@ class Comparison:
         return "\n".join(lines)
 
 
+def _label(p: Path) -> str:
+    """A run's label from its file: the stem, or the folder for the generic names of a study
+    or the demo (variants/<run>/damage.h5)."""
+    stem = p.stem.removesuffix(".damage")
+    return p.parent.name if stem in ("damage", "result") and p.parent.name else stem
+
+
 def _load(item, lda_kwargs) -> tuple[str, DamageAnalysis]:
     if isinstance(item, DamageAnalysis):
-        return item.source or "variant", item
+        return (_label(Path(item.source)) if item.source else "variant"), item
     if isinstance(item, Result):
         return "variant", analyse(item, **lda_kwargs)
     if isinstance(item, str | os.PathLike):
@@ -69,8 +76,8 @@ def _load(item, lda_kwargs) -> tuple[str, DamageAnalysis]:
         if not p.exists():
             raise FileNotFoundError(f"{str(p)!r} does not exist")
         if is_damage_file(p):
-            return p.stem, load_damage(p)
-        return p.stem, analyse(p, **lda_kwargs)
+            return _label(p), load_damage(p)
+        return _label(p), analyse(p, **lda_kwargs)
     raise TypeError(
         f"cannot compare {type(item).__name__}: give damage/result file paths, DamageAnalysis "
         "or Result objects"
@@ -89,10 +96,13 @@ def compare(
     labels: list[str] | None = None,
     *,
     check_settings: bool = True,
+    check_modes: bool = True,
     n_hot_spots: int = 3,
     **lda_kwargs,
 ) -> Comparison:
-    """Rank variants by maximum damage; ratios are relative to the best (lowest) variant."""
+    """Rank variants by maximum damage; ratios are relative to the best (lowest) variant.
+    Runs of different analysis modes (quasistatic vs dynamic) are not ranked together unless
+    ``check_modes=False``: their ratio is the inertia factor, not a variant's merit."""
     items = list(items)
     if len(items) == 0:
         raise ValueError("compare needs at least one variant")
@@ -102,6 +112,14 @@ def compare(
     names = list(labels) if labels is not None else [n for n, _ in loaded]
     if len(set(names)) < len(names):
         names = [f"{n} [{i + 1}]" for i, n in enumerate(names)]
+    modes = {n: a.mode for n, (_, a) in zip(names, loaded, strict=True) if a.mode}
+    if check_modes and len(set(modes.values())) > 1:
+        raise ValueError(
+            "the runs were simulated in different modes ("
+            + ", ".join(f"{n}: {m}" for n, m in modes.items())
+            + "): rank the variants within one mode (their dynamic/quasistatic ratio is the "
+            "inertia factor); cablelife compare --force (check_modes=False) ranks them anyway"
+        )
     if check_settings:
         ref = _signature(loaded[0][1])
         for name, (_, a) in zip(names[1:], loaded[1:], strict=True):

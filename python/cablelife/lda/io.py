@@ -62,6 +62,7 @@ def save_damage(analysis: DamageAnalysis, path: str | os.PathLike) -> Path:
         f.attrs["format_version"] = FORMAT_VERSION
         f.attrs["cablelife_version"] = __version__
         f.attrs["source"] = analysis.source
+        f.attrs["mode"] = analysis.mode
         f.attrs["stress_convention"] = "ranges"
         for k, v in analysis.curve.as_attrs().items():
             f.attrs[k] = v
@@ -189,7 +190,11 @@ def load_damage(path: str | os.PathLike) -> DamageAnalysis:
                 rainflow=_get_rainflow(g["rainflow"], name) if "rainflow" in g else None,
             )
     analysis = DamageAnalysis(
-        cables=cables, curve=curve, settings=settings, source=str(a["source"])
+        cables=cables,
+        curve=curve,
+        settings=settings,
+        source=str(a["source"]),
+        mode=str(a.get("mode", "")),
     )
     check_damage_values(analysis, path)
     return analysis

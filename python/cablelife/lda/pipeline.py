@@ -130,6 +130,7 @@ class DamageAnalysis:
     curve: WohlerCurve
     settings: dict
     source: str = ""
+    mode: str = ""  # the analysis mode of the run (static, quasistatic, dynamic; "" unknown)
 
     @property
     def max_damage(self) -> float:
@@ -332,7 +333,9 @@ def analyse(
         "residue": residue,
         "hysteresis": float(hysteresis),
     }
-    return DamageAnalysis(cables=out, curve=curve, settings=settings, source=source)
+    return DamageAnalysis(
+        cables=out, curve=curve, settings=settings, source=source, mode=result.mode
+    )
 
 
 def default_damage_path(result_path: str | os.PathLike) -> Path:

@@ -18,9 +18,8 @@ import math
 
 import numpy as np
 
+from cablelife.lda.defaults import DEFAULT_PLANE_STEP_DEG
 from cablelife.lda.stress import CircularSection
-
-DEFAULT_PLANE_STEP_DEG = 10.0
 
 
 def plane_angles(step_deg: float = DEFAULT_PLANE_STEP_DEG) -> np.ndarray:

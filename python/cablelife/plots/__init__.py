@@ -2,33 +2,18 @@
 and along the cable, bend radius against a rule, clip reactions, natural frequencies over the
 excitation spectrum, rainflow matrices and damage along the cable. See docs/visuals.md."""
 
-from cablelife.plots.bend_radius import BendRadiusCheck, check_bend_radius, plot_bend_radius
-from cablelife.plots.clips import plot_clip_reactions
-from cablelife.plots.fatigue import plot_damage_along_cable, plot_rainflow_matrix
-from cablelife.plots.fatigue_data import DamageMap, HotSpot, RainflowMatrix, damage_maps
-from cablelife.plots.figure import png_bytes, save_png
-from cablelife.plots.loads import plot_envelopes, plot_maxima_over_time
-from cablelife.plots.runs import QUANTITIES, Run, as_runs, quantity
-from cablelife.plots.spectrum import plot_frequencies_over_spectrum
+from cablelife._lazy import lazy_package
 
-__all__ = [
-    "QUANTITIES",
-    "BendRadiusCheck",
-    "DamageMap",
-    "HotSpot",
-    "RainflowMatrix",
-    "Run",
-    "as_runs",
-    "check_bend_radius",
-    "damage_maps",
-    "plot_bend_radius",
-    "plot_clip_reactions",
-    "plot_damage_along_cable",
-    "plot_envelopes",
-    "plot_frequencies_over_spectrum",
-    "plot_maxima_over_time",
-    "plot_rainflow_matrix",
-    "png_bytes",
-    "quantity",
-    "save_png",
-]
+__all__ = lazy_package(
+    __name__,
+    {
+        "cablelife.plots.bend_radius": ["BendRadiusCheck", "check_bend_radius", "plot_bend_radius"],
+        "cablelife.plots.clips": ["plot_clip_reactions"],
+        "cablelife.plots.fatigue": ["plot_damage_along_cable", "plot_rainflow_matrix"],
+        "cablelife.plots.fatigue_data": ["DamageMap", "HotSpot", "RainflowMatrix", "damage_maps"],
+        "cablelife.plots.figure": ["png_bytes", "save_png"],
+        "cablelife.plots.loads": ["plot_envelopes", "plot_maxima_over_time"],
+        "cablelife.plots.runs": ["QUANTITIES", "Run", "as_runs", "quantity"],
+        "cablelife.plots.spectrum": ["plot_frequencies_over_spectrum"],
+    },
+)

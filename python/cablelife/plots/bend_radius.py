@@ -73,8 +73,8 @@ def plot_bend_radius(runs, factor: float = DEFAULT_FACTOR) -> Figure:
     for k, run in enumerate(runs):
         chk = check_bend_radius(run.cable, factor)
         r = np.where(np.isfinite(chk.min_radius), chk.min_radius, np.nan)
-        ax.plot(chk.arc_length, r, run.linestyle, color=f"C{k}", label=run.legend)
-        ax.axhline(chk.allowed, color=f"C{k}", lw=0.8, ls=":")
+        ax.plot(chk.arc_length, r, run.linestyle, color=run.colour(k), label=run.legend)
+        ax.axhline(chk.allowed, color=run.colour(k), lw=0.8, ls=":")
         for s0, s1, _ in chk.violations:
             ax.axvspan(s0, max(s1, s0 + 1e-3), color="red", alpha=0.15, lw=0)
     ax.axhline(np.nan, color="gray", ls=":", label=f"rule: {factor:g} × diameter")
@@ -83,5 +83,5 @@ def plot_bend_radius(runs, factor: float = DEFAULT_FACTOR) -> Figure:
     ax.set_ylabel("smallest bend radius [m]")
     ax.grid(alpha=0.3, which="both")
     ax.legend(fontsize=8)
-    ax.set_title("smallest bend radius over time (red: below the rule)")
+    ax.set_title("smallest bend radius along the cable, minimum over time (red: below the rule)")
     return fig

@@ -26,9 +26,11 @@ def plot_clip_reactions(runs) -> Figure:
             t = run.cable.time
             lab = run.legend
             axes[row, 0].plot(
-                t, np.linalg.norm(rc.force, axis=1), run.linestyle, color=f"C{k}", label=lab
+                t, np.linalg.norm(rc.force, axis=1), run.linestyle, color=run.colour(k), label=lab
             )
-            axes[row, 1].plot(t, np.linalg.norm(rc.moment, axis=1), run.linestyle, color=f"C{k}")
+            axes[row, 1].plot(
+                t, np.linalg.norm(rc.moment, axis=1), run.linestyle, color=run.colour(k)
+            )
         s = next(r.cable.clips[clip].s for r in runs if clip in r.cable.clips)
         axes[row, 0].set_ylabel(f"clip {clip}\n(s = {s:.3f} m)\n|force| [N]", fontsize=8)
         axes[row, 1].set_ylabel("|moment| [N m]", fontsize=8)

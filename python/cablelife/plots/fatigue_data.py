@@ -17,7 +17,12 @@ import numpy as np
 
 from cablelife.lda.rainflow import RainflowMatrix
 
-__all__ = ["DamageMap", "HotSpot", "RainflowMatrix", "damage_maps"]
+__all__ = ["DAMAGE_FLOOR", "DamageMap", "HotSpot", "RainflowMatrix", "damage_maps"]
+
+#: Damage below this fraction of a map's maximum is "below floor": the pictures' colour and
+#: log scales start there and hot spots are listed only above it. Spans that do not move carry
+#: numerical-noise damage (1e-50 … 1e-78) that would otherwise set the scale.
+DAMAGE_FLOOR = 1e-6
 
 
 @dataclass
@@ -100,19 +105,25 @@ class DamageMap:
             )
 
     @property
+    def floor(self) -> float:
+        """Damage below which the pictures show "below floor": DAMAGE_FLOOR × the maximum."""
+        return DAMAGE_FLOOR * float(self.damage.max()) if self.damage.size else 0.0
+
+    @property
     def along_cable(self) -> np.ndarray:
         """Largest damage around the circumference per station, (S,)."""
         return self.damage.max(axis=1)
 
     def hot_spots(self, count: int = 3, separation: float = 0.05) -> list[HotSpot]:
         """The analysis' hot spots when given, else the ``count`` largest damages at stations
-        at least ``separation`` (m) apart."""
+        at least ``separation`` (m) apart; only those above the floor."""
+        floor = self.floor
         if self.spots is not None:
-            return self.spots[:count]
+            return [h for h in self.spots if h.damage > 0 and h.damage >= floor][:count]
         along = self.along_cable
         spots: list[HotSpot] = []
         for i in np.argsort(along)[::-1]:
-            if along[i] <= 0 or len(spots) >= count:
+            if along[i] <= 0 or along[i] < floor or len(spots) >= count:
                 break
             s = self.arc_length[i]
             if all(abs(s - h.arc_length) >= separation for h in spots):

@@ -26,7 +26,7 @@ def plot_maxima_over_time(runs, quantities=ORDER) -> Figure:
                 run.cable.time,
                 extreme_along(v),
                 run.linestyle,
-                color=f"C{k}",
+                color=run.colour(k),
                 label=run.legend,
             )
         ax.set_ylabel(f"{label}\n[{unit}]", fontsize=8)
@@ -48,9 +48,9 @@ def plot_envelopes(runs, quantities=ORDER) -> Figure:
         for k, run in enumerate(runs):
             s, v = quantity(run.cable, name)
             lo, hi = v.min(axis=0), v.max(axis=0)
-            ax.fill_between(s, lo, hi, color=f"C{k}", alpha=0.2, lw=0)
-            ax.plot(s, hi, run.linestyle, color=f"C{k}", label=run.legend)
-            ax.plot(s, lo, run.linestyle, color=f"C{k}", lw=0.8)
+            ax.fill_between(s, lo, hi, color=run.colour(k), alpha=0.2, lw=0)
+            ax.plot(s, hi, run.linestyle, color=run.colour(k), label=run.legend)
+            ax.plot(s, lo, run.linestyle, color=run.colour(k), lw=0.8)
         ax.set_ylabel(f"{label}\n[{unit}]", fontsize=8)
         ax.grid(alpha=0.3)
     axes[0, 0].legend(fontsize=8, loc="best")

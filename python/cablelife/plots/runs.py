@@ -22,6 +22,11 @@ class Run:
     label: str
     cable: CableResult
     mode: str = "dynamic"
+    color: str | None = None  # default: the k-th colour of the cycle
+
+    def colour(self, k: int) -> str:
+        """This run's colour (one per variant in the report), else the k-th of the cycle."""
+        return self.color or f"C{k % 10}"
 
     @property
     def legend(self) -> str:

@@ -8,6 +8,21 @@ from matplotlib.figure import Figure
 from cablelife.plots.figure import new_figure
 
 
+def variance_band(frequency, psd, share: float = 0.99) -> tuple[float, float]:
+    """(lowest, highest) frequency of the band that holds the central ``share`` of the
+    variance of the largest of the PSDs ((F,) or (C, F)): a robust estimate of the excited band
+    of a measured signal (leakage, e.g. of a fade-in, carries little variance)."""
+    f = np.asarray(frequency, dtype=float)
+    top = np.atleast_2d(np.asarray(psd, dtype=float)).max(axis=0)
+    total = top.sum()
+    if not total > 0:
+        return (0.0, 0.0)
+    c = np.cumsum(top) / total
+    lo = f[np.searchsorted(c, (1 - share) / 2)]
+    hi = f[min(np.searchsorted(c, 1 - (1 - share) / 2), f.size - 1)]
+    return float(lo), float(hi)
+
+
 def excited_band(frequency, psd, band_level: float = 0.0) -> tuple[float, float]:
     """(lowest, highest) frequency where the largest of the PSDs ((F,) or (C, F)) exceeds
     ``band_level`` × its peak; (0, 0) when every PSD is zero."""
@@ -26,6 +41,7 @@ def plot_frequencies_over_spectrum(
     psd_unit: str = "(m/s²)²/Hz",
     labels: list[str] | None = None,
     band_level: float = 0.0,
+    band: tuple[float, float] | None = None,
 ) -> Figure:
     """The excitation PSD (``frequency`` (F,) Hz, ``psd`` (F,) or (C, F) for C channels, named
     by ``labels``) on log-log axes, with a vertical line at each natural frequency (Hz)
@@ -53,23 +69,22 @@ def plot_frequencies_over_spectrum(
             color=f"C{k}",
             label=labels[k] if labels else (f"{psd_label} {k + 1}" if len(g) > 1 else psd_label),
         )
-    excited = excited_band(f, g, band_level)
+    excited = band if band is not None else excited_band(f, g, band_level)
+    if band is not None:
+        ax.axvspan(*band, color="red", alpha=0.06, lw=0)
     for i, x in enumerate(fn):
         inside = excited[0] <= x <= excited[1]
-        ax.axvline(x, color="red" if inside else "gray", lw=1, ls="-" if inside else "--")
-        ax.annotate(
-            f"{i + 1}: {x:.3g} Hz",
-            (x, 1),
-            xycoords=("data", "axes fraction"),
-            rotation=90,
-            va="top",
-            ha="right",
-            fontsize=7,
+        ax.axvline(
+            x,
+            color="red" if inside else "gray",
+            lw=1,
+            ls="-" if inside else "--",
+            label=f"mode {i + 1}: {x:.3g} Hz",
         )
     ax.set_xlim(min(f[f > 0].min(initial=fn.min()), fn.min()) / 1.2, max(f.max(), fn.max()) * 1.2)
     ax.set_xlabel("frequency [Hz]")
     ax.set_ylabel(f"PSD [{psd_unit}]")
     ax.grid(alpha=0.3, which="both")
-    ax.legend(fontsize=8, loc="lower left")
+    ax.legend(fontsize=7, loc="center left", bbox_to_anchor=(1.01, 0.5))
     ax.set_title("natural frequencies over the excitation spectrum (red: inside the excited band)")
     return fig

@@ -1,17 +1,13 @@
 """The HTML report and the interactive 3D views (plotly, offline). See docs/visuals.md."""
 
-from cablelife.report.html import ReportRun, build_report, write_report
-from cablelife.report.interactive import maxima_over_time_figure
-from cablelife.report.scene3d import cable_figure, damage_figure
-from cablelife.report.tube import TubeMesh, tube_mesh
+from cablelife._lazy import lazy_package
 
-__all__ = [
-    "ReportRun",
-    "TubeMesh",
-    "build_report",
-    "cable_figure",
-    "damage_figure",
-    "maxima_over_time_figure",
-    "tube_mesh",
-    "write_report",
-]
+__all__ = lazy_package(
+    __name__,
+    {
+        "cablelife.report.html": ["ReportRun", "build_report", "write_report"],
+        "cablelife.report.interactive": ["maxima_over_time_figure"],
+        "cablelife.report.scene3d": ["cable_figure", "damage_figure"],
+        "cablelife.report.tube": ["TubeMesh", "tube_mesh"],
+    },
+)

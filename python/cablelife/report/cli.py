@@ -103,7 +103,7 @@ def report_command(
     color_by: Annotated[
         str, typer.Option(help="tube colour: shear, tension, bending or torsion")
     ] = "bending",
-    frames: Annotated[int, typer.Option(help="animation frames of the 3D view")] = 40,
+    frames: Annotated[int, typer.Option(help="animation frames of the 3D view")] = 24,
     voxel: Annotated[str, typer.Option(help="voxel of the motion volumes ('none': skip)")] = "4mm",
     bend_factor: Annotated[
         float, typer.Option(help="bend radius rule: at least this × the diameter")
@@ -120,11 +120,17 @@ def report_command(
         if not (math.isfinite(bend_factor) and bend_factor > 0):
             raise ValueError(f"--bend-factor = {bend_factor}: allowed: a number > 0")
         h = None if voxel.strip().lower() == "none" else parse_length(voxel)
-        with printed_warnings(err):  # partial results
+        with printed_warnings(err), err.status("reading the runs") as status:  # partial results
             runs = report_runs(files)
-        path = write_report(
-            output, runs, color_by=color_by, frames=frames, voxel=h, bend_factor=bend_factor
-        )
+            path = write_report(
+                output,
+                runs,
+                color_by=color_by,
+                frames=frames,
+                voxel=h,
+                bend_factor=bend_factor,
+                on_step=lambda what: status.update(f"report: {what}"),
+            )
     except KeyboardInterrupt:
         from cablelife.interrupt import interrupted
 

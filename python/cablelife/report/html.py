@@ -1,16 +1,20 @@
-"""The HTML report: one self-contained, offline page (plotly.js embedded once, every plot
-interactive) with a comparison of the runs (ranking by pseudo-damage via
-:func:`cablelife.lda.compare`, motion volumes overlaid), and per run its scene summary, solver
-statistics, maxima, bend radius check, clip reactions, natural frequencies over the excitation
-spectrum, 3D views and, with an LDA result, the damage pictures, hot spots and rainflow matrix.
-The page records in ``<body data-*>`` how many figures rendered and any script errors (used by
-the test in headless Chromium)."""
+"""The HTML report: one self-contained, offline page (plotly.js embedded once, compressed;
+every plot interactive) with a comparison of the runs (ranking by pseudo-damage within one
+analysis mode via :func:`cablelife.lda.compare`, the dynamic/quasistatic inertia factor per
+variant, motion volumes overlaid), and per run its scene summary, solver statistics, maxima,
+bend radius check, clip reactions, natural frequencies over the excitation spectrum, 3D views
+and, with an LDA result, the damage pictures, hot spots and rainflow matrix. One function per
+section (``_comparison``, ``_ranking``, ``_frequencies``, ``_damage_section`` …) writes to the
+page (:mod:`cablelife.report.page`). See docs/visuals.md."""
 
 from __future__ import annotations
 
 import datetime as _dt
 import html
 import os
+import re
+from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -32,15 +36,22 @@ from cablelife.plots import (
     plot_rainflow_matrix,
 )
 from cablelife.plots.bend_radius import DEFAULT_FACTOR
-from cablelife.plots.spectrum import excited_band
+from cablelife.plots.fatigue_data import DAMAGE_FLOOR
 from cablelife.report.interactive import maxima_over_time_figure
+from cablelife.report.page import Page
 from cablelife.report.scene3d import FRAMES, cable_figure, damage_figure, volumes_figure
 from cablelife.results import Result
 from cablelife.summary import cable_summary
 
-#: Natural frequencies computed per cable, and the excited band's level below the PSD peak.
+#: Natural frequencies computed per cable.
 N_MODES = 10
-BAND_LEVEL = 1e-4
+#: Saved steps swept for a motion volume in the report at most (every k-th of longer runs).
+VOLUME_STEPS = 500
+#: A maximum below this fraction of the largest value of its kind (forces, moments) in the run
+#: is a numerical zero and shown as 0.
+ZERO = 1e-6
+#: Analysis modes in the order the report ranks them.
+MODE_ORDER = ("dynamic", "quasistatic", "static")
 
 
 @dataclass
@@ -75,55 +86,35 @@ class ReportRun:
         return self._maps.get(cable)
 
 
-class _Page:
-    def __init__(self):
-        self.parts: list[str] = []
-        self.figures = 0
-
-    def add(self, text: str) -> None:
-        self.parts.append(text)
-
-    def h(self, level: int, text: str, anchor: str | None = None) -> None:
-        a = f' id="{html.escape(anchor)}"' if anchor else ""
-        self.add(f"<h{level}{a}>{html.escape(text)}</h{level}>")
-
-    def plot(self, fig, alt: str) -> None:
-        """A matplotlib figure, drawn interactively (plotly) from the same artists."""
-        from cablelife.report.mpl_plotly import to_plotly
-
-        self.plotly(to_plotly(fig), alt)
-
-    def plotly(self, fig, alt: str = "") -> None:
-        import plotly.io as pio
-
-        self.figures += 1
-        div = pio.to_html(
-            fig,
-            full_html=False,
-            include_plotlyjs=False,
-            div_id=f"figure-{self.figures}",
-            auto_play=False,
-            config={"displaylogo": False},
-        )
-        label = f' aria-label="{html.escape(alt)}"' if alt else ""
-        self.add(f'<div class="figure"{label}>{div}</div>')
-
-    def table(self, header: list[str], rows: list[list], caption: str = "") -> None:
-        cap = f"<caption>{html.escape(caption)}</caption>" if caption else ""
-        head = "".join(f"<th>{html.escape(str(h))}</th>" for h in header)
-        body = "".join(
-            "<tr>" + "".join(f"<td>{html.escape(str(c))}</td>" for c in r) + "</tr>" for r in rows
-        )
-        self.add(f"<table>{cap}<thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>")
-
-    def note(self, text: str, cls: str = "note") -> None:
-        self.add(f'<p class="{cls}">{html.escape(text)}</p>')
-
-
-def _g(x: float, unit: str = "") -> str:
+def _g(x: float, unit: str = "", scale: float | None = None) -> str:
+    """A number for a table; 0 when below ZERO × ``scale`` (a numerical zero)."""
     if x is None or (isinstance(x, float) and not np.isfinite(x)):
         return "–" if x is None else ("∞" if x > 0 else "−∞")
+    if scale is not None and abs(x) < ZERO * scale:
+        x = 0.0
     return f"{x:.4g}{' ' + unit if unit else ''}"
+
+
+def _scales(c) -> dict[str, float]:
+    """The largest force and moment magnitude of a cable (the reference of numerical zeros)."""
+    return {"N": float(np.abs(c.forces).max()), "N m": float(np.abs(c.moments).max())}
+
+
+def variant_of(label: str, mode: str) -> str:
+    """The variant a run belongs to: its label without the mode ("A-dynamic" → "A")."""
+    v = re.sub(rf"[\s_\-(]*{mode}\)?$", "", label).strip()
+    return v or label
+
+
+def _colours(runs) -> dict[str, str]:
+    """One colour per variant (quasistatic and dynamic runs of a variant share it)."""
+    from plotly.colors import qualitative
+
+    out: dict[str, str] = {}
+    for r in runs:
+        v = variant_of(r.label, r.result.mode)
+        out.setdefault(v, qualitative.Plotly[len(out) % 10])
+    return {r.label: out[variant_of(r.label, r.result.mode)] for r in runs}
 
 
 MAXIMA = [
@@ -137,40 +128,57 @@ MAXIMA = [
 
 
 def _runs_of(runs: list[ReportRun]) -> list[Run]:
+    colours = _colours(runs)
     out = []
     for r in runs:
         for name, c in r.result.cables.items():
             label = r.label if len(r.result.cables) == 1 else f"{r.label}: {name}"
-            out.append(Run(label, c, r.result.mode))
+            out.append(Run(label, c, r.result.mode, colours[r.label]))
     return out
 
 
-def _ranking(page: _Page, runs: list[ReportRun], summaries) -> None:
-    """Ranking by maximum (pseudo-)damage with ratios and hot spots when every run has an LDA
-    result with the same settings, else by maximum bending moment (the reason noted)."""
+def _ranking(page: Page, runs: list[ReportRun], summaries) -> None:
+    """Ranking by maximum (pseudo-)damage within each analysis mode (dynamic first), with
+    ratios and hot spots, when every run has an LDA result with the same settings, else by
+    maximum bending moment (the reason noted); then the inertia factor per variant."""
     from cablelife.lda.compare import compare
 
     missing = [r.label for r in runs if r.damage is None]
     reason = "no run has a damage file"
     if not missing:
         try:
-            cmp = compare([r.damage for r in runs], labels=[r.label for r in runs])
+            by_mode = {
+                m: [r for r in runs if r.result.mode == m]
+                for m in MODE_ORDER
+                if any(r.result.mode == m for r in runs)
+            }
+            ranked = {
+                m: compare([r.damage for r in rs], labels=[r.label for r in rs])
+                for m, rs in by_mode.items()
+            }
         except ValueError as e:
             reason = str(e)
         else:
-            kind = (
-                "pseudo-damage" if all(v.analysis.curve.pseudo for v in cmp.variants) else "damage"
-            )
-            rows = []
-            for i, v in enumerate(cmp.variants, 1):
-                for j, h in enumerate(v.hot_spots or [None]):
-                    head = [i, v.label, _g(v.max_damage), _g(v.ratio)] if j == 0 else [""] * 4
-                    rows.append(head + _spot_cells(h))
-            page.table(
-                ["rank", "variant", f"max {kind}", "ratio to best", *SPOT_HEADER],
-                rows,
-                f"ranking by maximum {kind} (lower is better) with the hot spots",
-            )
+            for mode, cmp in ranked.items():
+                kind = (
+                    "pseudo-damage"
+                    if all(v.analysis.curve.pseudo for v in cmp.variants)
+                    else "damage"
+                )
+                rows = []
+                for i, v in enumerate(cmp.variants, 1):
+                    floor = DAMAGE_FLOOR * v.max_damage
+                    spots = [h for h in v.hot_spots if h.damage >= floor]
+                    for j, h in enumerate(spots or [None]):
+                        head = [i, v.label, _g(v.max_damage), _g(v.ratio)] if j == 0 else [""] * 4
+                        rows.append(head + _spot_cells(h))
+                page.table(
+                    ["rank", "variant", f"max {kind}", "ratio to best", *SPOT_HEADER],
+                    rows,
+                    f"{mode} runs: ranking by maximum {kind} (lower is better) with the hot spots",
+                    cls=f"ranking ranking-{mode}",
+                )
+            _inertia(page, runs)
             return
     elif len(missing) < len(runs):
         reason = f"no damage file for {', '.join(missing)}"
@@ -181,6 +189,28 @@ def _ranking(page: _Page, runs: list[ReportRun], summaries) -> None:
         [[i + 1, lab, _g(s["max_bending"], "N m")] for i, (lab, s) in enumerate(ranked)],
         "ranking by maximum bending moment",
     )
+
+
+def _inertia(page: Page, runs: list[ReportRun]) -> None:
+    """Dynamic over quasistatic maximum damage per variant that has both runs: how much the
+    inertia (resonance) adds; not a ranking."""
+    by_variant: dict[str, dict[str, float]] = {}
+    for r in runs:
+        if r.damage is not None:
+            v = variant_of(r.label, r.result.mode)
+            by_variant.setdefault(v, {})[r.result.mode] = r.damage.max_damage
+    rows = [
+        [v, _g(d["dynamic"]), _g(d["quasistatic"]), _g(d["dynamic"] / d["quasistatic"])]
+        for v, d in by_variant.items()
+        if d.get("quasistatic", 0) > 0 and "dynamic" in d
+    ]
+    if rows:
+        page.table(
+            ["variant", "max damage, dynamic", "max damage, quasistatic", "inertia factor"],
+            rows,
+            "inertia factor: dynamic over quasistatic maximum damage of each variant",
+            cls="inertia",
+        )
 
 
 SPOT_HEADER = ["hot spot s [m]", "angle γ [°]", "plane φ [°]", "damage", "nearest clip"]
@@ -207,14 +237,24 @@ def _spot_cells(h) -> list[str]:
     ]
 
 
-def _comparison(page: _Page, runs: list[ReportRun], volumes: dict, voxel: float, factor: float):
+def _comparison(page: Page, runs: list[ReportRun], volumes: dict, voxel: float, factor: float):
     page.h(2, "Comparison of the variants", "comparison")
     plot_runs = _runs_of(runs)
     summaries = [(run.label, cable_summary(run.cable)) for run in plot_runs]
+    scales = [_scales(run.cable) for run in plot_runs]
     page.table(
         ["quantity", *[s[0] for s in summaries]],
-        [[lab, *[_g(s[key], unit) for _, s in summaries]] for key, lab, unit in MAXIMA],
-        "maxima over time and arc length",
+        [
+            [
+                lab,
+                *[
+                    _g(s[key], unit, sc.get(unit))
+                    for (_, s), sc in zip(summaries, scales, strict=True)
+                ],
+            ]
+            for key, lab, unit in MAXIMA
+        ],
+        f"maxima over time and arc length (0: below {ZERO:g} × the largest force or moment)",
     )
     _ranking(page, runs, summaries)
     if len(volumes) == 2:
@@ -239,24 +279,40 @@ def _comparison(page: _Page, runs: list[ReportRun], volumes: dict, voxel: float,
     if len(volumes) >= 2:
         cables = {r.label: r.result.cable for r in runs if len(r.result.cables) == 1}
         page.plotly(volumes_figure(volumes, cables), "motion volumes of the runs")
-    page.plotly(maxima_over_time_figure(plot_runs))
+    page.plotly(maxima_over_time_figure(plot_runs), "maxima over time of the runs")
     page.plot(plot_envelopes(plot_runs), "envelopes along the cable")
     page.plot(plot_bend_radius(plot_runs, factor), "smallest bend radius along the cable")
-    maps = [
-        d[0]
-        for r in runs
-        for n in r.result.cables
-        if (d := r.damage_of(n)) is not None and d[0].damage.max() > 0
-    ]
-    if maps:
-        page.plot(plot_damage_along_cable(maps), "damage along the cable")
+    if any(run.cable.clips for run in plot_runs):
+        page.plot(plot_clip_reactions(plot_runs), "clip reactions of the runs")
+    colours = _colours(runs)
+    for mode in MODE_ORDER:  # damage of one mode per picture: the modes differ by orders
+        picked = [
+            (d[0], colours[r.label], r.result.cables[n])
+            for r in runs
+            if r.result.mode == mode
+            for n in r.result.cables
+            if (d := r.damage_of(n)) is not None and d[0].damage.max() > 0
+        ]
+        if picked:
+            clips = {n: rc.s for n, rc in picked[0][2].clips.items()}
+            page.plot(
+                plot_damage_along_cable(
+                    [m for m, _, _ in picked], clips, [c for _, c, _ in picked]
+                ),
+                f"damage along the cable, {mode} runs",
+            )
 
 
-def _frequencies(page: _Page, res: Result, name: str) -> None:
-    """Natural frequencies of the mounted cable (about its static equilibrium, bodies at rest)
-    over the acceleration PSD at its clips on moving bodies."""
+def _scene_key(res: Result, name: str) -> tuple[str, str]:
+    """Runs of one scene in several modes share their modes and excitation."""
+    return (re.sub(r'(?m)^mode = "\w+"$', "", res.scene_toml), name)
+
+
+def frequency_data(res: Result, name: str):
+    """(natural frequencies, excitation PSD or the reason it is missing, excited band) of a
+    cable of a run, or the exception that stopped it."""
     from cablelife.modal import cable_modes
-    from cablelife.report.scene_data import excitation_psd, result_scene
+    from cablelife.report.scene_data import excitation_psd, excited_band, result_scene
     from cablelife.scene import SceneError
     from cablelife.signals import SignalError
 
@@ -265,18 +321,48 @@ def _frequencies(page: _Page, res: Result, name: str) -> None:
         spec = next(c for c in scene.cables if c.name == name)
         fn = cable_modes(scene, spec, N_MODES).frequencies
     except (SceneError, SignalError, StopIteration, ValueError) as e:
-        page.note(f"natural frequencies not available: {e or 'cable not in the scene'}")
-        return
+        return e or ValueError("cable not in the scene")
     try:
-        exc = excitation_psd(scene, name, res.mode)
+        mode = "dynamic" if res.mode == "static" else res.mode
+        exc = excitation_psd(scene, name, mode)
+        band = excited_band(scene, name, exc)
     except (SceneError, SignalError, ValueError, OSError) as e:
+        exc, band = e, None
+    return fn, exc, band
+
+
+def _frequencies(page: Page, res: Result, name: str, cache: dict, run_label: str = "") -> None:
+    """Natural frequencies of the mounted cable (about its static equilibrium, bodies at rest)
+    over the acceleration PSD at its clips on moving bodies; the excited band from the signal
+    definitions (:func:`cablelife.report.scene_data.excited_band`). Computed once per scene
+    (``cache``: scene key → the future of :func:`frequency_data`)."""
+    key = _scene_key(res, name)
+    if key not in cache:
+        cache[key] = frequency_data(res, name)
+    if hasattr(cache[key], "result"):
+        cache[key] = cache[key].result()
+    got = cache[key]
+    shown = cache.setdefault("shown", {})
+    if key in shown:
+        page.note(
+            f"natural frequencies and excitation spectrum: as in run {shown[key]} (the same "
+            "scene in another mode)"
+        )
+        return
+    shown[key] = run_label
+    if isinstance(got, Exception):
+        page.note(f"natural frequencies not available: {got}")
+        return
+    fn, exc, band = got
+    if isinstance(exc, Exception) or res.mode == "static":
+        why = "a static run" if res.mode == "static" else exc
         page.table(
             ["mode", *range(1, fn.size + 1)],
             [["f [Hz]", *[f"{x:.4g}" for x in fn]]],
-            f"natural frequencies of the mounted cable (no excitation spectrum: {e})",
+            f"natural frequencies of the mounted cable (no excitation spectrum: {why})",
         )
         return
-    lo, hi = excited_band(exc.frequency, exc.psd, BAND_LEVEL)
+    lo, hi = band
     inside = [i + 1 for i, x in enumerate(fn) if lo <= x <= hi]
     page.table(
         ["mode", *range(1, fn.size + 1)],
@@ -285,7 +371,7 @@ def _frequencies(page: _Page, res: Result, name: str) -> None:
             ["excited", *["yes" if i + 1 in inside else "" for i in range(fn.size)]],
         ],
         f"natural frequencies of the mounted cable; excited band {lo:.3g} – {hi:.3g} Hz "
-        f"(acceleration PSD above {BAND_LEVEL:g} × its peak)",
+        "(from the signal definitions)",
     )
     if inside and res.mode == "quasistatic":
         page.note(
@@ -294,14 +380,13 @@ def _frequencies(page: _Page, res: Result, name: str) -> None:
             "warning",
         )
     page.plot(
-        plot_frequencies_over_spectrum(
-            fn, exc.frequency, exc.psd, labels=exc.labels, band_level=BAND_LEVEL
-        ),
+        plot_frequencies_over_spectrum(fn, exc.frequency, exc.psd, labels=exc.labels, band=band),
         f"natural frequencies of {name} over the excitation spectrum",
     )
 
 
-def _run_section(page, k, run: ReportRun, volumes, color_by, frames, factor):
+def _run_section(page, k, run: ReportRun, volumes, color_by, frames, factor, cache, alone):
+    """A run's section; its load plots only when ``alone`` (else the comparison has them)."""
     res = run.result
     page.h(2, f"Run {run.label} ({res.mode})", f"run-{k}")
     if not res.complete:
@@ -336,7 +421,8 @@ def _run_section(page, k, run: ReportRun, volumes, color_by, frames, factor):
                 ["complete", f"{res.complete} {res.message}".strip()],
             ],
         )
-        rows = [[lab, _g(s[key], unit)] for key, lab, unit in MAXIMA]
+        sc = _scales(c)
+        rows = [[lab, _g(s[key], unit, sc.get(unit))] for key, lab, unit in MAXIMA]
         rows.append(
             [
                 "min bend radius at",
@@ -374,20 +460,22 @@ def _run_section(page, k, run: ReportRun, volumes, color_by, frames, factor):
         page.plotly(
             cable_figure(
                 c, color_by, frames=frames, volume=vol, scene_toml=res.scene_toml, mode=res.mode
-            )
+            ),
+            f"3D view of {name}",
         )
-        one = [Run(run.label, c, res.mode)]
-        page.plotly(maxima_over_time_figure(one))
-        page.plot(plot_envelopes(one), f"envelopes of {name}")
-        page.plot(plot_bend_radius(one, factor), f"bend radius of {name}")
-        if c.clips:
+        one = [Run(run.label, c, res.mode, _colours([run])[run.label])]
+        if alone:
+            page.plotly(maxima_over_time_figure(one), f"maxima over time of {name}")
+            page.plot(plot_envelopes(one), f"envelopes of {name}")
+            page.plot(plot_bend_radius(one, factor), f"bend radius of {name}")
+        if c.clips and alone:
             page.plot(plot_clip_reactions(one), f"clip reactions of {name}")
-        _frequencies(page, res, name)
+        _frequencies(page, res, name, cache, run.label)
         if run.damage_of(name) is not None:
-            _damage_section(page, run, name)
+            _damage_section(page, run, name, alone)
 
 
-def _damage_section(page: _Page, run: ReportRun, name: str) -> None:
+def _damage_section(page: Page, run: ReportRun, name: str, alone: bool = True) -> None:
     """LDA settings, hot spots, the damage on the surface (3D), along the cable and the
     rainflow matrix of the most damaged series."""
     res, c = run.result, run.result.cables[name]
@@ -426,11 +514,15 @@ def _damage_section(page: _Page, run: ReportRun, name: str) -> None:
     page.table(
         ["#", *SPOT_HEADER],
         [[i + 1, *_spot_cells(h)] for i, h in enumerate(dm.hot_spots(5))],
-        "damage hot spots (local maxima along the cable)",
+        f"damage hot spots (local maxima along the cable above {DAMAGE_FLOOR:g} × the maximum)",
     )
-    page.plotly(damage_figure(c, dm, scene_toml=res.scene_toml, mode=res.mode))
+    page.plotly(
+        damage_figure(c, dm, scene_toml=res.scene_toml, mode=res.mode),
+        f"damage on the surface of {name}",
+    )
     clips = {n: r.s for n, r in c.clips.items()}
-    page.plot(plot_damage_along_cable([dm], clips), f"damage along {name}")
+    if alone:  # else the comparison draws the runs of a mode together
+        page.plot(plot_damage_along_cable([dm], clips), f"damage along {name}")
     if rf is not None:
         page.plot(plot_rainflow_matrix(rf), f"rainflow matrix of {name}")
     else:
@@ -445,22 +537,8 @@ caption{text-align:left;font-weight:600;padding:.3em 0}
 th,td{border:1px solid #ccd;padding:.25em .6em;text-align:left}th{background:#eef}
 .figure{margin:1em 0}
 .warning{color:#a00;font-weight:600}.note{color:#335}nav a{margin-right:1em}
+.plot{min-height:320px}
 """
-
-# Records script errors (before plotly runs) and, after load, which figures rendered.
-CHECK_HEAD = """<script>
-window.__errors=[];window.addEventListener('error',function(e){__errors.push(String(e.message))});
-(function(){var ce=console.error;console.error=function(){
-__errors.push(Array.prototype.join.call(arguments,' '));ce.apply(console,arguments)}})();
-</script>"""
-CHECK_TAIL = """<script>
-window.addEventListener('load',function(){setTimeout(function(){
-var figs=document.querySelectorAll('.js-plotly-plot'),ok=0;
-figs.forEach(function(f){var L=f._fullLayout||{},gl=L._has&&L._has('gl3d');
-if(f.querySelector('.main-svg')&&L.width>0&&(!gl||f.querySelector('canvas')))ok++});
-var b=document.body.dataset;b.renderedFigures=ok;
-b.errors=JSON.stringify(window.__errors);b.checked='yes';},1500)});
-</script>"""
 
 
 def build_report(
@@ -471,11 +549,10 @@ def build_report(
     voxel: float | None = 0.004,
     bend_factor: float = DEFAULT_FACTOR,
     title: str = "cablelife report",
+    on_step: Callable[[str], None] | None = None,
 ) -> str:
     """The report page as an HTML string. ``voxel`` (m) for the motion volumes; None skips
-    them."""
-    from plotly.offline import get_plotlyjs
-
+    them. ``on_step(what)`` follows the progress (one call per section)."""
     from cablelife import __version__
     from cablelife.volume import motion_volume
 
@@ -484,10 +561,28 @@ def build_report(
     labels = [r.label for r in runs]
     if len(set(labels)) != len(labels):
         raise ValueError(f"run labels must be unique, got {labels}")
+    step = on_step or (lambda what: None)
+    # In the background (the modal solves, signal synthesis and volume kernels release the
+    # GIL): the natural frequencies and excitation per scene, the motion volumes per run.
+    pool = ThreadPoolExecutor(max_workers=max(1, min(4, os.cpu_count() or 1)))
+
+    def volume(r):
+        n = next(iter(r.result.cables.values())).n_steps
+        every = slice(None, None, max(1, -(-n // VOLUME_STEPS)))
+        return motion_volume(r.result, voxel, steps=every)
+
+    pending = {r.label: pool.submit(volume, r) for r in runs} if voxel is not None else {}
+    cache: dict = {}
+    for r in runs:
+        for name in r.result.cables:
+            key = _scene_key(r.result, name)
+            if key not in cache:
+                cache[key] = pool.submit(frequency_data, r.result, name)
     volumes = {}
-    if voxel is not None:
-        volumes = {r.label: motion_volume(r.result, voxel) for r in runs}
-    page = _Page()
+    for label, f in pending.items():
+        step(f"motion volume of {label}")
+        volumes[label] = f.result()
+    page = Page()
     stamp = _dt.datetime.now().strftime("%Y-%m-%d %H:%M")
     page.h(1, title)
     page.note(f"cablelife {__version__}, {stamp}; runs: {', '.join(labels)}")
@@ -496,17 +591,14 @@ def build_report(
     ]
     page.add("<nav>" + "".join(f'<a href="#{a}">{html.escape(t)}</a>' for a, t in links) + "</nav>")
     if len(runs) > 1:
+        step("comparison")
         _comparison(page, runs, volumes, voxel or 0.004, bend_factor)
     for k, run in enumerate(runs):
-        _run_section(page, k, run, volumes, color_by, frames, bend_factor)
-    body = "\n".join(page.parts)
-    return (
-        '<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8">'
-        f"<title>{html.escape(title)}</title><style>{CSS}</style>{CHECK_HEAD}"
-        f'<script type="text/javascript">{get_plotlyjs()}</script></head>'
-        f'<body data-expected-figures="{page.figures}">'
-        f"\n{body}\n{CHECK_TAIL}</body></html>\n"
-    )
+        step(f"run {run.label}")
+        _run_section(page, k, run, volumes, color_by, frames, bend_factor, cache, len(runs) == 1)
+    pool.shutdown()
+    step("page")
+    return page.html(title, CSS)
 
 
 def write_report(output: str | os.PathLike, runs: list[ReportRun], **kw) -> Path:

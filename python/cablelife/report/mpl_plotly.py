@@ -98,8 +98,12 @@ def to_plotly(fig: Figure):
 
 
 def _convert_axes(out, ax, r: int, c: int, legend: set[str], go) -> None:
+    from cablelife.report.decimate import minmax, nice_range
+
     xlog, ylog = ax.get_xscale() == "log", ax.get_yscale() == "log"
     xlim, ylim = ax.get_xlim(), ax.get_ylim()
+    if not ylog:  # a (nearly) constant series: a sensible range, not round-off-sized ticks
+        ylim = nice_range(np.asarray(ylim)) or ylim
 
     def add(trace):
         out.add_trace(trace, row=r, col=c)
@@ -176,10 +180,13 @@ def _convert_axes(out, ax, r: int, c: int, legend: set[str], go) -> None:
         has_marker = marker not in (None, "None", "", " ")
         has_line = line.get_linestyle() not in ("None", "", " ")
         mode = "+".join(m for m, on in (("lines", has_line), ("markers", has_marker)) if on)
+        x, y = _values(x), _values(y)
+        if x.size > 2 and np.all(np.diff(x) >= 0):
+            x, y = minmax(x, y)
         add(
             go.Scatter(
-                x=_values(x),
-                y=_values(y),
+                x=x,
+                y=y,
                 mode=mode or "lines",
                 line=style,
                 marker={
@@ -218,6 +225,7 @@ def _convert_axes(out, ax, r: int, c: int, legend: set[str], go) -> None:
         type="log" if xlog else "linear",
         range=[np.log10(v) for v in xlim] if xlog else list(xlim),
         exponentformat="e",
+        ticklabelstandoff=5,  # below the y axis' lowest tick label at the corner
         row=r,
         col=c,
     )
@@ -227,6 +235,8 @@ def _convert_axes(out, ax, r: int, c: int, legend: set[str], go) -> None:
         type="log" if ylog else "linear",
         range=[np.log10(v) for v in ylim] if ylog else list(ylim),
         exponentformat="e",
+        tickformat="" if ylog else "~g",
+        ticklabelstandoff=6,  # clear of the x axis' first tick label at the corner
         row=r,
         col=c,
     )
@@ -245,6 +255,6 @@ def _heatmap(mesh: QuadMesh, go):
         z=[_values(row) for row in shown],
         customdata=[_values(row) for row in z],
         colorscale=str(mesh.get_cmap().name).capitalize() if mesh.get_cmap() else None,
-        colorbar={"title": f"log10 {label}" if log else label},
+        colorbar={"title": {"text": f"log10 {label}" if log else label, "side": "right"}},
         hovertemplate="x %{x:.4g}, y %{y:.4g}: %{customdata:.4g}<extra></extra>",
     )

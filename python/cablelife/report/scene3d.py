@@ -8,7 +8,7 @@ import tomllib
 
 import numpy as np
 
-from cablelife.plots.fatigue_data import DamageMap
+from cablelife.plots.fatigue_data import DAMAGE_FLOOR, DamageMap
 from cablelife.plots.runs import QUANTITIES, quantity
 from cablelife.report.scene_data import BodyPose
 from cablelife.report.tube import node_frames, tube_mesh
@@ -16,7 +16,7 @@ from cablelife.results import CableResult
 from cablelife.scene import SceneError
 
 #: Default number of animation frames (the saved steps are subsampled evenly).
-FRAMES = 40
+FRAMES = 24
 
 
 def clip_bodies(scene_toml: str, cable: str) -> dict[str, str]:
@@ -83,11 +83,11 @@ def _layout(fig, title: str, box: np.ndarray) -> None:
         f"{a}axis": {"range": [centre[i] - half, centre[i] + half], "title": f"{a} [m]"}
         for i, a in enumerate("xyz")
     }
-    fig.update_layout(
+    fig.update_layout(  # the legend left of the scene, not over it
         title=title,
-        scene={**axes, "aspectmode": "cube"},
+        scene={**axes, "aspectmode": "cube", "domain": {"x": [0.3, 1.0], "y": [0.0, 1.0]}},
         margin={"l": 0, "r": 0, "t": 40, "b": 0},
-        legend={"x": 0.0, "y": 1.0, "xanchor": "left"},
+        legend={"x": 0.0, "y": 1.0, "xanchor": "left", "font": {"size": 10}},
         height=560,
     )
 
@@ -110,14 +110,14 @@ def _clip_trace(cable: CableResult, k: int, bodies: dict[str, str]):
 
     nodes = _clip_nodes(cable)
     p = cable.positions[k, list(nodes.values())] if nodes else np.zeros((0, 3))
-    text = [f"{n} ({bodies.get(n, 'world')})" for n in nodes]
+    text = [f"clip {n} ({bodies.get(n, 'world')})" for n in nodes]
     return _scatter3d(
         p,
-        mode="markers+text",
-        text=text,
-        name="clips",
+        mode="markers",
+        hovertext=text,
+        hoverinfo="text",
+        name="clips (hover for names)",
         marker={"size": 6, "color": "black", "symbol": "diamond"},
-        textposition="top center",
     )
 
 
@@ -144,11 +144,11 @@ def _body_traces(cable: CableResult, k: int, bodies: list[BodyPose], length: flo
     traces = [
         _scatter3d(
             o,
-            mode="markers+text",
-            text=labels,
+            mode="markers",
+            hovertext=labels,
+            hoverinfo="text",
             name="bodies",
             marker={"size": 5, "color": "purple", "symbol": "square"},
-            textposition="bottom center",
         )
     ]
     for i, colour in enumerate(AXIS_COLOURS):
@@ -209,7 +209,7 @@ def cable_figure(
     volume=None,
     scene_toml: str = "",
     mode: str | None = None,
-    n_angles: int = 16,
+    n_angles: int = 8,
     title: str | None = None,
 ):
     """A plotly figure: the tube coloured by ``color_by`` (one of the plot quantities) at up
@@ -242,11 +242,12 @@ def cable_figure(
         j=m0.faces[:, 1],
         k=m0.faces[:, 2],
         intensity=v0,
+        meta={"tube": n_angles, "radius": radius},
         cmin=lo,
         cmax=hi,
         colorscale="Turbo",
         name=cable.name,
-        colorbar={"title": f"{label} [{unit}]"},
+        colorbar={"title": {"text": f"{label} [{unit}]", "side": "right"}},
         flatshading=False,
         hovertemplate=f"{label}: %{{intensity:.4g}} {unit}<extra></extra>",
     )
@@ -266,14 +267,20 @@ def cable_figure(
         mesh = getattr(volume, "mesh", volume)
         if len(mesh.faces):
             vv = mesh.vertices
-            traces.append(volume_trace(mesh, "motion volume", "lightsteelblue", 0.25))
+            traces.append(volume_trace(mesh, "motion volume", "#1f9e89", 0.18))
             box = np.stack([np.minimum(box[0], vv.min(0)), np.maximum(box[1], vv.max(0))])
     fig = go.Figure(data=traces)
     fig.frames = [
         go.Frame(
             name=f"{cable.time[k]:.4g}",
             data=[
-                go.Mesh3d(x=m.vertices[:, 0], y=m.vertices[:, 1], z=m.vertices[:, 2], intensity=v),
+                go.Mesh3d(
+                    x=m.vertices[:, 0],
+                    y=m.vertices[:, 1],
+                    z=m.vertices[:, 2],
+                    intensity=v,
+                    meta={"tube": n_angles, "radius": radius},
+                ),
                 _clip_trace(cable, k, bodies),
                 *_body_traces(cable, k, poses, axis_length),
             ],
@@ -287,7 +294,11 @@ def cable_figure(
         fig.update_layout(
             sliders=[
                 {
-                    "currentvalue": {"prefix": "t = ", "suffix": " s"},
+                    "x": 0.16,
+                    "len": 0.84,
+                    "y": 0.0,
+                    "pad": {"t": 10, "b": 0},
+                    "currentvalue": {"prefix": "t = ", "suffix": " s", "xanchor": "right"},
                     "steps": [
                         {
                             "label": f.name,
@@ -304,9 +315,13 @@ def cable_figure(
             updatemenus=[
                 {
                     "type": "buttons",
+                    "direction": "left",
                     "showactive": False,
                     "x": 0.0,
+                    "xanchor": "left",
                     "y": 0.0,
+                    "yanchor": "top",
+                    "pad": {"t": 28, "r": 10},
                     "buttons": [
                         {
                             "label": "play",
@@ -348,9 +363,11 @@ def damage_figure(
     radius = float(cable.section.get("outer_radius", 0.005))
     m = tube_mesh(cable.positions[step], cable.quaternions[step], radius, n_angles)
     per_node = damage.on_surface(cable.arc_length, m.angles)
-    positive = damage.damage[damage.damage > 0]
-    floor = positive.min() if positive.size else 1.0
+    top = float(damage.damage.max())
+    floor = damage.floor if top > 0 else 1.0
     log = np.log10(np.maximum(per_node.ravel(), floor))
+    lo, hi = np.log10(floor), np.log10(top) if top > 0 else 1.0
+    ticks = np.arange(np.ceil(lo + 0.5), hi + 1e-9)  # whole decades above the floor
     traces = [
         go.Mesh3d(
             x=m.vertices[:, 0],
@@ -360,45 +377,55 @@ def damage_figure(
             j=m.faces[:, 1],
             k=m.faces[:, 2],
             intensity=log,
+            meta={"tube": n_angles, "radius": radius},
+            cmin=lo,
+            cmax=hi,
             colorscale="Hot",
             reversescale=True,
             name="damage",
-            colorbar={"title": "log10 damage"},
+            colorbar={
+                "title": {"text": "log10 damage", "side": "right"},
+                "tickvals": [lo, *ticks],
+                "ticktext": ["≤ floor", *[f"{v:g}" for v in ticks]],
+            },
             hovertemplate="log10 damage: %{intensity:.2f}<extra></extra>",
         ),
         _clip_trace(cable, step, clip_bodies(scene_toml, cable.name)),
     ]
     spots = damage.hot_spots(hot_spots)
     if spots:
-        pts, text = [], []
         d1, d2 = node_frames(cable.positions[step], cable.quaternions[step])
         for rank, h in enumerate(spots, 1):
             n = int(np.argmin(np.abs(cable.arc_length - h.arc_length)))
             x = _position_at(cable, step, h.arc_length)
-            pts.append(x + 1.6 * radius * (np.cos(h.angle) * d1[n] + np.sin(h.angle) * d2[n]))
+            p = x + 1.6 * radius * (np.cos(h.angle) * d1[n] + np.sin(h.angle) * d2[n])
             clip = "" if h.nearest_clip is None else f", near {h.nearest_clip}"
             if h.nearest_clip is not None and h.clip_distance is not None:
                 clip += f" ({h.clip_distance * 1e3:.0f} mm)"
-            text.append(
-                f"#{rank} s={h.arc_length:.3f} m γ={np.degrees(h.angle):.0f}° "
-                f"D={h.damage:.3g}{clip}"
+            text = (
+                f"#{rank} s = {h.arc_length:.3f} m, γ = {np.degrees(h.angle):.0f}°, "
+                f"D = {h.damage:.3g}{clip}"
             )
-        p = np.array(pts)
-        traces.append(
-            _scatter3d(
-                p,
-                mode="markers+text",
-                text=text,
-                name="hot spots",
-                marker={"size": 5, "color": "blue"},
-                textposition="top center",
+            traces.append(
+                _scatter3d(
+                    p[None],
+                    mode="markers",
+                    hovertext=[text],
+                    hoverinfo="text",
+                    name=f"hot spot {text}",
+                    marker={"size": 6, "color": "blue", "symbol": "circle-open"},
+                )
             )
-        )
     box = np.stack([m.vertices.min(0), m.vertices.max(0)])
     poses = scene_bodies(scene_toml, cable, mode)
     traces += _body_traces(cable, step, poses, 0.08 * float((box[1] - box[0]).max()))
     fig = go.Figure(data=traces)
-    _layout(fig, title or f"{cable.name}: pseudo-damage on the surface", box)
+    _layout(
+        fig,
+        title
+        or f"{cable.name}: pseudo-damage on the surface (floor {DAMAGE_FLOOR:g} × the maximum)",
+        box,
+    )
     return fig
 
 
@@ -421,7 +448,7 @@ def volumes_figure(volumes: dict, cables: dict | None = None, title: str | None 
         mesh = getattr(volume, "mesh", volume)
         if len(mesh.faces):
             v = mesh.vertices
-            traces.append(volume_trace(mesh, f"motion volume {label}", colour, 0.3))
+            traces.append(volume_trace(mesh, f"motion volume {label}", colour, 0.35))
             points.append(v)
         cable = (cables or {}).get(label)
         if cable is not None:
@@ -431,8 +458,9 @@ def volumes_figure(volumes: dict, cables: dict | None = None, title: str | None 
                 _scatter3d(
                     x,
                     mode="lines",
-                    line={"color": colour, "width": 5},
+                    line={"color": "#222222", "width": 3, "dash": "solid"},
                     name=f"cable {label} (t = {cable.time[0]:.3g} s)",
+                    legendgroup=label,
                 )
             )
     fig = go.Figure(data=traces)

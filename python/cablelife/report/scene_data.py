@@ -112,3 +112,48 @@ def excitation_psd(scene: Scene, cable: str, mode: str) -> Excitation:
     keep = f > 0
     labels = [f"clip {spec.clips[j].name} ({spec.clips[j].body})" for j in picked]
     return Excitation(f[keep], psd[:, keep], labels)
+
+
+def signal_band(signal) -> tuple[float, float] | None:
+    """(lowest, highest) frequency a signal definition excites, Hz: a sine its frequency, a
+    sweep f0–f1, a PSD its band (f_low–f_high, default the breakpoints); None for measured
+    signals and tables (no definition of a band)."""
+    kind = getattr(signal, "type", None)
+    if kind == "sine":
+        return (float(signal.frequency), float(signal.frequency))
+    if kind == "sweep":
+        return (float(min(signal.f0, signal.f1)), float(max(signal.f0, signal.f1)))
+    if kind == "psd":
+        f = signal.psd().frequency
+        lo = float(f[0] if signal.f_low is None else signal.f_low)
+        hi = float(f[-1] if signal.f_high is None else signal.f_high)
+        return (lo, hi)
+    return None
+
+
+def excited_band(scene: Scene, cable: str, exc: Excitation | None = None) -> tuple[float, float]:
+    """The band the cable's clips are excited in: the union of the bands of the signals of the
+    bodies that carry its clips (:func:`signal_band`), capped at the Nyquist frequency of the
+    time step; where a signal defines no band (measured, table), the central 99 % of the
+    variance of ``exc`` (:func:`cablelife.plots.spectrum.variance_band`), which the leakage of
+    a fade-in does not widen the way a level below the peak does."""
+    from cablelife.plots.spectrum import variance_band
+
+    spec = next(c for c in scene.cables if c.name == cable)
+    carriers = {c.body for c in spec.clips}
+    bands = []
+    for body in scene.bodies:
+        if body.name not in carriers:
+            continue
+        for m in body.channel_motions(scene.base_dir):
+            b = signal_band(m.signal)
+            if b is None and exc is not None:
+                b = variance_band(exc.frequency, exc.psd)
+            if b is not None:
+                bands.append(b)
+    if not bands:
+        if exc is None:
+            raise SceneError(f"no clip of cable {cable!r} sits on a moving body")
+        return variance_band(exc.frequency, exc.psd)
+    nyquist = 0.5 / scene.simulation.time_step
+    return (min(b[0] for b in bands), min(max(b[1] for b in bands), nyquist))

@@ -6,42 +6,26 @@ on a uniform time grid; ``body_motion`` combines a body's channels into its rigi
 See docs/signals.md.
 """
 
-from cablelife.signals.errors import SignalError, SignalWarning
-from cablelife.signals.generate import generate, kinematics
-from cablelife.signals.kinematics import Kinematics, time_grid
-from cablelife.signals.motion import BodyMotion, body_motion
-from cablelife.signals.profiles import PROFILES, Profile, get_profile
-from cablelife.signals.psd import PowerLawPsd
-from cablelife.signals.spec import (
-    ChannelMotion,
-    MeasuredSignal,
-    PsdSignal,
-    Signal,
-    SignalFile,
-    SineSignal,
-    SweepSignal,
-    TableSignal,
-)
+from cablelife._lazy import lazy_package
 
-__all__ = [
-    "PROFILES",
-    "BodyMotion",
-    "ChannelMotion",
-    "Kinematics",
-    "MeasuredSignal",
-    "PowerLawPsd",
-    "Profile",
-    "PsdSignal",
-    "Signal",
-    "SignalError",
-    "SignalFile",
-    "SignalWarning",
-    "SineSignal",
-    "SweepSignal",
-    "TableSignal",
-    "body_motion",
-    "generate",
-    "get_profile",
-    "kinematics",
-    "time_grid",
-]
+__all__ = lazy_package(
+    __name__,
+    {
+        "cablelife.signals.errors": ["SignalError", "SignalWarning"],
+        "cablelife.signals.generate": ["generate", "kinematics"],
+        "cablelife.signals.kinematics": ["Kinematics", "time_grid"],
+        "cablelife.signals.motion": ["BodyMotion", "body_motion"],
+        "cablelife.signals.profiles": ["PROFILES", "Profile", "get_profile"],
+        "cablelife.signals.psd": ["PowerLawPsd"],
+        "cablelife.signals.spec": [
+            "ChannelMotion",
+            "MeasuredSignal",
+            "PsdSignal",
+            "Signal",
+            "SignalFile",
+            "SineSignal",
+            "SweepSignal",
+            "TableSignal",
+        ],
+    },
+)

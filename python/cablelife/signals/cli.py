@@ -8,13 +8,6 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
-from rich.console import Console
-from rich.markup import escape
-from rich.table import Table
-
-from cablelife.signals.errors import SignalError
-from cablelife.signals.export import write_signals
-from cablelife.signals.specfile import generate_channels, load_spec, rms_summary
 
 
 def signal_command(
@@ -46,6 +39,14 @@ def signal_command(
 ) -> None:
     """Generate excitation signals from SPEC; write them (CSV or HDF5) and a PNG with the time
     history and the Welch PSD over the target."""
+    from rich.console import Console
+    from rich.markup import escape
+    from rich.table import Table
+
+    from cablelife.signals.errors import SignalError
+    from cablelife.signals.export import write_signals
+    from cablelife.signals.specfile import generate_channels, load_spec, rms_summary
+
     out = Console(emoji=False, highlight=False)
     err = Console(stderr=True, emoji=False, highlight=False)
     output = output or spec.with_suffix(".csv")

@@ -15,8 +15,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from scipy.interpolate import CubicSpline
-from scipy.signal import butter, sosfiltfilt
 
 from cablelife.paths import SceneFileError, resolve_scene_file, shown_names
 from cablelife.signals.errors import SignalError
@@ -269,6 +267,8 @@ def anti_alias(value: np.ndarray, dt_source: float, dt_target: float) -> np.ndar
     """Zero-phase low-pass at 80 % of the target Nyquist frequency, if the target is coarser."""
     if dt_target <= dt_source * (1 + 1e-9):
         return value
+    from scipy.signal import butter, sosfiltfilt
+
     cutoff = ANTI_ALIAS_FRACTION * 0.5 / dt_target  # Hz
     sos = butter(ANTI_ALIAS_ORDER, cutoff, btype="low", fs=1.0 / dt_source, output="sos")
     # pad (odd extension) over ~10 periods of the cut-off so the ends settle; the straight line
@@ -287,6 +287,8 @@ def resample(
     Returns the kinematics and a mask of the grid points inside the record (up to one record
     step of extrapolation at either end); outside, the values are the record's end values.
     """
+    from scipy.interpolate import CubicSpline
+
     dt_source = float(np.median(np.diff(time_source)))
     dt_target = time_step_of(time)
     filtered = anti_alias(value_source, dt_source, dt_target)

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import numpy as np
-from scipy.interpolate import CubicSpline, PchipInterpolator
 
 from cablelife.signals.kinematics import Kinematics, grid_derivatives, time_step_of
 from cablelife.signals.spec import TableSignal
@@ -30,6 +29,8 @@ def table(spec: TableSignal, time: np.ndarray) -> Kinematics:
         velocity = np.where(inside, slopes[seg], 0.0)
         acceleration = grid_derivatives(velocity, dt).velocity
         return Kinematics(value, velocity, acceleration)
+    from scipy.interpolate import CubicSpline, PchipInterpolator
+
     curve = (
         PchipInterpolator(knots, values)
         if spec.interpolation == "pchip"

@@ -1,18 +1,14 @@
 """Variant studies: a base scene, parameters to vary, every variant simulated and analysed as a
 Dask task, and a summary table ranking them by pseudo-damage."""
 
-from cablelife.study.runner import StudyOutcome, run_study
-from cablelife.study.spec import StudyError, StudyFile, load_study
-from cablelife.study.task import run_variant
-from cablelife.study.variants import Variant, expand
+from cablelife._lazy import lazy_package
 
-__all__ = [
-    "StudyError",
-    "StudyFile",
-    "StudyOutcome",
-    "Variant",
-    "expand",
-    "load_study",
-    "run_study",
-    "run_variant",
-]
+__all__ = lazy_package(
+    __name__,
+    {
+        "cablelife.study.runner": ["StudyOutcome", "run_study"],
+        "cablelife.study.spec": ["StudyError", "StudyFile", "load_study"],
+        "cablelife.study.task": ["run_variant"],
+        "cablelife.study.variants": ["Variant", "expand"],
+    },
+)

@@ -43,6 +43,16 @@ def tls_security(scheduler: str | None, ca_file, cert, key):
     )
 
 
+HEADERS = {
+    "rank": "#",
+    "max_damage": "max D",
+    "ratio_to_best": "ratio",
+    "hot_spot_s_m": "spot s (m)",
+    "hot_spot_clip": "near clip",
+    "motion_volume_l": "vol. (l)",
+}
+
+
 def study_command(
     study: Annotated[Path, typer.Argument(help="Study file (TOML): base scene + parameters.")],
     output: Annotated[
@@ -77,6 +87,7 @@ def study_command(
 
     A re-run skips finished variants; failed ones are reported and computed again next time.
     """
+    from rich import box
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
     from rich.table import Table
 
@@ -128,13 +139,19 @@ def study_command(
         print_error(err, e)
         raise typer.Exit(2) from None
     frame = outcome.table
-    t = Table(title=escape(f"study {outcome.out_dir}"), title_justify="left")
+    t = Table(title=escape(f"study {outcome.out_dir}"), title_justify="left", box=box.SIMPLE_HEAD)
     shown = ["rank", "variant", *outcome.parameters, "max_damage", "ratio_to_best"]
     shown += ["hot_spot_s_m", "hot_spot_clip", "motion_volume_l", "status"]
     shown = [c for c in shown if c in frame]
-    for c in shown:
+    if "status" in shown and frame["status"].eq("ok").all():
+        shown.remove("status")  # fits 80 columns; the failures are listed below
+    for c in shown:  # short headers; text cells wrap instead of turning into "body…"
+        text = c in ("variant", "hot_spot_clip", "status")
         t.add_column(
-            escape(c), justify="left" if c in ("variant", "hot_spot_clip", "status") else "right"
+            escape(HEADERS.get(c, c)),
+            justify="left" if text else "right",
+            overflow="fold" if text else "ellipsis",
+            no_wrap=not text,
         )
     for _, r in frame.head(20).iterrows():
         t.add_row(

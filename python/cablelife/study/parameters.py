@@ -165,3 +165,33 @@ def apply_parameter(scene: dict, parameter: Parameter, value: float) -> None:
     if not math.isfinite(value):
         raise StudyError(f"parameter {parameter.name!r}: value {value} must be finite")
     _APPLY[parameter.kind](scene, parameter, float(value))
+
+
+#: Units of material values a study may vary.
+_MATERIAL_UNITS = {
+    "youngs_modulus": "Pa",
+    "shear_modulus": "Pa",
+    "density": "kg/m³",
+    "poisson_ratio": "1",
+    "EA": "N",
+    "GA": "N",
+    "EI": "N m²",
+    "EI1": "N m²",
+    "EI2": "N m²",
+    "GJ": "N m²",
+    "mass_per_length": "kg/m",
+}
+
+
+def parameter_axis(parameter: Parameter) -> str:
+    """An axis label of a parameter with its unit (when the kind tells it)."""
+    unit = {
+        "clip_position": "m, shift",
+        "cable_length": "m",
+        "excitation": "× the base motion",
+    }.get(parameter.kind)
+    if parameter.kind == "material":
+        unit = _MATERIAL_UNITS.get(parameter.field)
+    if parameter.kind == "set" and parameter.path.endswith(("time_step", "duration", ".s")):
+        unit = "s" if "simulation" in parameter.path else "m"
+    return f"{parameter.name} [{unit}]" if unit else parameter.name

@@ -200,8 +200,10 @@ def _finish(study: StudyFile, variants: list[Variant], rows, out: Path, skipped)
     plot = None
     if frame["status"].eq("ok").any():
         from cablelife.plots.figure import save_png
+        from cablelife.study.parameters import parameter_axis
 
-        plot = save_png(plot_damage_over_parameters(frame, params), out / "damage.png")
+        labels = {p.name: parameter_axis(p) for p in study.parameters}
+        plot = save_png(plot_damage_over_parameters(frame, params, labels), out / "damage.png")
     failed = {r["variant"]: r.get("error", "") for r in rows.values() if r.get("status") != "ok"}
     computed = [v.name for v in variants if v.name in rows and v.name not in skipped]
     return StudyOutcome(out, frame, csv, parquet, plot, params, computed, list(skipped), failed)

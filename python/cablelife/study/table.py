@@ -47,9 +47,12 @@ def save_tables(frame: pd.DataFrame, out_dir: Path) -> tuple[Path, Path]:
     return csv, parquet
 
 
-def plot_damage_over_parameters(frame: pd.DataFrame, parameters: list[str]):
-    """Max damage over each parameter (one panel each, log scale); in a grid, variants that
-    share the other parameters' values are joined by lines."""
+def plot_damage_over_parameters(
+    frame: pd.DataFrame, parameters: list[str], labels: dict[str, str] | None = None
+):
+    """Max damage over each parameter (one panel each, log scale; ``labels``: axis label with
+    unit per parameter); in a grid, variants that share the other parameters' values are
+    joined by lines."""
     from cablelife.plots.figure import new_figure
 
     ok = frame[frame["status"].eq("ok") & frame["max_damage"].gt(0)]
@@ -63,7 +66,7 @@ def plot_damage_over_parameters(frame: pd.DataFrame, parameters: list[str]):
             key = key if isinstance(key, tuple) else (key,)
             label = ", ".join(f"{q}={v:g}" for q, v in zip(others, key, strict=False)) or None
             ax.plot(g[p], g["max_damage"], "o-", label=label)
-        ax.set_xlabel(p)
+        ax.set_xlabel((labels or {}).get(p, p))
         ax.set_yscale("log")
         ax.grid(True, which="both", alpha=0.3)
         if others and len(ok) and ax.get_legend_handles_labels()[0]:

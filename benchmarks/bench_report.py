@@ -1,0 +1,74 @@
+"""The demo's HTML report (issue 14): its size, the time to generate it from the run folders
+(median of --repeat), and the time until every figure has rendered in headless Chromium (the
+page's own record, data-render-ms since navigation start; median of --repeat fresh browsers),
+with the figures that rendered and any overlapping text boxes.
+
+    python benchmarks/bench_report.py [DEMO_DIR] [--repeat 3] [--page report.html]
+
+DEMO_DIR: the output of ``cablelife demo --no-report`` (default: run it into a temporary
+folder first). ``--page`` measures only the load time of an existing page (e.g. of an older
+version, whose page has no data-render-ms: then the time until its own check, minus the
+1.5 s it waits, is printed).
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import tempfile
+import time
+import warnings
+from pathlib import Path
+
+from cablelife.report.browser import check_page
+
+
+def load_times(page: Path, repeat: int) -> None:
+    seen = [check_page(page) for _ in range(repeat)]
+    last = seen[-1]
+    old = all(s.load_s < 0 for s in seen)  # an older page: no data-render-ms
+    loads = [s.wall_s - 1.5 if old else s.load_s for s in seen]
+    print(
+        f"load in headless chromium: median {statistics.median(loads):.2f} s "
+        f"(min {min(loads):.2f}, max {max(loads):.2f}, n = {repeat}"
+        + (", older page: time to its check − 1.5 s" if old else "")
+        + f"); figures rendered {last.rendered}/{last.expected}, script errors "
+        f"{len(last.errors)}, overlapping text boxes {len(last.overlaps)}"
+    )
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("demo_dir", nargs="?", type=Path)
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--page", type=Path, help="only the load time of this page")
+    args = ap.parse_args()
+    if args.page is not None:
+        print(f"{args.page}: {args.page.stat().st_size / 1e6:.2f} MB")
+        load_times(args.page, args.repeat)
+        return
+    from cablelife.demo import _write_report, demo_runs, run_demo
+
+    with tempfile.TemporaryDirectory() as tmp:
+        folder = args.demo_dir
+        if folder is None:
+            folder = Path(tmp) / "demo"
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                run_demo(folder, report=False)
+        runs = demo_runs()
+        times = []
+        for _ in range(args.repeat):
+            t0 = time.perf_counter()
+            page = _write_report(folder, runs, 24)
+            times.append(time.perf_counter() - t0)
+        print(
+            f"report of the demo (4 runs): {page.stat().st_size / 1e6:.2f} MB, generated in "
+            f"median {statistics.median(times):.2f} s (min {min(times):.2f}, n = {args.repeat}; "
+            "results and damage files read included)"
+        )
+        load_times(page, args.repeat)
+
+
+if __name__ == "__main__":
+    main()

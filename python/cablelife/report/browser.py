@@ -1,0 +1,205 @@
+"""A report as a person sees it: the page opened in headless Chromium (Debian's ``chromium``),
+driven over the DevTools protocol with tornado's websocket client (tornado comes with
+dask.distributed): time until every figure rendered (the page's own ``data-render-ms``),
+figures rendered, script errors, overlapping text boxes, screenshots. Used by the report test
+and ``benchmarks/bench_report.py``."""
+
+from __future__ import annotations
+
+import asyncio
+import base64
+import json
+import shutil
+import socket
+import subprocess
+import tempfile
+import time
+import urllib.request
+from dataclasses import dataclass, field
+from pathlib import Path
+
+BROWSERS = ("chromium", "chromium-browser", "google-chrome")
+# Software WebGL (SwiftShader) so plotly's 3D scenes draw without a GPU; root needs no sandbox.
+FLAGS = [
+    "--headless",
+    "--no-sandbox",
+    "--use-angle=swiftshader",
+    "--enable-unsafe-swiftshader",
+    "--hide-scrollbars",
+    "--no-first-run",
+    "--disable-gpu-sandbox",
+]
+
+# Text boxes (SVG text of every plotly figure, and the HTML text) whose rectangles overlap by
+# more than 1 px in both directions; the rendered figures' texts only when visible.
+OVERLAP_JS = r"""
+(function(){
+ var out=[];
+ document.querySelectorAll('.js-plotly-plot').forEach(function(fig,n){
+  var boxes=[];
+  fig.querySelectorAll('svg text').forEach(function(t){
+   if(!t.textContent.trim())return;
+   var s=getComputedStyle(t);
+   if(s.display==='none'||s.visibility==='hidden'||+s.opacity===0||+s.fillOpacity===0)return;
+   var p=t.parentElement,hidden=false;
+   while(p&&p!==fig){var ps=getComputedStyle(p);
+    if(ps.display==='none'||+ps.opacity===0){hidden=true;break}p=p.parentElement}
+   if(hidden)return;
+   var r=t.getBoundingClientRect();
+   if(r.width<1||r.height<1)return;
+   boxes.push({t:t.textContent.trim(),r:r});});
+  for(var i=0;i<boxes.length;i++)for(var j=i+1;j<boxes.length;j++){
+   var a=boxes[i].r,b=boxes[j].r;
+   var w=Math.min(a.right,b.right)-Math.max(a.left,b.left);
+   var h=Math.min(a.bottom,b.bottom)-Math.max(a.top,b.top);
+   if(w>1&&h>1)out.push({figure:fig.id,a:boxes[i].t,b:boxes[j].t});}
+ });
+ return JSON.stringify(out);
+})()
+"""
+
+
+def find_browser() -> str | None:
+    return next((b for b in map(shutil.which, BROWSERS) if b), None)
+
+
+@dataclass
+class PageCheck:
+    """What the browser saw."""
+
+    load_s: float  # navigation start → every figure rendered (the page's data-render-ms)
+    wall_s: float  # navigate command → the page reported it had finished
+    expected: int
+    rendered: int
+    errors: list[str]
+    overlaps: list[dict] = field(default_factory=list)
+    screenshots: list[Path] = field(default_factory=list)
+    values: dict = field(default_factory=dict)
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+class _Cdp:
+    def __init__(self, ws):
+        self.ws, self.n = ws, 0
+
+    async def call(self, method: str, **params):
+        self.n += 1
+        await self.ws.write_message(json.dumps({"id": self.n, "method": method, "params": params}))
+        while True:
+            msg = json.loads(await self.ws.read_message())
+            if msg.get("id") == self.n:
+                if "error" in msg:
+                    raise RuntimeError(f"{method}: {msg['error']}")
+                return msg.get("result", {})
+
+    async def evaluate(self, expr: str):
+        r = await self.call("Runtime.evaluate", expression=expr, returnByValue=True)
+        return r.get("result", {}).get("value")
+
+
+async def _check(url, port, width, height, timeout, shots, scroll_shots, evaluate) -> PageCheck:
+    from tornado.websocket import websocket_connect
+
+    deadline = time.monotonic() + 20
+    while True:
+        try:
+            with urllib.request.urlopen(f"http://127.0.0.1:{port}/json/list") as r:
+                pages = [t for t in json.load(r) if t["type"] == "page"]
+            if pages:
+                break
+        except OSError:
+            pass
+        if time.monotonic() > deadline:
+            raise RuntimeError("chromium did not open its DevTools port")
+        await asyncio.sleep(0.1)
+    ws = await websocket_connect(pages[0]["webSocketDebuggerUrl"], max_message_size=2**30)
+    cdp = _Cdp(ws)
+    await cdp.call("Emulation.setDeviceMetricsOverride", width=width, height=height,
+                   deviceScaleFactor=1, mobile=False)  # fmt: skip
+    t0 = time.perf_counter()
+    await cdp.call("Page.navigate", url=url)
+    while True:
+        done = await cdp.evaluate("document.body && document.body.dataset.checked")
+        if done == "yes":
+            break
+        if time.perf_counter() - t0 > timeout:
+            raise TimeoutError(f"the report did not finish rendering within {timeout} s")
+        await asyncio.sleep(0.02)
+    wall = time.perf_counter() - t0
+    data = await cdp.evaluate("JSON.stringify(document.body.dataset)")
+    d = json.loads(data)
+    overlaps = json.loads(await cdp.evaluate(OVERLAP_JS))
+    values = {k: await cdp.evaluate(js) for k, js in (evaluate or {}).items()}
+    files = []
+    if shots is not None:
+        shots.mkdir(parents=True, exist_ok=True)
+        total = await cdp.evaluate("document.documentElement.scrollHeight")
+        tops = [0] if not scroll_shots else list(range(0, int(total), height))
+        for k, top in enumerate(tops):
+            await cdp.evaluate(f"window.scrollTo(0, {top})")
+            await asyncio.sleep(0.3)
+            png = await cdp.call("Page.captureScreenshot", format="png")
+            path = shots / f"report-{k:02d}.png"
+            path.write_bytes(base64.b64decode(png["data"]))
+            files.append(path)
+    ws.close()
+    return PageCheck(
+        load_s=int(d.get("renderMs", -1)) / 1e3,
+        wall_s=wall,
+        expected=int(d.get("expectedFigures", 0)),
+        rendered=int(d.get("renderedFigures", 0)),
+        errors=json.loads(d.get("errors", "[]")),
+        overlaps=overlaps,
+        screenshots=files,
+        values=values,
+    )
+
+
+def check_page(
+    path: str | Path,
+    *,
+    width: int = 1200,
+    height: int = 900,
+    timeout: float = 120.0,
+    screenshots: Path | None = None,
+    scroll_shots: bool = True,
+    evaluate: dict[str, str] | None = None,
+) -> PageCheck:
+    """Opens ``path`` in a fresh headless Chromium and reports what it saw; with
+    ``screenshots`` (a folder) one PNG per screen height down the page; ``evaluate``: name →
+    JavaScript expression, their values in ``values``."""
+    browser = find_browser()
+    if browser is None:
+        raise FileNotFoundError("chromium not found (Debian package 'chromium')")
+    port = _free_port()
+    with tempfile.TemporaryDirectory() as profile:
+        proc = subprocess.Popen(
+            [browser, *FLAGS, f"--remote-debugging-port={port}", f"--user-data-dir={profile}",
+             f"--window-size={width},{height}", "about:blank"],
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+        )  # fmt: skip
+        try:
+            return asyncio.run(
+                _check(
+                    Path(path).resolve().as_uri(),
+                    port,
+                    width,
+                    height,
+                    timeout,
+                    screenshots,
+                    scroll_shots,
+                    evaluate,
+                )  # fmt: skip
+            )
+        finally:
+            proc.terminate()
+            try:
+                proc.wait(10)
+            except subprocess.TimeoutExpired:
+                proc.kill()

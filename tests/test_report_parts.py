@@ -1,0 +1,76 @@
+"""Parts of the report that decide what a person sees: decimation keeps every peak, constant
+series get a sensible axis, the excited band comes from the signal definitions, runs belong to
+variants, a span between clips on one body is at rest, numerical zeros show as 0."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def test_minmax_keeps_every_peak_within_the_point_budget():
+    from cablelife.report.decimate import minmax
+
+    t = np.linspace(0.0, 5.0, 5001)
+    y = np.sin(2 * np.pi * 37 * t) + np.random.default_rng(1).normal(0, 0.1, t.size)
+    y[1234] = 9.0  # a single spike
+    x2, y2 = minmax(t, y, 1000)
+    assert x2.size <= 1000 and np.all(np.diff(x2) > 0)
+    assert y2.max() == y.max() == 9.0 and y2.min() == y.min()
+    # every bucket's extremes are kept: the envelope over 10-sample windows is the same
+    for a in range(0, 5000, 500):
+        sel = (t >= t[a]) & (t < t[a] + 0.5)
+        keep = (x2 >= t[a]) & (x2 < t[a] + 0.5)
+        assert y2[keep].max() == y[sel].max()
+    short = np.arange(10.0)
+    assert minmax(short, short)[0] is short
+
+
+def test_constant_series_get_a_readable_range():
+    from cablelife.report.decimate import nice_range
+
+    y = 0.123456789 + np.array([0.0, 1e-16, -2e-16, 0.0])  # round-off "noise"
+    lo, hi = nice_range(y)
+    assert lo < 0.1234 and hi > 0.1235 and hi - lo == pytest.approx(0.2 * 0.123456789)
+    assert nice_range(np.zeros(5)) == [-1.0, 1.0]
+    assert nice_range(np.array([0.0, 1.0])) is None
+
+
+def test_excited_band_of_the_demo_is_the_band_of_its_psd_signals():
+    from cablelife.report.scene_data import excited_band
+    from cablelife.scene import load_scene
+
+    scene = load_scene(ROOT / "examples" / "clip-variants" / "scene.toml")
+    assert excited_band(scene, "harness") == (10.0, 100.0)
+
+
+def test_runs_belong_to_variants_by_label():
+    from cablelife.report.html import _g, variant_of
+
+    assert variant_of("A-dynamic", "dynamic") == "A"
+    assert variant_of("B_quasistatic", "quasistatic") == "B"
+    assert variant_of("long (dynamic)", "dynamic") == "long"
+    assert variant_of("dynamic", "dynamic") == "dynamic"
+    # a numerical zero (2.4e-7 N next to forces of 6 N) shows as 0
+    assert _g(2.4e-7, "N", 6.5) == "0 N" and _g(0.11, "N", 6.5) == "0.11 N"
+
+
+def test_a_span_between_clips_at_rest_does_not_move():
+    from cablelife.plots.spans import cable_spans
+    from cablelife.scene import scene_from_dict
+    from cablelife.simulate import simulate
+    from conftest import BASE
+
+    d = {**BASE, "simulation": {"mode": "quasistatic", "duration": 0.5, "time_step": 0.05}}
+    d["cables"] = [dict(BASE["cables"][0])]
+    clips = [dict(c) for c in BASE["cables"][0]["clips"]]
+    clips.insert(1, {**clips[0], "name": "m", "s": 0.4, "position": [0.38, 0.0, 0.0]})
+    clips[2] = {**clips[2], "body": "engine"}
+    d["cables"][0]["clips"] = clips
+    sine = {"type": "sine", "amplitude": 0.02, "frequency": 1.0}
+    d["bodies"] = [{"name": "engine", "origin": [0.8, 0.2, 0.0],
+                    "motion": [{"channel": "z", "signal": sine}]}]  # fmt: skip
+    spans = {sp.name: sp.moves for sp in cable_spans(simulate(scene_from_dict(d)).cable)}
+    assert spans == {"a → m": False, "m → b": True}
