@@ -77,6 +77,10 @@ def print_summary(result: Result) -> None:
         for clip, v in s["clips"].items():
             ct.add_row(clip, f"{v['s']:.3f}", f"{v['max_force']:.4g}", f"{v['max_moment']:.4g}")
         console.print(ct)
+        if c.surroundings is not None:
+            from cablelife.surroundings.summary import clearance_table
+
+            console.print(clearance_table(c))
 
 
 @app.command()

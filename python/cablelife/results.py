@@ -15,6 +15,8 @@ HDF5 layout (every dataset carries a ``unit`` attribute)::
     /cables/<name>/section       attrs: shape, outer_radius, inner_radius, poisson_ratio,
                                         EA, GA1, GA2, EI1, EI2, GJ, mass_per_length, from_measured
     /cables/<name>/solver        attrs and datasets: iterations (T,), residual (T,), ...
+    /cables/<name>/clearance, clearance_body, clearance_part   (T, N+1) with geometry
+                                 (see cablelife.surroundings.data)
 """
 
 from __future__ import annotations
@@ -27,6 +29,7 @@ import h5py
 import numpy as np
 
 from cablelife.h5files import atomic_h5, open_h5, plain
+from cablelife.surroundings.data import CableClearance
 
 FORMAT = "cablelife-result"
 FORMAT_VERSION = 1
@@ -72,6 +75,18 @@ class CableResult:
     section: dict = field(default_factory=dict)
     solver: dict = field(default_factory=dict)
     energies: dict[str, np.ndarray] = field(default_factory=dict)
+    surroundings: CableClearance | None = None  # clearance to the scene's geometry
+
+    @property
+    def clearance(self) -> np.ndarray | None:
+        """(T, N+1) clearance of the cable surface to the nearest geometry, m (None without
+        geometry); negative inside. See docs/environment.md."""
+        return None if self.surroundings is None else self.surroundings.value
+
+    @property
+    def clearance_body(self) -> np.ndarray | None:
+        """(T, N+1) index of the nearest body into ``surroundings.bodies``."""
+        return None if self.surroundings is None else self.surroundings.body
 
     @property
     def n_steps(self) -> int:
@@ -161,6 +176,8 @@ def save_result(result: Result, path: str | os.PathLike) -> Path:
                     sol.create_dataset(key, data=value)
                 else:
                     sol.attrs[key] = value
+            if c.surroundings is not None:
+                c.surroundings.write(g)
     return path
 
 
@@ -190,6 +207,7 @@ def load_result(path: str | os.PathLike) -> Result:
                 section={k: plain(v) for k, v in g["section"].attrs.items()},
                 solver={k: plain(v) for k, v in solver.items()},
                 energies=energies,
+                surroundings=CableClearance.read(g),
             )
         return Result(
             mode=str(f.attrs["mode"]),

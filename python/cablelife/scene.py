@@ -26,6 +26,7 @@ from pydantic import (
 from cablelife import _core
 from cablelife.sections import SectionProperties, from_material, from_measured
 from cablelife.signals.spec import ChannelMotion, TableSignal
+from cablelife.surroundings.models import ClearanceSettings, GeometryPart
 from cablelife.tomlfile import read_toml
 
 Vec3 = tuple[float, float, float]
@@ -252,6 +253,7 @@ class Body(_Model):
     orientation: Vec3 = (0.0, 0.0, 0.0)  # rx, ry, rz (rad) of the body frame, R = Rz Ry Rx
     motion: list[ChannelMotion] = []
     motion_file: Path | None = None
+    geometry: list[GeometryPart] = []  # shapes moving with the body (docs/environment.md)
 
     @model_validator(mode="after")
     def _one_motion(self):
@@ -329,6 +331,7 @@ class Scene(_Model):
     simulation: Simulation = Simulation()
     bodies: list[Body] = []
     cables: Annotated[list[Cable], Field(min_length=1)]
+    clearance: ClearanceSettings | None = None  # settings of the clearance to the geometry
     base_dir: Annotated[Path | None, Field(exclude=True)] = None
 
     @model_validator(mode="after")

@@ -19,6 +19,8 @@ from cablelife import _core
 from cablelife.results import CableResult, ClipReaction, Result
 from cablelife.scene import Cable, Scene, SceneError
 from cablelife.signals import body_motion, time_grid
+from cablelife.surroundings.build import load_surroundings
+from cablelife.surroundings.clearance import add_clearance
 
 Progress = Callable[[str, int, int], None]
 
@@ -62,15 +64,11 @@ def output_times(scene: Scene, mode: str) -> np.ndarray:
     return time_grid(sim.duration, sim.output_step or sim.time_step)
 
 
-def clip_kinematics(
-    scene: Scene, cable: Cable, times: np.ndarray, with_motion: bool = True
-) -> dict[str, np.ndarray]:
-    """Clip kinematics on ``times``: positions (T, C, 3), quaternions scalar first (T, C, 4),
-    velocities, angular velocities, accelerations, angular accelerations (T, C, 3), global.
-    Without ``with_motion``: the reference poses (bodies at rest)."""
-    n_t, n_c = times.size, len(cable.clips)
+def body_motions(scene: Scene, times: np.ndarray, with_motion: bool = True) -> dict:
+    """Per body name: (body, R0 its axes at rest, its BodyMotion on ``times`` or None when it
+    does not move). Clips and the surroundings' geometry move with these motions."""
     grid = times
-    if n_t == 1:  # one pose (static run): the motions' value at that time on their usual grid
+    if times.size == 1:  # one pose (static run): the motions' value at that time on their grid
         sim = scene.simulation
         grid = (
             time_grid(sim.duration, sim.time_step, times[0])
@@ -83,6 +81,17 @@ def clip_kinematics(
         channels = body.channel_motions(scene.base_dir) if with_motion else []
         motion = body_motion(channels, grid, scene.base_dir, r0) if channels else None
         motions[body.name] = (body, r0, motion)
+    return motions
+
+
+def clip_kinematics(
+    scene: Scene, cable: Cable, times: np.ndarray, with_motion: bool = True
+) -> dict[str, np.ndarray]:
+    """Clip kinematics on ``times``: positions (T, C, 3), quaternions scalar first (T, C, 4),
+    velocities, angular velocities, accelerations, angular accelerations (T, C, 3), global.
+    Without ``with_motion``: the reference poses (bodies at rest)."""
+    n_t, n_c = times.size, len(cable.clips)
+    motions = body_motions(scene, times, with_motion)
     out = {
         k: np.zeros((n_t, n_c, 3))
         for k in (
@@ -300,6 +309,7 @@ def simulate(scene: Scene, mode: str | None = None, progress: Progress | None = 
             f"mode = {mode!r} is not a simulation mode; allowed: 'static', 'quasistatic', 'dynamic'"
         )
     times = output_times(scene, mode)
+    env = load_surroundings(scene)  # reads and checks the geometry before the run
     workers = max(1, min(len(scene.cables), os.cpu_count() or 1))
     with ThreadPoolExecutor(max_workers=workers) as pool:
         futures = [pool.submit(_run_cable, scene, c, times, mode, progress) for c in scene.cables]
@@ -313,6 +323,8 @@ def simulate(scene: Scene, mode: str | None = None, progress: Progress | None = 
         complete=not errors,
         message="; ".join(errors),
     )
+    if env is not None:
+        add_clearance(env, scene, result, times, output_every(scene) if mode == "dynamic" else 1)
     if errors:
         raise SimulationError(result.message, result)
     return result

@@ -3,6 +3,7 @@ use pyo3::prelude::*;
 
 mod cable;
 mod fatigue;
+mod geometry;
 mod volume;
 
 #[pymodule]
@@ -11,5 +12,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     cable::register(m)?;
     volume::register(m)?;
     fatigue::register(m)?;
+    geometry::register(m)?;
     Ok(())
 }
