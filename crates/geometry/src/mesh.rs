@@ -6,7 +6,6 @@
 //! vertex (Bærentzen & Aanæs 2005). For a closed, consistently oriented mesh this is the exact
 //! inside test; for an open mesh it says on which side of the surface (by its normals) the
 //! point is.
-use std::collections::HashMap;
 use std::fmt;
 
 use crate::closest::{point_triangle, segment_triangle, Feature};
@@ -30,6 +29,11 @@ impl std::error::Error for MeshError {}
 struct Node {
     min: V3,
     max: V3,
+    /// Slab bound: the node's triangles lie in lo ≤ axis·x ≤ hi (axis zero: no slab). Tight
+    /// where the surface is nearly flat, which the box is not when the surface is inclined.
+    axis: V3,
+    lo: f64,
+    hi: f64,
     /// Leaf: first triangle; inner node: index of the right child (the left one follows).
     index: u32,
     /// Leaf: number of triangles (> 0); inner node: 0.
@@ -44,7 +48,18 @@ impl Node {
             let e = (self.min[k] - p[k]).max(p[k] - self.max[k]).max(0.0);
             d2 += e * e;
         }
-        d2
+        let x = self.axis.dot(p);
+        let e = (self.lo - x).max(x - self.hi).max(0.0);
+        d2.max(e * e)
+    }
+
+    /// Lower bound of the squared distance of segment [a, b] (with box lo..hi).
+    #[inline]
+    fn distance2_segment(&self, a: &V3, b: &V3, lo: &V3, hi: &V3) -> f64 {
+        let d2 = self.distance2_box(lo, hi);
+        let (xa, xb) = (self.axis.dot(a), self.axis.dot(b));
+        let e = (self.lo - xa.max(xb)).max(xa.min(xb) - self.hi).max(0.0);
+        d2.max(e * e)
     }
 
     #[inline]
@@ -108,14 +123,30 @@ impl TriMesh {
                 vertex_normals[f[k] as usize] += n * angle;
             }
         }
-        // edge pseudo-normals: sum of the normals of the faces sharing the edge
-        let mut edges: HashMap<(u32, u32), V3> = HashMap::with_capacity(faces.len() * 2);
-        for (f, n) in faces.iter().zip(&normals) {
+        // edge pseudo-normals: sum of the normals of the faces sharing the edge (edges grouped
+        // by sorting their vertex pairs)
+        let mut keys: Vec<(u64, u32)> = Vec::with_capacity(faces.len() * 3);
+        for (i, f) in faces.iter().enumerate() {
             for k in 0..3 {
-                let key = edge_key(f[k], f[(k + 1) % 3]);
-                *edges.entry(key).or_insert_with(V3::zeros) += n;
+                keys.push((edge_key(f[k], f[(k + 1) % 3]), (3 * i + k) as u32));
             }
         }
+        keys.sort_unstable();
+        let mut edge_of = vec![V3::zeros(); faces.len() * 3];
+        let mut g = 0;
+        while g < keys.len() {
+            let mut h = g;
+            let mut sum = V3::zeros();
+            while h < keys.len() && keys[h].0 == keys[g].0 {
+                sum += normals[keys[h].1 as usize / 3];
+                h += 1;
+            }
+            for key in &keys[g..h] {
+                edge_of[key.1 as usize] = sum;
+            }
+            g = h;
+        }
+        drop(keys);
         // hierarchy over the triangle centroids
         let mut items: Vec<(V3, u32)> = faces
             .iter()
@@ -132,7 +163,13 @@ impl TriMesh {
                 (a.inf(&b).inf(&c), a.sup(&b).sup(&c))
             })
             .collect();
-        let nodes = build(&mut items, 0, &boxes);
+        let ctx = BuildData {
+            boxes: &boxes,
+            vertices,
+            faces,
+            normals: &normals,
+        };
+        let nodes = build(&mut items, 0, &ctx);
         let order: Vec<usize> = items.iter().map(|&(_, i)| i as usize).collect();
         let triangles = order
             .iter()
@@ -142,10 +179,7 @@ impl TriMesh {
         let face_normals: Vec<V3> = order.iter().map(|&i| normals[i]).collect();
         let edge_normals = order
             .iter()
-            .map(|&i| {
-                let f = faces[i];
-                [0, 1, 2].map(|k| edges[&edge_key(f[k], f[(k + 1) % 3])])
-            })
+            .map(|&i| [0, 1, 2].map(|k| edge_of[3 * i + k]))
             .collect();
         Ok(TriMesh {
             triangles,
@@ -199,6 +233,10 @@ impl TriMesh {
                 let start = node.index as usize;
                 for t in start..start + node.count as usize {
                     let [a, b, c] = &self.triangles[t];
+                    let h = self.face_normals[t].dot(&(p - a));
+                    if h * h > best_d2 {
+                        continue;
+                    }
                     let (cp, _) = point_triangle(p, a, b, c);
                     let d2 = (cp - p).norm_squared();
                     if d2 < best_d2 || (d2 == best_d2 && best.is_none()) {
@@ -238,12 +276,29 @@ impl TriMesh {
         let half = (b - a).norm() * 0.5;
         let (lo, hi) = (a.inf(b), a.sup(b));
         let lower2 = |n: &Node| {
-            let db = n.distance2_box(&lo, &hi);
+            let db = n.distance2_segment(a, b, &lo, &hi);
             let dm = (n.distance2_point(&mid).sqrt() - half).max(0.0);
             db.max(dm * dm)
         };
         let check = |t: usize, best_d2: &mut f64, best: &mut Option<_>| {
             let [p, q, r] = &self.triangles[t];
+            // cheap lower bounds first: the triangle's plane, then the midpoint's distance
+            // minus the half length
+            let n = &self.face_normals[t];
+            let (ha, hb) = (n.dot(&(a - p)), n.dot(&(b - p)));
+            let h = if ha * hb <= 0.0 {
+                0.0
+            } else {
+                ha.abs().min(hb.abs())
+            };
+            if h * h > *best_d2 {
+                return;
+            }
+            let (cm, _) = point_triangle(&mid, p, q, r);
+            let lb = ((cm - mid).norm() - half).max(0.0);
+            if lb * lb > *best_d2 {
+                return;
+            }
             let (s, x, y) = segment_triangle(a, b, p, q, r);
             let d2 = (x - y).norm_squared();
             if d2 < *best_d2 || (d2 == *best_d2 && best.is_none()) {
@@ -339,53 +394,96 @@ impl Surface for TriMesh {
 }
 
 #[inline]
-fn edge_key(a: u32, b: u32) -> (u32, u32) {
-    if a < b {
-        (a, b)
-    } else {
-        (b, a)
+fn edge_key(a: u32, b: u32) -> u64 {
+    let (lo, hi) = if a < b { (a, b) } else { (b, a) };
+    ((lo as u64) << 32) | hi as u64
+}
+
+struct BuildData<'a> {
+    boxes: &'a [(V3, V3)],
+    vertices: &'a [V3],
+    faces: &'a [[u32; 3]],
+    normals: &'a [V3],
+}
+
+/// Subtrees up to this many triangles get a slab bound (the surface is nearly flat there).
+const SLAB_MAX: usize = 64;
+
+/// The slab of a node's triangles: axis = mean normal, and the range of axis·x over them.
+fn slab(items: &[(V3, u32)], d: &BuildData) -> (V3, f64, f64) {
+    let none = (V3::zeros(), f64::NEG_INFINITY, f64::INFINITY);
+    if items.len() > SLAB_MAX {
+        return none;
     }
+    let mean: V3 = items.iter().map(|(_, i)| d.normals[*i as usize]).sum();
+    let len = mean.norm();
+    if len < 0.5 * items.len() as f64 {
+        return none; // normals spread: the slab would not be thin
+    }
+    let axis = mean / len;
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for (_, i) in items {
+        for &k in &d.faces[*i as usize] {
+            let x = axis.dot(&d.vertices[k as usize]);
+            lo = lo.min(x);
+            hi = hi.max(x);
+        }
+    }
+    // widen by the round-off of the projections
+    let pad = 1e-12 * (lo.abs() + hi.abs() + (hi - lo));
+    (axis, lo - pad, hi + pad)
 }
 
 /// Builds the hierarchy over `items` (centroid, triangle), reordering them; `offset` is the
 /// position of items[0] in the whole triangle order. Nodes in depth-first order.
-fn build(items: &mut [(V3, u32)], offset: usize, boxes: &[(V3, V3)]) -> Vec<Node> {
-    let (mut lo, mut hi) = (V3::repeat(f64::INFINITY), V3::repeat(f64::NEG_INFINITY));
-    let (mut clo, mut chi) = (lo, hi);
-    for (c, i) in items.iter() {
-        let (a, b) = boxes[*i as usize];
-        lo = lo.inf(&a);
-        hi = hi.sup(&b);
-        clo = clo.inf(c);
-        chi = chi.sup(c);
-    }
+fn build(items: &mut [(V3, u32)], offset: usize, d: &BuildData) -> Vec<Node> {
+    let boxes = d.boxes;
     if items.len() <= LEAF_SIZE {
+        let (mut lo, mut hi) = (V3::repeat(f64::INFINITY), V3::repeat(f64::NEG_INFINITY));
+        for (_, i) in items.iter() {
+            let (a, b) = boxes[*i as usize];
+            lo = lo.inf(&a);
+            hi = hi.sup(&b);
+        }
+        let (axis, slo, shi) = slab(items, d);
         return vec![Node {
             min: lo,
             max: hi,
+            axis,
+            lo: slo,
+            hi: shi,
             index: offset as u32,
             count: items.len() as u32,
         }];
     }
+    let (mut clo, mut chi) = (V3::repeat(f64::INFINITY), V3::repeat(f64::NEG_INFINITY));
+    for (c, _) in items.iter() {
+        clo = clo.inf(c);
+        chi = chi.sup(c);
+    }
+    let (slab_axis, slab_lo, slab_hi) = slab(items, d);
     let axis = (chi - clo).imax();
     let mid = items.len() / 2;
     items.select_nth_unstable_by(mid, |x, y| x.0[axis].total_cmp(&y.0[axis]));
     let (left_items, right_items) = items.split_at_mut(mid);
     let (left, right) = if left_items.len() + right_items.len() > PARALLEL_BUILD {
         rayon::join(
-            || build(left_items, offset, boxes),
-            || build(right_items, offset + mid, boxes),
+            || build(left_items, offset, d),
+            || build(right_items, offset + mid, d),
         )
     } else {
         (
-            build(left_items, offset, boxes),
-            build(right_items, offset + mid, boxes),
+            build(left_items, offset, d),
+            build(right_items, offset + mid, d),
         )
     };
     let mut nodes = Vec::with_capacity(1 + left.len() + right.len());
     nodes.push(Node {
-        min: lo,
-        max: hi,
+        min: left[0].min.inf(&right[0].min),
+        max: left[0].max.sup(&right[0].max),
+        axis: slab_axis,
+        lo: slab_lo,
+        hi: slab_hi,
         index: (1 + left.len()) as u32,
         count: 0,
     });
