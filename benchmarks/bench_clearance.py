@@ -19,7 +19,6 @@ import statistics
 import time
 
 import numpy as np
-
 from cablelife import _core
 
 RADIUS = 0.006
@@ -78,7 +77,8 @@ def main() -> None:
         runs.append(time.perf_counter() - t0)
     b, r = statistics.median(builds), statistics.median(runs)
     print(f"hierarchy build          median {b:.3f} s")
-    print(f"clearance (all steps)    median {r:.3f} s   ({r / (steps * nodes) * 1e6:.2f} µs per node)")
+    per_node = r / (steps * nodes) * 1e6
+    print(f"clearance (all steps)    median {r:.3f} s   ({per_node:.2f} µs per node)")
     print(f"build + clearance        median {b + r:.3f} s   (target ≤ 1 s)")
     print(f"clearance range          {value.min() * 1e3:.2f} … {value.max() * 1e3:.2f} mm")
     # cold queries: every step alone (no warm start from the previous step)
@@ -89,7 +89,8 @@ def main() -> None:
     )
     t_cold = time.perf_counter() - t0
     assert np.allclose(cold, value[::50], rtol=0, atol=1e-15)
-    print(f"cold (no warm start)     {t_cold / cold.size * 1e6:.2f} µs per node (one call per step)")
+    per_node = t_cold / cold.size * 1e6
+    print(f"cold (no warm start)     {per_node:.2f} µs per node (one call per step)")
 
 
 if __name__ == "__main__":
