@@ -356,7 +356,8 @@ def test_run_stores_and_summarises_clearance(scene_dict, tmp_path):
     out = CliRunner().invoke(app, ["run", str(tmp_path / "s.toml"), "-q"])
     assert out.exit_code == 0, out.output
     assert "clearance to the surroundings" in out.output
-    assert "length closer than 0.02 m" in out.output
+    assert "closer than min_clearance = 0.02 m" in out.output
+    assert "min clearance [m]" in out.output
 
 
 # ---------------------------------------------------------------------------- bad meshes

@@ -78,9 +78,10 @@ def print_summary(result: Result) -> None:
             ct.add_row(clip, f"{v['s']:.3f}", f"{v['max_force']:.4g}", f"{v['max_moment']:.4g}")
         console.print(ct)
         if c.surroundings is not None:
-            from cablelife.surroundings.summary import clearance_table
+            from cablelife.surroundings.summary import clearance_tables
 
-            console.print(clearance_table(c))
+            for table in clearance_tables(c):
+                console.print(table)
 
 
 @app.command()

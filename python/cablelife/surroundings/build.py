@@ -77,7 +77,14 @@ def load_surroundings(scene: Scene) -> Surroundings | None:
                     path = resolve_scene_file(scene.base_dir, part.mesh)
                     m = load_mesh(path, part.scale, what, size)
                     v = m.vertices @ rot0.T + o
-                    core.add_mesh(b, np.ascontiguousarray(v), m.faces)
+                    v = np.ascontiguousarray(v)
+                    shells = m.shells or [m.faces]
+                    for shell in shells[:-1]:  # each closed shell its own solid
+                        core.add_mesh(b, v, shell)
+                        labels.append(part_label(body.name, k, part))
+                        part_body.append(b)
+                        friction.append(part.friction)
+                    core.add_mesh(b, v, shells[-1])
                     meshes.append((b, v, m.faces))
                 elif isinstance(part, PlanePart):
                     core.add_plane(b, _at(o, rot0, part.point), (rot0 @ part.normal).tolist())

@@ -29,6 +29,9 @@ class Mesh:
     faces: np.ndarray  # (F, 3) int64
     watertight: bool
     boundary_edges: int
+    # closed meshes of several shells (overlapping solids exported together): the faces of
+    # each shell, measured as separate solids (their union) so that overlaps stay inside
+    shells: list[np.ndarray] | None = None
 
 
 def load_mesh(path: Path, scale: float | None, what: str, scene_size: float) -> Mesh:
@@ -114,4 +117,10 @@ def load_mesh(path: Path, scale: float | None, what: str, scene_size: float) -> 
             SurroundingsWarning,
             stacklevel=2,
         )
-    return Mesh(vertices, faces, watertight, boundary)
+    shells = None
+    if watertight and mesh.body_count > 1:
+        from trimesh.graph import connected_component_labels, face_adjacency
+
+        labels = connected_component_labels(face_adjacency(faces), node_count=len(faces))
+        shells = [faces[labels == k] for k in range(labels.max() + 1)]
+    return Mesh(vertices, faces, watertight, boundary, shells)

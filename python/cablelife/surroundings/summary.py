@@ -46,34 +46,39 @@ def clearance_summary(c) -> dict:
     }
 
 
-def clearance_table(c):
-    """Rich table of :func:`clearance_summary` (for ``cablelife run``)."""
+def clearance_tables(c) -> list:
+    """Rich tables of :func:`clearance_summary` (for ``cablelife run``)."""
+    from rich.markup import escape
     from rich.table import Table
 
     s = clearance_summary(c)
     t = Table(title="clearance to the surroundings (cable surface)", title_justify="left")
     t.add_column("body")
-    t.add_column("min clearance [m]", justify="right")
-    t.add_column("at s [m]", justify="right")
-    t.add_column("at t [s]", justify="right")
+    t.add_column(escape("min clearance [m]"), justify="right")
+    t.add_column(escape("at s [m]"), justify="right")
+    t.add_column(escape("at t [s]"), justify="right")
     t.add_column("nearest part")
     for name, v in s["bodies"].items():
         if v is None:
-            t.add_row(name, "never nearest", "", "", "")
+            t.add_row(escape(name), "never nearest", "", "", "")
         else:
-            t.add_row(name, f"{v['min']:.4g}", f"{v['s']:.3f}", f"{v['t']:.4g}", v["part"])
-    t.add_row(
-        "length in collision (< 0)",
-        f"{s['length_in_collision']:.4g} m",
-        "",
+            t.add_row(
+                escape(name), f"{v['min']:.4g}", f"{v['s']:.3f}", f"{v['t']:.4g}", escape(v["part"])
+            )
+    lengths = Table(
+        title="cable length near the surroundings (max over time)", title_justify="left"
+    )
+    lengths.add_column("")
+    lengths.add_column(escape("length [m]"), justify="right")
+    lengths.add_column(escape("at t [s]"), justify="right")
+    lengths.add_row(
+        "in collision (clearance < 0)",
+        f"{s['length_in_collision']:.4g}",
         f"{s['length_in_collision_t']:.4g}",
-        "",
     )
-    t.add_row(
-        f"length closer than {s['min_clearance']:g} m",
-        f"{s['length_below_min']:.4g} m",
-        "",
+    lengths.add_row(
+        f"closer than min_clearance = {s['min_clearance']:g} m",
+        f"{s['length_below_min']:.4g}",
         f"{s['length_below_min_t']:.4g}",
-        "",
     )
-    return t
+    return [t, lengths]
