@@ -491,3 +491,65 @@ def test_example_scene(tmp_path):
     c = simulate(sc, mode="quasistatic").cable
     assert c.surroundings.bodies == ["engine", "car-body"]
     assert 0 < c.clearance.min() < 0.02  # near the bracket, not through it
+
+
+def test_display_geometry_follows_the_bodies_and_goes_to_paraview(scene_dict, tmp_path):
+    """The result keeps each body's display mesh and poses: the pose of the engine body maps
+    the clip's rest position onto the cable end it holds; ParaView gets the bodies per step."""
+    import xml.etree.ElementTree as ET
+
+    from cablelife.export.cli import paraview_command
+    from cablelife.results import load_result
+    from cablelife.simulate import simulate
+
+    d = copy.deepcopy(scene_dict)
+    d["simulation"].update(mode="quasistatic", duration=0.5, time_step=0.05)
+    turn = {
+        "channel": "rz",
+        "frame": "global",
+        "signal": {"type": "table", "t": [0, 0.5], "value": [0, 0.3]},
+    }
+    d["bodies"] = [
+        {
+            "name": "engine",
+            "origin": [0.9, 0.2, 0.0],
+            "motion": [turn],
+            "geometry": [{"shape": "box", "center": [1.0, 0.2, -0.1], "size": [0.1, 0.1, 0.1]}],
+        },
+        {
+            "name": "floor",
+            "geometry": [{"shape": "plane", "point": [0, 0, -0.5], "normal": [0, 0, 1]}],
+        },
+    ]
+    d["cables"][0]["clips"][1]["body"] = "engine"
+    res = simulate(scene_from_dict(d))
+    path = res.save(tmp_path / "r.h5")
+    geom = load_result(path).surroundings
+    assert geom.bodies == ["engine", "floor"]
+    end = np.array([0.8, 0.2, 0.0])  # clip b at rest, on the engine
+    pose = geom.poses[0]
+    moved = np.einsum("tij,j->ti", pose[..., :3], end) + pose[..., 3]
+    assert np.allclose(moved, res.cable.positions[:, -1], rtol=0, atol=1e-9)
+    assert np.ptp(moved[:, 1]) > 0.02  # it did move
+    assert np.allclose(geom.poses[1, :, :, :3], np.eye(3)) and not geom.poses[1, :, :, 3].any()
+    paraview_command(path, tmp_path / "pv" / "run.pvd", None, 5, None)
+    index = ET.parse(tmp_path / "pv" / "run_bodies.pvd").getroot()
+    files = [e.get("file") for e in index.iter("DataSet")]
+    assert len(files) == 2 * 3  # two bodies, steps 0, 5, 10
+    last = ET.parse(tmp_path / "pv" / files[2]).getroot()
+    pts = np.array(last.find(".//Points/DataArray").text.split(), float).reshape(-1, 3)
+    assert np.allclose(pts, geom.at(0, 10), atol=1e-8)
+    cable = ET.parse(tmp_path / "pv" / "run" / "run_00010.vtp").getroot()
+    names = [a.get("Name") for a in cable.iter("DataArray")]
+    assert "clearance" in names and "clearance_body" in names
+
+
+def test_decimation_for_display():
+    from cablelife.surroundings.display import decimate
+
+    ico = trimesh.creation.icosphere(subdivisions=6, radius=1.0)  # 81 920 triangles
+    v, f = decimate(np.asarray(ico.vertices), np.asarray(ico.faces), 20_000)
+    assert 5_000 < len(f) <= 20_000
+    assert f.max() < len(v)
+    r = np.linalg.norm(v, axis=1)
+    assert r.min() > 0.95 and r.max() <= 1.0 + 1e-12  # still the sphere

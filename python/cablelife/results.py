@@ -30,6 +30,7 @@ import numpy as np
 
 from cablelife.h5files import atomic_h5, open_h5, plain
 from cablelife.surroundings.data import CableClearance
+from cablelife.surroundings.display import SurroundingsGeometry
 
 FORMAT = "cablelife-result"
 FORMAT_VERSION = 1
@@ -120,6 +121,7 @@ class Result:
     scene_toml: str = ""
     complete: bool = True
     message: str = ""
+    surroundings: SurroundingsGeometry | None = None  # body geometry and poses, for pictures
 
     @property
     def cable(self) -> CableResult:
@@ -178,6 +180,8 @@ def save_result(result: Result, path: str | os.PathLike) -> Path:
                     sol.attrs[key] = value
             if c.surroundings is not None:
                 c.surroundings.write(g)
+        if result.surroundings is not None:
+            result.surroundings.write(f)
     return path
 
 
@@ -215,4 +219,5 @@ def load_result(path: str | os.PathLike) -> Result:
             scene_toml=str(f.attrs.get("scene_toml", "")),
             complete=bool(f.attrs.get("complete", True)),
             message=str(f.attrs.get("message", "")),
+            surroundings=SurroundingsGeometry.read(f),
         )

@@ -50,6 +50,10 @@ def paraview_command(
             written.append(
                 write_paraview(res.cables[name], out, damage=dm, steps=slice(None, None, every))
             )
+        if res.surroundings is not None:  # the bodies' geometry, moving with them
+            from cablelife.surroundings.paraview import write_bodies
+
+            written.append(write_bodies(res.surroundings, output, slice(None, None, every)))
     except (ValueError, FileNotFoundError) as e:
         err.print(f"[bold red]error:[/] {e}", highlight=False, soft_wrap=True)
         raise typer.Exit(2) from None

@@ -31,8 +31,18 @@ class Surroundings:
     parts: list[str]
     part_body: np.ndarray  # (P,) body index of each part
     min_clearance: float = 0.0
+    # (body index, vertices, faces) of every part, global at rest (primitives tessellated)
     meshes: list[tuple[int, np.ndarray, np.ndarray]] = field(default_factory=list)
     friction: list[float | None] = field(default_factory=list)
+
+    def display_meshes(self) -> list[tuple[np.ndarray, np.ndarray]]:
+        """One mesh per body for pictures, decimated to ≤ 20 000 triangles."""
+        from cablelife.surroundings.display import decimate, merge
+
+        return [
+            decimate(*merge([(v, f) for b, v, f in self.meshes if b == k]))
+            for k in range(len(self.bodies))
+        ]
 
 
 def scene_size(scene: Scene) -> float:
@@ -107,6 +117,11 @@ def load_surroundings(scene: Scene) -> Surroundings | None:
                 if isinstance(err, SceneError):
                     raise
                 raise SceneError(f"{what}: {err}") from None
+            if not isinstance(part, MeshPart):
+                from cablelife.surroundings.display import primitive_mesh
+
+                pv, pf = primitive_mesh(part, size)
+                meshes.append((b, pv @ rot0.T + o, pf))
             labels.append(part_label(body.name, k, part))
             part_body.append(b)
             friction.append(part.friction)
