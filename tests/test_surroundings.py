@@ -553,3 +553,27 @@ def test_decimation_for_display():
     assert f.max() < len(v)
     r = np.linalg.norm(v, axis=1)
     assert r.min() > 0.95 and r.max() <= 1.0 + 1e-12  # still the sphere
+
+
+def test_report_has_the_clearance_section(scene_dict, tmp_path):
+    from cablelife.cli import app
+    from cablelife.simulate import simulate
+    from typer.testing import CliRunner
+
+    d = copy.deepcopy(scene_dict)
+    d["bodies"] = [
+        {
+            "name": "floor",
+            "geometry": [{"shape": "plane", "point": [0, 0, -0.26], "normal": [0, 0, 1]}],
+        }
+    ]
+    d["clearance"] = {"min_clearance": 0.02}
+    path = simulate(scene_from_dict(d)).save(tmp_path / "r.h5")
+    out = CliRunner().invoke(
+        app, ["report", str(path), "-o", str(tmp_path / "r.html"), "--voxel", "none"]
+    )
+    assert out.exit_code == 0, out.output
+    html = (tmp_path / "r.html").read_text()
+    assert "clearance of hose to the surroundings" in html
+    assert "clearance of hose along the cable" in html  # the envelope figure
+    assert "least clearance" in html and "floor/plane#0" in html

@@ -87,7 +87,8 @@ pub fn clearance(
         .enumerate()
         .for_each(|(k, (val, prt))| {
             let first = k * chunk_steps;
-            let mut hints = vec![usize::MAX; n_nodes * parts.len()];
+            // per node and part: the feature nearest to the node, to its two half-edges
+            let mut hints = vec![usize::MAX; 3 * n_nodes * parts.len()];
             let mut local = vec![V3::zeros(); n_bodies * n_nodes];
             for (j, (vrow, prow)) in val
                 .chunks_mut(n_nodes)
@@ -123,7 +124,7 @@ fn step(
         let mut nearest = 0usize;
         for (k, pt) in parts.iter().enumerate() {
             let x = &local[pt.body * n + i];
-            let h = &mut hints[i * n_parts + k];
+            let h = &mut hints[3 * (i * n_parts + k)];
             if let Some(r) = pt.shape.project_point(x, f64::INFINITY, *h) {
                 *h = r.feature;
                 if r.distance < best {
@@ -136,13 +137,19 @@ fn step(
             for (k, pt) in parts.iter().enumerate() {
                 let base = pt.body * n;
                 let x = &local[base + i];
-                let h = hints[i * n_parts + k];
-                for nb in [i.wrapping_sub(1), i + 1] {
+                let at = 3 * (i * n_parts + k);
+                for (side, nb) in [i.wrapping_sub(1), i + 1].into_iter().enumerate() {
                     if nb >= n {
                         continue;
                     }
                     let mid = (x + local[base + nb]) * 0.5;
+                    // warm start: this half-edge's feature at the previous step, else the node's
+                    let h = match hints[at + 1 + side] {
+                        usize::MAX => hints[at],
+                        h => h,
+                    };
                     if let Some(s) = pt.shape.closest_to_segment(x, &mid, best, h) {
+                        hints[at + 1 + side] = s.feature;
                         if s.distance < best {
                             best = s.distance;
                             nearest = k;

@@ -71,6 +71,8 @@ def load_surroundings(scene: Scene) -> Surroundings | None:
     meshes: list[tuple[int, np.ndarray, np.ndarray]] = []
     friction: list[float | None] = []
     size = scene_size(scene)
+    clips = [c.position for cable in scene.cables for c in cable.clips if c.frame == "global"]
+    centre = np.mean(clips, axis=0) if clips else None
     for bi, body in enumerate(scene.bodies):
         if not body.geometry:
             continue
@@ -120,7 +122,9 @@ def load_surroundings(scene: Scene) -> Surroundings | None:
             if not isinstance(part, MeshPart):
                 from cablelife.surroundings.display import primitive_mesh
 
-                pv, pf = primitive_mesh(part, size)
+                # a plane is drawn as a square of the scene's size under the clips
+                near = None if part.frame == "body" else centre
+                pv, pf = primitive_mesh(part, 1.5 * size, near)
                 meshes.append((b, pv @ rot0.T + o, pf))
             labels.append(part_label(body.name, k, part))
             part_body.append(b)

@@ -76,9 +76,9 @@ def decimate(vertices: np.ndarray, faces: np.ndarray, max_faces: int = MAX_FACES
         cells *= 0.7
 
 
-def primitive_mesh(part, size: float) -> tuple[np.ndarray, np.ndarray]:
+def primitive_mesh(part, size: float, near=None) -> tuple[np.ndarray, np.ndarray]:
     """A triangle mesh of an analytic part (in its own coordinates); a plane becomes a square
-    of side 2 ``size`` around its point."""
+    of side ``size`` around the projection of ``near`` (default: its point)."""
     import trimesh
 
     from cablelife.simulate import euler_matrix
@@ -90,7 +90,10 @@ def primitive_mesh(part, size: float) -> tuple[np.ndarray, np.ndarray]:
         u /= np.linalg.norm(u)
         w = np.cross(n, u)
         p = np.asarray(part.point, float)
-        v = np.array([p + size * (a * u + b * w) for a, b in ((-1, -1), (1, -1), (1, 1), (-1, 1))])
+        if near is not None:
+            p = near - n * (np.asarray(near, float) - p).dot(n)
+        h = size / 2
+        v = np.array([p + h * (a * u + b * w) for a, b in ((-1, -1), (1, -1), (1, 1), (-1, 1))])
         return v, np.array([[0, 1, 2], [0, 2, 3]])
     t = np.eye(4)
     t[:3, 3] = part.center
