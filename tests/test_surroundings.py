@@ -577,3 +577,27 @@ def test_report_has_the_clearance_section(scene_dict, tmp_path):
     assert "clearance of hose to the surroundings" in html
     assert "clearance of hose along the cable" in html  # the envelope figure
     assert "least clearance" in html and "floor/plane#0" in html
+
+
+def test_motion_volume_against_the_bodies(scene_dict):
+    """A straight cable through a 0.1 m thick box: the volume inside is the tube's
+    π r² · 0.1 m (to the voxel resolution), the least distance the node depth."""
+    from cablelife.simulate import simulate
+    from cablelife.surroundings.volume import volume_vs_surroundings
+
+    d = copy.deepcopy(scene_dict)
+    d["simulation"]["gravity"] = [0, 0, 0]
+    d["cables"][0]["clips"][1]["position"] = [1.0, 0.0, 0.0]
+    d["bodies"] = [
+        {
+            "name": "wall",
+            "geometry": [{"shape": "box", "center": [0.5, 0, 0], "size": [0.1, 0.2, 0.2]}],
+        },
+        {"name": "far", "geometry": [{"shape": "sphere", "center": [0.5, 0.3, 0], "radius": 0.1}]},
+    ]
+    res = simulate(scene_from_dict(d))
+    wall, far = volume_vs_surroundings(res, voxel=0.0005)
+    assert wall.min_distance == pytest.approx(-0.05 - RADIUS, abs=1e-12)
+    exact = math.pi * RADIUS**2 * 0.1
+    assert wall.intersection == pytest.approx(exact, rel=0.03)
+    assert far.intersection == 0.0 and far.min_distance == pytest.approx(0.2 - RADIUS, abs=2e-4)
