@@ -8,7 +8,7 @@
 //! point is.
 use std::fmt;
 
-use crate::closest::{point_triangle, segment_triangle, Feature};
+use crate::closest::{point_segment, point_triangle, segment_triangle, Feature};
 use crate::{PointProjection, SegmentProjection, Surface, V3};
 
 const LEAF_SIZE: usize = 4;
@@ -80,6 +80,9 @@ pub struct TriMesh {
     /// Vertex indices of the triangles (for the vertex pseudo-normals).
     corners: Vec<[u32; 3]>,
     face_normals: Vec<V3>,
+    /// Bounding sphere (centroid, radius) of each triangle: a cheap, tight lower bound of its
+    /// distance to a segment.
+    spheres: Vec<(V3, f64)>,
     edge_normals: Vec<[V3; 3]>,
     vertex_normals: Vec<V3>,
     nodes: Vec<Node>,
@@ -176,6 +179,7 @@ impl TriMesh {
             .map(|&i| faces[i].map(|k| vertices[k as usize]))
             .collect();
         let corners = order.iter().map(|&i| faces[i]).collect();
+        let spheres = triangles_spheres(&order, faces, vertices);
         let face_normals: Vec<V3> = order.iter().map(|&i| normals[i]).collect();
         let edge_normals = order
             .iter()
@@ -185,6 +189,7 @@ impl TriMesh {
             triangles,
             corners,
             face_normals,
+            spheres,
             edge_normals,
             vertex_normals,
             nodes,
@@ -232,6 +237,11 @@ impl TriMesh {
             if node.count > 0 {
                 let start = node.index as usize;
                 for t in start..start + node.count as usize {
+                    let (sc, sr) = &self.spheres[t];
+                    let ds = ((sc - p).norm() - sr).max(0.0);
+                    if ds * ds > best_d2 {
+                        continue;
+                    }
                     let [a, b, c] = &self.triangles[t];
                     let h = self.face_normals[t].dot(&(p - a));
                     if h * h > best_d2 {
@@ -281,9 +291,14 @@ impl TriMesh {
             db.max(dm * dm)
         };
         let check = |t: usize, best_d2: &mut f64, best: &mut Option<_>| {
+            // cheap lower bounds first: the triangle's bounding sphere, its plane
+            let (c, rad) = &self.spheres[t];
+            let (_, y) = point_segment(c, a, b);
+            let lb = ((c - y).norm() - rad).max(0.0);
+            if lb * lb > *best_d2 {
+                return;
+            }
             let [p, q, r] = &self.triangles[t];
-            // cheap lower bounds first: the triangle's plane, then the midpoint's distance
-            // minus the half length
             let n = &self.face_normals[t];
             let (ha, hb) = (n.dot(&(a - p)), n.dot(&(b - p)));
             let h = if ha * hb <= 0.0 {
@@ -292,11 +307,6 @@ impl TriMesh {
                 ha.abs().min(hb.abs())
             };
             if h * h > *best_d2 {
-                return;
-            }
-            let (cm, _) = point_triangle(&mid, p, q, r);
-            let lb = ((cm - mid).norm() - half).max(0.0);
-            if lb * lb > *best_d2 {
                 return;
             }
             let (s, x, y) = segment_triangle(a, b, p, q, r);
@@ -391,6 +401,18 @@ impl Surface for TriMesh {
             feature: t,
         })
     }
+}
+
+fn triangles_spheres(order: &[usize], faces: &[[u32; 3]], vertices: &[V3]) -> Vec<(V3, f64)> {
+    order
+        .iter()
+        .map(|&i| {
+            let v = faces[i].map(|k| vertices[k as usize]);
+            let c = (v[0] + v[1] + v[2]) / 3.0;
+            let r = v.iter().map(|x| (x - c).norm()).fold(0.0, f64::max);
+            (c, r * (1.0 + 1e-12))
+        })
+        .collect()
 }
 
 #[inline]
