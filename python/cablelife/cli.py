@@ -131,6 +131,11 @@ def print_summary(result: Result) -> None:
                 escape(clip), f"{v['s']:.3f}", f"{v['max_force']:.4g}", f"{v['max_moment']:.4g}"
             )
         console.print(ct)
+        if c.surroundings is not None:
+            from cablelife.surroundings.summary import clearance_tables
+
+            for table in clearance_tables(c):
+                console.print(table)
 
 
 @app.command()

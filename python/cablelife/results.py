@@ -15,6 +15,8 @@ HDF5 layout (every dataset carries a ``unit`` attribute)::
     /cables/<name>/section       attrs: shape, outer_radius, inner_radius, poisson_ratio,
                                         EA, GA1, GA2, EI1, EI2, GJ, mass_per_length, from_measured
     /cables/<name>/solver        attrs and datasets: iterations (T,), residual (T,), ...
+    /cables/<name>/clearance, clearance_body, clearance_part   (T, N+1) with geometry
+                                 (see cablelife.surroundings.data)
 
 Datasets are chunked and compressed (gzip level 1 with the shuffle filter: lossless, readable by
 any HDF5 tool); the histories (positions … clip reactions) are float64, or float32 when the
@@ -33,6 +35,8 @@ import numpy as np
 
 from cablelife.h5files import atomic_h5, open_h5, plain
 from cablelife.resultcheck import check_result_file, check_result_values, warn_partial
+from cablelife.surroundings.data import CableClearance
+from cablelife.surroundings.display import SurroundingsGeometry
 
 if TYPE_CHECKING:
     import h5py
@@ -133,6 +137,18 @@ class CableResult:
     section: dict = field(default_factory=dict)
     solver: dict = field(default_factory=dict)
     energies: dict[str, np.ndarray] = field(default_factory=dict)
+    surroundings: CableClearance | None = None  # clearance to the scene's geometry
+
+    @property
+    def clearance(self) -> np.ndarray | None:
+        """(T, N+1) clearance of the cable surface to the nearest geometry, m (None without
+        geometry); negative inside. See docs/environment.md."""
+        return None if self.surroundings is None else self.surroundings.value
+
+    @property
+    def clearance_body(self) -> np.ndarray | None:
+        """(T, N+1) index of the nearest body into ``surroundings.bodies``."""
+        return None if self.surroundings is None else self.surroundings.body
 
     def __repr__(self) -> str:
         return (
@@ -174,6 +190,7 @@ class Result:
     message: str = ""
     #: Precision of the histories in the file ("float64" or "float32"; docs/results.md).
     precision: str = "float64"
+    surroundings: SurroundingsGeometry | None = None  # body geometry and poses, for pictures
 
     @property
     def cable(self) -> CableResult:
@@ -252,6 +269,10 @@ def save_result(result: Result, path: str | os.PathLike, precision: str | None =
                     _put(sol, key, value)
                 else:
                     sol.attrs[key] = value
+            if c.surroundings is not None:
+                c.surroundings.write(g)
+        if result.surroundings is not None:
+            result.surroundings.write(f)
     return path
 
 
@@ -293,6 +314,7 @@ def load_result(path: str | os.PathLike, lazy: bool = True) -> Result:
                 section={k: plain(v) for k, v in g["section"].attrs.items()},
                 solver={k: plain(v) for k, v in solver.items()},
                 energies=energies,
+                surroundings=CableClearance.read(g),
             )
         result = Result(
             mode=str(f.attrs["mode"]),
@@ -301,6 +323,7 @@ def load_result(path: str | os.PathLike, lazy: bool = True) -> Result:
             complete=bool(f.attrs.get("complete", True)),
             message=str(f.attrs.get("message", "")),
             precision=str(f.attrs.get("precision", "float64")),
+            surroundings=SurroundingsGeometry.read(f),
         )
     check_result_values(result, path)  # no NaN into reports, VTK files, damage maps
     warn_partial(result, path)

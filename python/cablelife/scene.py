@@ -27,6 +27,7 @@ from cablelife.limits import LIMITS, MAX_SEGMENTS, MIN_SEGMENTS, check_name
 from cablelife.paths import SceneFileError, resolve_scene_file, shown_names
 from cablelife.sections import SectionProperties, from_material, from_measured
 from cablelife.signals.spec import ChannelMotion, TableSignal
+from cablelife.surroundings.models import ClearanceSettings, GeometryPart
 from cablelife.tomlfile import read_toml
 
 # Strict numbers: a TOML number is a number (ints are fine where floats are wanted); booleans
@@ -318,6 +319,7 @@ class Body(_Model):
     orientation: Vec3 = (0.0, 0.0, 0.0)  # rx, ry, rz (rad) of the body frame, R = Rz Ry Rx
     motion: list[ChannelMotion] = []
     motion_file: Path | None = None
+    geometry: list[GeometryPart] = []  # shapes moving with the body (docs/environment.md)
 
     @model_validator(mode="after")
     def _one_motion(self):
@@ -418,6 +420,7 @@ class Scene(_Model):
     files: Files = Files()
     bodies: list[Body] = []
     cables: Annotated[list[Cable], Field(min_length=1)]
+    clearance: ClearanceSettings | None = None  # settings of the clearance to the geometry
     base_dir: Annotated[Path | None, Field(exclude=True)] = None
 
     @model_validator(mode="after")

@@ -20,6 +20,8 @@ from cablelife.results import CableResult, ClipReaction, Result
 from cablelife.rotations import euler_matrix, matrix_quaternions
 from cablelife.scene import Cable, Scene, SceneError
 from cablelife.signals import body_motion, time_grid
+from cablelife.surroundings.build import load_surroundings
+from cablelife.surroundings.clearance import add_clearance
 
 Progress = Callable[[str, int, int], None]
 
@@ -102,15 +104,11 @@ def output_times(scene: Scene, mode: str) -> np.ndarray:
     return time_grid(sim.duration, sim.output_step or sim.time_step)
 
 
-def clip_kinematics(
-    scene: Scene, cable: Cable, times: np.ndarray, with_motion: bool = True
-) -> dict[str, np.ndarray]:
-    """Clip kinematics on ``times``: positions (T, C, 3), quaternions scalar first (T, C, 4),
-    velocities, angular velocities, accelerations, angular accelerations (T, C, 3), global.
-    Without ``with_motion``: the reference poses (bodies at rest)."""
-    n_t, n_c = times.size, len(cable.clips)
+def body_motions(scene: Scene, times: np.ndarray, with_motion: bool = True) -> dict:
+    """Per body name: (body, R0 its axes at rest, its BodyMotion on ``times`` or None when it
+    does not move). Clips and the surroundings' geometry move with these motions."""
     grid = times
-    if n_t == 1:  # one pose (static run): the motions' value at that time
+    if times.size == 1:  # one pose (static run): the motions' value at that time on their grid
         sim = scene.simulation
         grid = (  # on the run's grid only where the value depends on it (PSD, measured)
             time_grid(sim.duration, sim.time_step, times[0])
@@ -127,6 +125,17 @@ def clip_kinematics(
         channels = body.channel_motions(scene.base_dir, allow) if with_motion else []
         motion = body_motion(channels, grid, scene.base_dir, r0, allow) if channels else None
         motions[body.name] = (body, r0, motion)
+    return motions
+
+
+def clip_kinematics(
+    scene: Scene, cable: Cable, times: np.ndarray, with_motion: bool = True
+) -> dict[str, np.ndarray]:
+    """Clip kinematics on ``times``: positions (T, C, 3), quaternions scalar first (T, C, 4),
+    velocities, angular velocities, accelerations, angular accelerations (T, C, 3), global.
+    Without ``with_motion``: the reference poses (bodies at rest)."""
+    n_t, n_c = times.size, len(cable.clips)
+    motions = body_motions(scene, times, with_motion)
     out = {
         k: np.zeros((n_t, n_c, 3))
         for k in (
@@ -430,6 +439,7 @@ def simulate(scene: Scene, mode: str | None = None, progress: Progress | None = 
         )
     check_run_size(scene, mode)
     times = output_times(scene, mode)
+    env = load_surroundings(scene)  # reads and checks the geometry before the run
     workers = max(1, min(len(scene.cables), os.cpu_count() or 1))
     with interrupt.stop_flag() as stop, ThreadPoolExecutor(max_workers=workers) as pool:
         futures = [
@@ -448,6 +458,8 @@ def simulate(scene: Scene, mode: str | None = None, progress: Progress | None = 
         message=interrupt.INTERRUPTED if errors and stop.is_set else "; ".join(errors),
         precision=scene.simulation.output_precision,
     )
+    if env is not None:
+        add_clearance(env, scene, result, times, output_every(scene) if mode == "dynamic" else 1)
     if errors:
         raise SimulationError(result.message, result)
     return result

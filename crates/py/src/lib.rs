@@ -4,6 +4,7 @@ use pyo3::prelude::*;
 mod cable;
 mod fatigue;
 mod stop;
+mod geometry;
 mod volume;
 
 #[pymodule]
@@ -13,5 +14,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     volume::register(m)?;
     fatigue::register(m)?;
     stop::register(m)?;
+    geometry::register(m)?;
     Ok(())
 }

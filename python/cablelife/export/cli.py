@@ -53,6 +53,10 @@ def paraview_command(
             written.append(
                 write_paraview(res.cables[name], out, damage=dm, steps=slice(None, None, every))
             )
+        if res.surroundings is not None:  # the bodies' geometry, moving with them
+            from cablelife.surroundings.paraview import write_bodies
+
+            written.append(write_bodies(res.surroundings, output, slice(None, None, every)))
     except KeyboardInterrupt:
         from cablelife.interrupt import interrupted
 

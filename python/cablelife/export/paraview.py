@@ -4,8 +4,10 @@ the times. The cable is N line cells (its edges) between N+1 points (its nodes).
 Point data (nodes): ``moment`` (M1, M2, M3, material frame, N m), ``bending_moment`` |M1, M2|,
 ``torsion`` M3, ``curvature`` (1/m, material frame), ``bend_radius`` (m; straight stretches
 get 1e9), ``displacement`` (from the first saved step, m), ``arc_length`` (m) and, when
-given, ``damage``. Cell data (edges): ``force`` (F1, F2, F3 material frame, N), ``force_global``
-(N), ``shear_force`` |F1, F2|, ``tension`` F3. Field data: ``tube_radius`` (m), ``time`` (s).
+given, ``damage``; with geometry in the scene ``clearance`` (m) and ``clearance_body``
+(index of the nearest body). Cell data (edges): ``force`` (F1, F2, F3 material frame, N),
+``force_global`` (N), ``shear_force`` |F1, F2|, ``tension`` F3. Field data: ``tube_radius``
+(m), ``time`` (s).
 
 With a damage map (an LDA result) every step also gets the tube surface as a second part
 (``<stem>_tube_<k>.vtp``, triangles): point data ``damage`` at each vertex (surface angle γ
@@ -26,6 +28,7 @@ import numpy as np
 from cablelife.atomic import write_text_atomic
 from cablelife.export.frames import to_global
 from cablelife.results import CableResult
+from cablelife.surroundings.paraview import clearance_point_data
 
 #: Bend radius written where the cable is straight (VTK readers dislike inf).
 STRAIGHT = 1e9
@@ -203,6 +206,7 @@ def write_paraview(
         }
         if node_damage is not None:
             point_data["damage"] = node_damage
+        point_data.update(clearance_point_data(cable, k))
         cell_data = {
             "force": f,
             "force_global": to_global(cable.quaternions[k], f),

@@ -471,6 +471,10 @@ def _run_section(page, k, run: ReportRun, volumes, color_by, frames, factor, cac
         if c.clips and alone:
             page.plot(plot_clip_reactions(one), f"clip reactions of {name}")
         _frequencies(page, res, name, cache, run.label)
+        if c.surroundings is not None:
+            from cablelife.report.surroundings import surroundings_section
+
+            surroundings_section(page, res, name)
         if run.damage_of(name) is not None:
             _damage_section(page, run, name, alone)
 

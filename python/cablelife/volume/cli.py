@@ -107,4 +107,15 @@ def volume_command(
         ct.add_row("A sticks out of B by", f"{c.a_beyond_b.distance * 1e3:.2f} mm")
         ct.add_row("B sticks out of A by", f"{c.b_beyond_a.distance * 1e3:.2f} mm")
         console.print(ct)
+    res = load_result(result)
+    if res.surroundings is not None:
+        from cablelife.surroundings.volume import volume_vs_surroundings
+
+        st = Table(title="motion volume relative to each body (all cables)", title_justify="left")
+        st.add_column("body")
+        st.add_column(escape("least distance [mm]"), justify="right")
+        st.add_column(escape("volume inside the body [l]"), justify="right")
+        for chk in volume_vs_surroundings(res, h):
+            st.add_row(escape(chk.body), f"{chk.min_distance * 1e3:.2f}", f"{chk.intersection * 1e3:.4g}")
+        console.print(st)
     console.print(escape(f"mesh saved to {output}"))

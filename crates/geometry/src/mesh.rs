@@ -1,0 +1,665 @@
+//! Triangle mesh with a bounding volume hierarchy and angle-weighted pseudo-normals.
+//!
+//! The sign of a point's distance is that of (p − c)·n with c the closest point and n the
+//! pseudo-normal of the feature c lies on: the face normal inside a face, the sum of the
+//! adjacent face normals on an edge, the angle-weighted sum of the incident face normals at a
+//! vertex (Bærentzen & Aanæs 2005). For a closed, consistently oriented mesh this is the exact
+//! inside test; for an open mesh it says on which side of the surface (by its normals) the
+//! point is.
+use std::fmt;
+
+use crate::closest::{point_segment, point_triangle, segment_triangle, Feature};
+use crate::{PointProjection, SegmentProjection, Surface, V3};
+
+const LEAF_SIZE: usize = 4;
+const PARALLEL_BUILD: usize = 20_000;
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct MeshError(pub String);
+
+impl fmt::Display for MeshError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for MeshError {}
+
+#[derive(Clone, Copy, Debug)]
+struct Node {
+    min: V3,
+    max: V3,
+    /// Slab bound: the node's triangles lie in lo ≤ axis·x ≤ hi (axis zero: no slab). Tight
+    /// where the surface is nearly flat, which the box is not when the surface is inclined.
+    axis: V3,
+    lo: f64,
+    hi: f64,
+    /// Leaf: first triangle; inner node: index of the right child (the left one follows).
+    index: u32,
+    /// Leaf: number of triangles (> 0); inner node: 0.
+    count: u32,
+}
+
+impl Node {
+    #[inline]
+    fn distance2_point(&self, p: &V3) -> f64 {
+        let mut d2 = 0.0;
+        for k in 0..3 {
+            let e = (self.min[k] - p[k]).max(p[k] - self.max[k]).max(0.0);
+            d2 += e * e;
+        }
+        let x = self.axis.dot(p);
+        let e = (self.lo - x).max(x - self.hi).max(0.0);
+        d2.max(e * e)
+    }
+
+    /// Lower bound of the squared distance of segment [a, b] (with box lo..hi).
+    #[inline]
+    fn distance2_segment(&self, a: &V3, b: &V3, lo: &V3, hi: &V3) -> f64 {
+        let d2 = self.distance2_box(lo, hi);
+        let (xa, xb) = (self.axis.dot(a), self.axis.dot(b));
+        let e = (self.lo - xa.max(xb)).max(xa.min(xb) - self.hi).max(0.0);
+        d2.max(e * e)
+    }
+
+    #[inline]
+    fn distance2_box(&self, lo: &V3, hi: &V3) -> f64 {
+        let mut d2 = 0.0;
+        for k in 0..3 {
+            let e = (self.min[k] - hi[k]).max(lo[k] - self.max[k]).max(0.0);
+            d2 += e * e;
+        }
+        d2
+    }
+}
+
+/// A triangle mesh ready for distance queries.
+pub struct TriMesh {
+    /// Triangles in hierarchy order.
+    triangles: Vec<[V3; 3]>,
+    /// Vertex indices of the triangles (for the vertex pseudo-normals).
+    corners: Vec<[u32; 3]>,
+    face_normals: Vec<V3>,
+    /// Bounding sphere (centroid, radius) of each triangle: a cheap, tight lower bound of its
+    /// distance to a segment.
+    spheres: Vec<(V3, f64)>,
+    edge_normals: Vec<[V3; 3]>,
+    vertex_normals: Vec<V3>,
+    nodes: Vec<Node>,
+}
+
+impl TriMesh {
+    /// Builds the mesh from vertices and triangles (vertex indices; shared vertices must be
+    /// merged for the pseudo-normals to see the neighbours). Degenerate triangles (zero area)
+    /// are an error: drop them before.
+    pub fn new(vertices: &[V3], faces: &[[u32; 3]]) -> Result<Self, MeshError> {
+        if faces.is_empty() {
+            return Err(MeshError("the mesh has no triangles".into()));
+        }
+        if let Some(v) = vertices.iter().find(|v| !v.iter().all(|x| x.is_finite())) {
+            return Err(MeshError(format!("vertex {v:?} is not finite")));
+        }
+        let n_v = vertices.len() as u32;
+        let mut normals = Vec::with_capacity(faces.len());
+        for (i, f) in faces.iter().enumerate() {
+            if f.iter().any(|&k| k >= n_v) {
+                return Err(MeshError(format!(
+                    "triangle {i} has vertex index {f:?} beyond the {n_v} vertices"
+                )));
+            }
+            let [a, b, c] = f.map(|k| vertices[k as usize]);
+            let n = (b - a).cross(&(c - a));
+            let len = n.norm();
+            if len == 0.0 || !len.is_finite() {
+                return Err(MeshError(format!("triangle {i} is degenerate (zero area)")));
+            }
+            normals.push(n / len);
+        }
+        // vertex pseudo-normals: incident face normals weighted by the incident angle
+        let mut vertex_normals = vec![V3::zeros(); vertices.len()];
+        for (f, n) in faces.iter().zip(&normals) {
+            for k in 0..3 {
+                let p = vertices[f[k] as usize];
+                let u = vertices[f[(k + 1) % 3] as usize] - p;
+                let w = vertices[f[(k + 2) % 3] as usize] - p;
+                let angle = u.angle(&w);
+                vertex_normals[f[k] as usize] += n * angle;
+            }
+        }
+        // edge pseudo-normals: sum of the normals of the faces sharing the edge (edges grouped
+        // by sorting their vertex pairs)
+        let mut keys: Vec<(u64, u32)> = Vec::with_capacity(faces.len() * 3);
+        for (i, f) in faces.iter().enumerate() {
+            for k in 0..3 {
+                keys.push((edge_key(f[k], f[(k + 1) % 3]), (3 * i + k) as u32));
+            }
+        }
+        keys.sort_unstable();
+        let mut edge_of = vec![V3::zeros(); faces.len() * 3];
+        let mut g = 0;
+        while g < keys.len() {
+            let mut h = g;
+            let mut sum = V3::zeros();
+            while h < keys.len() && keys[h].0 == keys[g].0 {
+                sum += normals[keys[h].1 as usize / 3];
+                h += 1;
+            }
+            for key in &keys[g..h] {
+                edge_of[key.1 as usize] = sum;
+            }
+            g = h;
+        }
+        drop(keys);
+        // hierarchy over the triangle centroids
+        let mut items: Vec<(V3, u32)> = faces
+            .iter()
+            .enumerate()
+            .map(|(i, f)| {
+                let c = f.iter().fold(V3::zeros(), |s, &k| s + vertices[k as usize]) / 3.0;
+                (c, i as u32)
+            })
+            .collect();
+        let boxes: Vec<(V3, V3)> = faces
+            .iter()
+            .map(|f| {
+                let [a, b, c] = f.map(|k| vertices[k as usize]);
+                (a.inf(&b).inf(&c), a.sup(&b).sup(&c))
+            })
+            .collect();
+        let ctx = BuildData {
+            boxes: &boxes,
+            vertices,
+            faces,
+            normals: &normals,
+        };
+        let nodes = build(&mut items, 0, &ctx);
+        let order: Vec<usize> = items.iter().map(|&(_, i)| i as usize).collect();
+        let triangles = order
+            .iter()
+            .map(|&i| faces[i].map(|k| vertices[k as usize]))
+            .collect();
+        let corners = order.iter().map(|&i| faces[i]).collect();
+        let spheres = triangles_spheres(&order, faces, vertices);
+        let face_normals: Vec<V3> = order.iter().map(|&i| normals[i]).collect();
+        let edge_normals = order
+            .iter()
+            .map(|&i| [0, 1, 2].map(|k| edge_of[3 * i + k]))
+            .collect();
+        Ok(TriMesh {
+            triangles,
+            corners,
+            face_normals,
+            spheres,
+            edge_normals,
+            vertex_normals,
+            nodes,
+        })
+    }
+
+    pub fn n_triangles(&self) -> usize {
+        self.triangles.len()
+    }
+
+    /// Axis-aligned bounding box (min, max).
+    pub fn bounds(&self) -> (V3, V3) {
+        (self.nodes[0].min, self.nodes[0].max)
+    }
+
+    #[inline]
+    fn pseudo_normal(&self, tri: usize, feature: Feature) -> V3 {
+        match feature {
+            Feature::Face => self.face_normals[tri],
+            Feature::Edge(k) => self.edge_normals[tri][k as usize],
+            Feature::Vertex(k) => self.vertex_normals[self.corners[tri][k as usize] as usize],
+        }
+    }
+
+    /// Closest triangle to p within sqrt(best_d2): (triangle, closest point, squared distance).
+    fn nearest_triangle(&self, p: &V3, mut best_d2: f64, hint: usize) -> Option<(usize, V3)> {
+        let mut best = None;
+        if hint < self.triangles.len() {
+            let [a, b, c] = &self.triangles[hint];
+            let (cp, _) = point_triangle(p, a, b, c);
+            let d2 = (cp - p).norm_squared();
+            if d2 <= best_d2 {
+                best_d2 = d2;
+                best = Some((hint, cp));
+            }
+        }
+        let mut stack = [0u32; 64];
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let node = &self.nodes[stack[top] as usize];
+            if node.distance2_point(p) > best_d2 {
+                continue;
+            }
+            if node.count > 0 {
+                let start = node.index as usize;
+                for t in start..start + node.count as usize {
+                    let (sc, sr) = &self.spheres[t];
+                    let ds = ((sc - p).norm() - sr).max(0.0);
+                    if ds * ds > best_d2 {
+                        continue;
+                    }
+                    let [a, b, c] = &self.triangles[t];
+                    let h = self.face_normals[t].dot(&(p - a));
+                    if h * h > best_d2 {
+                        continue;
+                    }
+                    let (cp, _) = point_triangle(p, a, b, c);
+                    let d2 = (cp - p).norm_squared();
+                    if d2 < best_d2 || (d2 == best_d2 && best.is_none()) {
+                        best_d2 = d2;
+                        best = Some((t, cp));
+                    }
+                }
+            } else {
+                let left = stack[top] + 1;
+                let right = node.index;
+                let dl = self.nodes[left as usize].distance2_point(p);
+                let dr = self.nodes[right as usize].distance2_point(p);
+                // nearer child on top of the stack
+                let (near, far) = if dl <= dr {
+                    (left, right)
+                } else {
+                    (right, left)
+                };
+                stack[top] = far;
+                stack[top + 1] = near;
+                top += 2;
+            }
+        }
+        best
+    }
+
+    /// Closest triangle to segment [a, b] within sqrt(best_d2).
+    fn nearest_to_segment(
+        &self,
+        a: &V3,
+        b: &V3,
+        mut best_d2: f64,
+        hint: usize,
+    ) -> Option<(usize, f64, V3, V3)> {
+        let mut best = None;
+        let mid = (a + b) * 0.5;
+        let half = (b - a).norm() * 0.5;
+        let (lo, hi) = (a.inf(b), a.sup(b));
+        let lower2 = |n: &Node| {
+            let db = n.distance2_segment(a, b, &lo, &hi);
+            let dm = (n.distance2_point(&mid).sqrt() - half).max(0.0);
+            db.max(dm * dm)
+        };
+        let check = |t: usize, best_d2: &mut f64, best: &mut Option<_>| {
+            // cheap lower bounds first: the triangle's bounding sphere, its plane
+            let (c, rad) = &self.spheres[t];
+            let (_, y) = point_segment(c, a, b);
+            let lb = ((c - y).norm() - rad).max(0.0);
+            if lb * lb > *best_d2 {
+                return;
+            }
+            let [p, q, r] = &self.triangles[t];
+            let n = &self.face_normals[t];
+            let (ha, hb) = (n.dot(&(a - p)), n.dot(&(b - p)));
+            let h = if ha * hb <= 0.0 {
+                0.0
+            } else {
+                ha.abs().min(hb.abs())
+            };
+            if h * h > *best_d2 {
+                return;
+            }
+            let (s, x, y) = segment_triangle(a, b, p, q, r);
+            let d2 = (x - y).norm_squared();
+            if d2 < *best_d2 || (d2 == *best_d2 && best.is_none()) {
+                *best_d2 = d2;
+                *best = Some((t, s, x, y));
+            }
+        };
+        if hint < self.triangles.len() {
+            check(hint, &mut best_d2, &mut best);
+        }
+        let mut stack = [0u32; 64];
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let node = &self.nodes[stack[top] as usize];
+            if lower2(node) > best_d2 {
+                continue;
+            }
+            if node.count > 0 {
+                let start = node.index as usize;
+                for t in start..start + node.count as usize {
+                    check(t, &mut best_d2, &mut best);
+                }
+            } else {
+                let left = stack[top] + 1;
+                let right = node.index;
+                let dl = self.nodes[left as usize].distance2_point(&mid);
+                let dr = self.nodes[right as usize].distance2_point(&mid);
+                let (near, far) = if dl <= dr {
+                    (left, right)
+                } else {
+                    (right, left)
+                };
+                stack[top] = far;
+                stack[top + 1] = near;
+                top += 2;
+            }
+        }
+        best
+    }
+}
+
+impl Surface for TriMesh {
+    fn project_point(&self, p: &V3, max_distance: f64, hint: usize) -> Option<PointProjection> {
+        let (t, c) = self.nearest_triangle(p, max_distance * max_distance, hint)?;
+        let [a, b, cc] = &self.triangles[t];
+        let (_, feature) = point_triangle(p, a, b, cc);
+        let n = self.pseudo_normal(t, feature);
+        let d = p - c;
+        let dist = d.norm();
+        let sign = if d.dot(&n) < 0.0 { -1.0 } else { 1.0 };
+        let normal = if dist > 1e-12 * (1.0 + c.norm()) {
+            d * (sign / dist)
+        } else {
+            n.normalize()
+        };
+        Some(PointProjection {
+            distance: sign * dist,
+            point: c,
+            normal,
+            feature: t,
+        })
+    }
+
+    fn closest_to_segment(
+        &self,
+        a: &V3,
+        b: &V3,
+        max_distance: f64,
+        hint: usize,
+    ) -> Option<SegmentProjection> {
+        let (t, s, x, y) = self.nearest_to_segment(a, b, max_distance * max_distance, hint)?;
+        let [p, q, r] = &self.triangles[t];
+        let (_, feature) = point_triangle(&x, p, q, r);
+        let n = self.pseudo_normal(t, feature);
+        let d = x - y;
+        let dist = d.norm();
+        let normal = if dist > 1e-12 * (1.0 + y.norm()) {
+            let sign = if d.dot(&n) < 0.0 { -1.0 } else { 1.0 };
+            d * (sign / dist)
+        } else {
+            n.normalize()
+        };
+        Some(SegmentProjection {
+            distance: dist,
+            t: s,
+            on_segment: x,
+            on_surface: y,
+            normal,
+            feature: t,
+        })
+    }
+}
+
+fn triangles_spheres(order: &[usize], faces: &[[u32; 3]], vertices: &[V3]) -> Vec<(V3, f64)> {
+    order
+        .iter()
+        .map(|&i| {
+            let v = faces[i].map(|k| vertices[k as usize]);
+            let c = (v[0] + v[1] + v[2]) / 3.0;
+            let r = v.iter().map(|x| (x - c).norm()).fold(0.0, f64::max);
+            (c, r * (1.0 + 1e-12))
+        })
+        .collect()
+}
+
+#[inline]
+fn edge_key(a: u32, b: u32) -> u64 {
+    let (lo, hi) = if a < b { (a, b) } else { (b, a) };
+    ((lo as u64) << 32) | hi as u64
+}
+
+struct BuildData<'a> {
+    boxes: &'a [(V3, V3)],
+    vertices: &'a [V3],
+    faces: &'a [[u32; 3]],
+    normals: &'a [V3],
+}
+
+/// Subtrees up to this many triangles get a slab bound (the surface is nearly flat there).
+const SLAB_MAX: usize = 64;
+
+/// The slab of a node's triangles: axis = mean normal, and the range of axis·x over them.
+fn slab(items: &[(V3, u32)], d: &BuildData) -> (V3, f64, f64) {
+    let none = (V3::zeros(), f64::NEG_INFINITY, f64::INFINITY);
+    if items.len() > SLAB_MAX {
+        return none;
+    }
+    let mean: V3 = items.iter().map(|(_, i)| d.normals[*i as usize]).sum();
+    let len = mean.norm();
+    if len < 0.5 * items.len() as f64 {
+        return none; // normals spread: the slab would not be thin
+    }
+    let axis = mean / len;
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for (_, i) in items {
+        for &k in &d.faces[*i as usize] {
+            let x = axis.dot(&d.vertices[k as usize]);
+            lo = lo.min(x);
+            hi = hi.max(x);
+        }
+    }
+    // widen by the round-off of the projections
+    let pad = 1e-12 * (lo.abs() + hi.abs() + (hi - lo));
+    (axis, lo - pad, hi + pad)
+}
+
+/// Builds the hierarchy over `items` (centroid, triangle), reordering them; `offset` is the
+/// position of items[0] in the whole triangle order. Nodes in depth-first order.
+fn build(items: &mut [(V3, u32)], offset: usize, d: &BuildData) -> Vec<Node> {
+    let boxes = d.boxes;
+    if items.len() <= LEAF_SIZE {
+        let (mut lo, mut hi) = (V3::repeat(f64::INFINITY), V3::repeat(f64::NEG_INFINITY));
+        for (_, i) in items.iter() {
+            let (a, b) = boxes[*i as usize];
+            lo = lo.inf(&a);
+            hi = hi.sup(&b);
+        }
+        let (axis, slo, shi) = slab(items, d);
+        return vec![Node {
+            min: lo,
+            max: hi,
+            axis,
+            lo: slo,
+            hi: shi,
+            index: offset as u32,
+            count: items.len() as u32,
+        }];
+    }
+    let (mut clo, mut chi) = (V3::repeat(f64::INFINITY), V3::repeat(f64::NEG_INFINITY));
+    for (c, _) in items.iter() {
+        clo = clo.inf(c);
+        chi = chi.sup(c);
+    }
+    let (slab_axis, slab_lo, slab_hi) = slab(items, d);
+    let axis = (chi - clo).imax();
+    let mid = items.len() / 2;
+    items.select_nth_unstable_by(mid, |x, y| x.0[axis].total_cmp(&y.0[axis]));
+    let (left_items, right_items) = items.split_at_mut(mid);
+    let (left, right) = if left_items.len() + right_items.len() > PARALLEL_BUILD {
+        rayon::join(
+            || build(left_items, offset, d),
+            || build(right_items, offset + mid, d),
+        )
+    } else {
+        (
+            build(left_items, offset, d),
+            build(right_items, offset + mid, d),
+        )
+    };
+    let mut nodes = Vec::with_capacity(1 + left.len() + right.len());
+    nodes.push(Node {
+        min: left[0].min.inf(&right[0].min),
+        max: left[0].max.sup(&right[0].max),
+        axis: slab_axis,
+        lo: slab_lo,
+        hi: slab_hi,
+        index: (1 + left.len()) as u32,
+        count: 0,
+    });
+    let shift = |mut n: Node, by: usize| {
+        if n.count == 0 {
+            n.index += by as u32;
+        }
+        n
+    };
+    nodes.extend(left.into_iter().map(|n| shift(n, 1)));
+    let by = nodes.len();
+    nodes.extend(right.into_iter().map(|n| shift(n, by)));
+    nodes
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Unit cube [0, 1]³ as 12 outward triangles.
+    pub fn cube() -> TriMesh {
+        let v: Vec<V3> = (0..8)
+            .map(|i| V3::new((i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64))
+            .collect();
+        let quads = [
+            [0, 2, 3, 1], // z = 0, normal −z
+            [4, 5, 7, 6], // z = 1
+            [0, 1, 5, 4], // y = 0
+            [2, 6, 7, 3], // y = 1
+            [0, 4, 6, 2], // x = 0
+            [1, 3, 7, 5], // x = 1
+        ];
+        let mut f = vec![];
+        for q in quads {
+            f.push([q[0], q[1], q[2]]);
+            f.push([q[0], q[2], q[3]]);
+        }
+        TriMesh::new(&v, &f).unwrap()
+    }
+
+    fn cube_sdf(p: &V3) -> f64 {
+        let q = (p - V3::repeat(0.5)).abs() - V3::repeat(0.5);
+        let out = q.sup(&V3::zeros()).norm();
+        out + q.max().min(0.0)
+    }
+
+    #[test]
+    fn cube_signed_distance_is_exact() {
+        let m = cube();
+        let mut seed = 12345u64;
+        let mut rnd = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for _ in 0..2000 {
+            let p = V3::new(rnd() * 3.0 - 1.0, rnd() * 3.0 - 1.0, rnd() * 3.0 - 1.0);
+            let r = m.project_point(&p, f64::INFINITY, usize::MAX).unwrap();
+            assert!((r.distance - cube_sdf(&p)).abs() < 1e-14, "{p:?}");
+            assert!((p - r.point).norm() - r.distance.abs() < 1e-14);
+        }
+        // corners and edges: vertex and edge pseudo-normals decide the sign
+        let r = m
+            .project_point(&V3::new(1.1, 1.1, 1.1), 10.0, usize::MAX)
+            .unwrap();
+        assert!((r.distance - 3f64.sqrt() * 0.1).abs() < 1e-14);
+        let r = m
+            .project_point(&V3::new(0.9, 0.95, 0.5), 10.0, usize::MAX)
+            .unwrap();
+        assert!((r.distance + 0.05).abs() < 1e-14);
+        assert!((r.normal - V3::new(0.0, 1.0, 0.0)).norm() < 1e-14);
+    }
+
+    #[test]
+    fn bound_and_hint() {
+        let m = cube();
+        let p = V3::new(0.5, 0.5, 3.0);
+        assert!(m.project_point(&p, 1.0, usize::MAX).is_none());
+        let r = m.project_point(&p, 2.5, 0).unwrap();
+        assert!((r.distance - 2.0).abs() < 1e-15);
+        let s = m.closest_to_segment(&V3::new(-1., 2., 0.5), &V3::new(2., 2., 0.5), 10.0, 3);
+        let s = s.unwrap();
+        assert!((s.distance - 1.0).abs() < 1e-15);
+        assert!((s.normal - V3::new(0.0, 1.0, 0.0)).norm() < 1e-14);
+        // a segment across a corner: both ends 1 away, the corner √½ − ... closer
+        let s = m
+            .closest_to_segment(
+                &V3::new(2.0, 1.0, 0.5),
+                &V3::new(1.0, 2.0, 0.5),
+                10.0,
+                usize::MAX,
+            )
+            .unwrap();
+        assert!((s.distance - 0.5f64.sqrt()).abs() < 1e-14);
+        assert!((s.t - 0.5).abs() < 1e-12);
+    }
+
+    #[test]
+    fn hierarchy_finds_the_nearest_of_many() {
+        // a 60×60 grid of tilted triangles against brute force
+        let mut v = vec![];
+        let mut f = vec![];
+        for i in 0..60 {
+            for j in 0..60 {
+                let k = v.len() as u32;
+                let (x, y) = (i as f64 * 0.1, j as f64 * 0.1);
+                v.push(V3::new(x, y, (x * 3.0).sin() * 0.1));
+                v.push(V3::new(x + 0.08, y, (y * 2.0).cos() * 0.1));
+                v.push(V3::new(x, y + 0.08, 0.05));
+                f.push([k, k + 1, k + 2]);
+            }
+        }
+        let m = TriMesh::new(&v, &f).unwrap();
+        for q in 0..200 {
+            let p = V3::new(
+                (q as f64 * 0.37) % 6.5 - 0.2,
+                (q as f64 * 0.61) % 6.3,
+                0.3 - q as f64 * 0.003,
+            );
+            let r = m.project_point(&p, f64::INFINITY, usize::MAX).unwrap();
+            let brute = f
+                .iter()
+                .map(|t| {
+                    let (c, _) =
+                        point_triangle(&p, &v[t[0] as usize], &v[t[1] as usize], &v[t[2] as usize]);
+                    (c - p).norm()
+                })
+                .fold(f64::INFINITY, f64::min);
+            assert_eq!(r.distance.abs(), brute);
+            let b = p + V3::new(0.05, -0.03, 0.01);
+            let s = m.closest_to_segment(&p, &b, f64::INFINITY, q).unwrap();
+            let brute = f
+                .iter()
+                .map(|t| {
+                    let (_, x, y) = segment_triangle(
+                        &p,
+                        &b,
+                        &v[t[0] as usize],
+                        &v[t[1] as usize],
+                        &v[t[2] as usize],
+                    );
+                    (x - y).norm()
+                })
+                .fold(f64::INFINITY, f64::min);
+            assert_eq!(s.distance, brute);
+        }
+    }
+
+    #[test]
+    fn bad_meshes_are_errors() {
+        let v = vec![V3::zeros(), V3::x(), V3::y()];
+        assert!(TriMesh::new(&v, &[]).is_err());
+        assert!(TriMesh::new(&v, &[[0, 1, 3]]).is_err());
+        assert!(TriMesh::new(&v, &[[0, 1, 1]]).is_err());
+    }
+}

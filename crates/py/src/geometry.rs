@@ -1,0 +1,334 @@
+//! Bindings of the surroundings' distance queries and the clearance kernel. Parts are added
+//! in their body's reference frame; queries and the clearance run without the GIL.
+use ::geometry::{
+    clearance, Cuboid, Cylinder, HalfSpace, Part, RigidMap, Shape, Sphere, Surface, TriMesh, V3,
+};
+use nalgebra::Matrix3;
+use numpy::{
+    PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2, PyReadonlyArray3, PyReadonlyArray4,
+};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+fn rows3(a: &PyReadonlyArray2<'_, f64>, what: &str) -> PyResult<Vec<V3>> {
+    let v = a.as_array();
+    if v.ncols() != 3 {
+        return Err(PyValueError::new_err(format!(
+            "{what} has shape {:?}: must be (M, 3)",
+            v.shape()
+        )));
+    }
+    Ok(v.rows()
+        .into_iter()
+        .map(|r| V3::new(r[0], r[1], r[2]))
+        .collect())
+}
+
+fn finite(values: &[f64], what: &str) -> PyResult<()> {
+    if values.iter().all(|x| x.is_finite()) {
+        Ok(())
+    } else {
+        Err(PyValueError::new_err(format!(
+            "{what} must be finite, got {values:?}"
+        )))
+    }
+}
+
+fn positive(x: f64, what: &str) -> PyResult<()> {
+    if x.is_finite() && x > 0.0 {
+        Ok(())
+    } else {
+        Err(PyValueError::new_err(format!(
+            "{what} must be positive and finite, got {x}"
+        )))
+    }
+}
+
+type ClearanceArrays<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<u32>>);
+
+/// Shapes carried by bodies (index 0, 1, …), in each body's reference frame.
+#[pyclass(module = "cablelife._core")]
+pub struct Surroundings {
+    parts: Vec<Part>,
+}
+
+#[pymethods]
+impl Surroundings {
+    #[new]
+    fn new() -> Self {
+        Surroundings { parts: vec![] }
+    }
+
+    /// Number of parts added.
+    fn __len__(&self) -> usize {
+        self.parts.len()
+    }
+
+    /// Adds a triangle mesh (vertices (V, 3), triangles (F, 3) of vertex indices, merged
+    /// vertices, no degenerate triangles); builds its hierarchy. Returns the part index.
+    fn add_mesh(
+        &mut self,
+        py: Python<'_>,
+        body: usize,
+        vertices: PyReadonlyArray2<'_, f64>,
+        faces: PyReadonlyArray2<'_, i64>,
+    ) -> PyResult<usize> {
+        let v = rows3(&vertices, "vertices")?;
+        let f = faces.as_array();
+        if f.ncols() != 3 {
+            return Err(PyValueError::new_err(format!(
+                "faces has shape {:?}: must be (F, 3)",
+                f.shape()
+            )));
+        }
+        let mut tris = Vec::with_capacity(f.nrows());
+        for r in f.rows() {
+            if r.iter().any(|&k| k < 0 || k > u32::MAX as i64) {
+                return Err(PyValueError::new_err(format!(
+                    "bad vertex index in face {r}"
+                )));
+            }
+            tris.push([r[0] as u32, r[1] as u32, r[2] as u32]);
+        }
+        let mesh = py
+            .detach(|| TriMesh::new(&v, &tris))
+            .map_err(|e| PyValueError::new_err(e.0))?;
+        Ok(self.push(Shape::Mesh(mesh), body))
+    }
+
+    /// Adds the half-space below the plane through `point` with outward `normal`.
+    fn add_plane(&mut self, body: usize, point: [f64; 3], normal: [f64; 3]) -> PyResult<usize> {
+        finite(&point, "plane point")?;
+        finite(&normal, "plane normal")?;
+        positive(V3::from(normal).norm(), "the length of the plane normal")?;
+        let s = HalfSpace::new(V3::from(point), V3::from(normal));
+        Ok(self.push(Shape::HalfSpace(s), body))
+    }
+
+    /// Adds a box: centre, rotation (3 × 3, columns = box axes), half extents.
+    fn add_box(
+        &mut self,
+        body: usize,
+        center: [f64; 3],
+        rotation: [[f64; 3]; 3],
+        half_extents: [f64; 3],
+    ) -> PyResult<usize> {
+        finite(&center, "box center")?;
+        for h in half_extents {
+            positive(h, "box half extent")?;
+        }
+        let r = Matrix3::from_fn(|i, j| rotation[i][j]);
+        let err = (r.transpose() * r - Matrix3::identity()).norm();
+        if err.is_nan() || err >= 1e-9 || r.determinant() < 0.0 {
+            return Err(PyValueError::new_err(
+                "box rotation must be a rotation matrix",
+            ));
+        }
+        let s = Cuboid {
+            center: V3::from(center),
+            rotation: r,
+            half_extents: V3::from(half_extents),
+        };
+        Ok(self.push(Shape::Cuboid(s), body))
+    }
+
+    /// Adds a solid cylinder: centre, axis, radius, half length along the axis.
+    fn add_cylinder(
+        &mut self,
+        body: usize,
+        center: [f64; 3],
+        axis: [f64; 3],
+        radius: f64,
+        half_length: f64,
+    ) -> PyResult<usize> {
+        finite(&center, "cylinder center")?;
+        finite(&axis, "cylinder axis")?;
+        positive(V3::from(axis).norm(), "the length of the cylinder axis")?;
+        positive(radius, "cylinder radius")?;
+        positive(half_length, "cylinder half length")?;
+        let s = Cylinder::new(V3::from(center), V3::from(axis), radius, half_length);
+        Ok(self.push(Shape::Cylinder(s), body))
+    }
+
+    /// Adds a solid sphere.
+    fn add_sphere(&mut self, body: usize, center: [f64; 3], radius: f64) -> PyResult<usize> {
+        finite(&center, "sphere center")?;
+        positive(radius, "sphere radius")?;
+        let s = Sphere {
+            center: V3::from(center),
+            radius,
+        };
+        Ok(self.push(Shape::Sphere(s), body))
+    }
+
+    /// Signed distance of points (P, 3) to part `part` (its body frame): dict of
+    /// distance (P,), point (P, 3), normal (P, 3).
+    fn project_points<'py>(
+        &self,
+        py: Python<'py>,
+        part: usize,
+        points: PyReadonlyArray2<'py, f64>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let shape = &self.part(part)?.shape;
+        let q = rows3(&points, "points")?;
+        let out: Vec<_> = py.detach(|| {
+            use rayon::prelude::*;
+            q.par_iter()
+                .map(|p| shape.project_point(p, f64::INFINITY, usize::MAX).unwrap())
+                .collect()
+        });
+        let d = out.iter().map(|r| r.distance).collect::<Vec<_>>();
+        let flat = |f: &dyn Fn(&::geometry::PointProjection) -> V3| {
+            out.iter()
+                .flat_map(|r| f(r).iter().copied().collect::<Vec<_>>())
+                .collect::<Vec<_>>()
+        };
+        let dict = PyDict::new(py);
+        dict.set_item("distance", PyArray1::from_vec(py, d))?;
+        dict.set_item(
+            "point",
+            PyArray1::from_vec(py, flat(&|r| r.point)).reshape([q.len(), 3])?,
+        )?;
+        dict.set_item(
+            "normal",
+            PyArray1::from_vec(py, flat(&|r| r.normal)).reshape([q.len(), 3])?,
+        )?;
+        Ok(dict)
+    }
+
+    /// Closest points of segments [a_i, b_i] ((P, 3) each) and part `part`: dict of
+    /// distance (P,) (unsigned), t (P,), on_segment, on_surface, normal (P, 3).
+    fn closest_to_segments<'py>(
+        &self,
+        py: Python<'py>,
+        part: usize,
+        a: PyReadonlyArray2<'py, f64>,
+        b: PyReadonlyArray2<'py, f64>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let shape = &self.part(part)?.shape;
+        let a = rows3(&a, "a")?;
+        let b = rows3(&b, "b")?;
+        if a.len() != b.len() {
+            return Err(PyValueError::new_err("a and b must have the same shape"));
+        }
+        let out: Vec<_> = py.detach(|| {
+            use rayon::prelude::*;
+            a.par_iter()
+                .zip(&b)
+                .map(|(p, q)| {
+                    shape
+                        .closest_to_segment(p, q, f64::INFINITY, usize::MAX)
+                        .unwrap()
+                })
+                .collect()
+        });
+        let n = a.len();
+        let flat = |f: &dyn Fn(&::geometry::SegmentProjection) -> V3| {
+            out.iter()
+                .flat_map(|r| f(r).iter().copied().collect::<Vec<_>>())
+                .collect::<Vec<_>>()
+        };
+        let dict = PyDict::new(py);
+        dict.set_item(
+            "distance",
+            PyArray1::from_vec(py, out.iter().map(|r| r.distance).collect()),
+        )?;
+        dict.set_item(
+            "t",
+            PyArray1::from_vec(py, out.iter().map(|r| r.t).collect()),
+        )?;
+        dict.set_item(
+            "on_segment",
+            PyArray1::from_vec(py, flat(&|r| r.on_segment)).reshape([n, 3])?,
+        )?;
+        dict.set_item(
+            "on_surface",
+            PyArray1::from_vec(py, flat(&|r| r.on_surface)).reshape([n, 3])?,
+        )?;
+        dict.set_item(
+            "normal",
+            PyArray1::from_vec(py, flat(&|r| r.normal)).reshape([n, 3])?,
+        )?;
+        Ok(dict)
+    }
+
+    /// Clearance of a cable of outer `radius` with node positions (T, N, 3) (global);
+    /// `to_body` (B, T, 3, 4): per body and step the map [M | v] of global points into the
+    /// body's reference frame, X = M x + v. Returns (clearance (T, N) m, part (T, N) index).
+    fn clearance<'py>(
+        &self,
+        py: Python<'py>,
+        positions: PyReadonlyArray3<'py, f64>,
+        radius: f64,
+        to_body: PyReadonlyArray4<'py, f64>,
+    ) -> PyResult<ClearanceArrays<'py>> {
+        let pos = positions.as_array();
+        let (t, n, k) = pos.dim();
+        if k != 3 {
+            return Err(PyValueError::new_err("positions must have shape (T, N, 3)"));
+        }
+        positive(radius, "cable radius")?;
+        let maps_a = to_body.as_array();
+        let (nb, nt, r, c) = maps_a.dim();
+        if nt != t || r != 3 || c != 4 {
+            return Err(PyValueError::new_err(format!(
+                "to_body has shape {:?}: must be (bodies, {t}, 3, 4)",
+                maps_a.shape()
+            )));
+        }
+        let points: Vec<V3> = pos
+            .outer_iter()
+            .flat_map(|step| {
+                step.outer_iter()
+                    .map(|p| V3::new(p[0], p[1], p[2]))
+                    .collect::<Vec<_>>()
+            })
+            .collect();
+        let mut maps = Vec::with_capacity(nb * nt);
+        for b in 0..nb {
+            for s in 0..nt {
+                let m = maps_a.slice(numpy::ndarray::s![b, s, .., ..]);
+                maps.push(RigidMap {
+                    m: Matrix3::from_fn(|i, j| m[[i, j]]),
+                    v: V3::new(m[[0, 3]], m[[1, 3]], m[[2, 3]]),
+                });
+            }
+        }
+        if let Some(p) = self.parts.iter().find(|p| p.body >= nb) {
+            return Err(PyValueError::new_err(format!(
+                "a part is on body {}, but only {nb} body maps are given",
+                p.body
+            )));
+        }
+        let parts = &self.parts;
+        let out = py
+            .detach(|| clearance(parts, &points, n, radius, &maps))
+            .map_err(PyValueError::new_err)?;
+        Ok((
+            PyArray1::from_vec(py, out.value).reshape([t, n])?,
+            PyArray1::from_vec(py, out.part).reshape([t, n])?,
+        ))
+    }
+}
+
+impl Surroundings {
+    fn push(&mut self, shape: Shape, body: usize) -> usize {
+        self.parts.push(Part { shape, body });
+        self.parts.len() - 1
+    }
+
+    fn part(&self, k: usize) -> PyResult<&Part> {
+        self.parts.get(k).ok_or_else(|| {
+            PyValueError::new_err(format!(
+                "part {k} does not exist ({} parts)",
+                self.parts.len()
+            ))
+        })
+    }
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<Surroundings>()?;
+    Ok(())
+}
