@@ -15,8 +15,9 @@
 //! factorisation, which is reused across iterations and steps while the iteration contracts
 //! fast. Prescribed unknowns follow the clips; the free twist of swivel clips is massless
 //! (quasistatic within the step).
-use crate::assembly::{KinkAt, Part, Rates, Workspace};
+use crate::assembly::{Elastic, Eval, External, KinkAt, Part, Rates, Term, Workspace};
 use crate::block_tridiag::BlockTridiag;
+use crate::contact::Contact;
 use crate::model::{EdgeKind, NodeKind, Pose, Rod, Segment};
 use crate::rotation::{right_jacobian, rotate_body, rotation_matrix, skew, slerp, Quat};
 use crate::state::State;
@@ -147,8 +148,10 @@ pub struct Energies {
     pub elastic: f64,
     /// Potential of gravity and dead loads (−work).
     pub load_potential: f64,
-    /// Dissipated by the viscous damping since the start.
+    /// Dissipated by the viscous damping and friction since the start.
     pub dissipated: f64,
+    /// Energy of the contact barrier.
+    pub contact: f64,
 }
 
 /// The factorisation state of one segment's iteration matrix.
@@ -163,6 +166,9 @@ struct SegmentFactor {
 pub struct Dynamics {
     pub ws: Workspace,
     pub opts: DynamicOptions,
+    /// Contact with the surroundings (a term of the assembly when set); the obstacles are
+    /// placed at their poses at t_{n+1} before each step.
+    pub contact: Option<Contact>,
     ga: GenAlpha,
     rates: Rates,
     vdot: Vec<Vector6<f64>>,
@@ -233,6 +239,7 @@ impl Dynamics {
         let n_seg = rod.segments.len();
         let mut dynamics = Dynamics {
             ws: Workspace::new(rod),
+            contact: None,
             ga: GenAlpha::new(opts.rho_inf),
             opts,
             rates,
@@ -336,8 +343,13 @@ impl Dynamics {
             }
         }
         self.ws.clear_part(part, want_jac);
-        self.ws
-            .add_elastic_part(rod, st, Some(&self.rates), want_jac, part)?;
+        let ev = Eval {
+            part,
+            want_jac,
+            rates: Some(&self.rates),
+            load_factor: 1.0,
+        };
+        Elastic.add_residual_jacobian(rod, st, &ev, &mut self.ws)?;
         // Inertia: m ẍ on nodes, J ω̇ + ω × Jω on edges (prescribed ones enter the reactions).
         let n_edges = rod.n_edges();
         for b in blocks {
@@ -368,8 +380,9 @@ impl Dynamics {
                 self.ws.jac.add3(b, 1, b, 1, &block);
             }
         }
-        self.ws
-            .add_external_part(rod, st, 1.0, want_jac, part, Some(&self.rates));
+        External.add_residual_jacobian(rod, st, &ev, &mut self.ws)?;
+        self.contact
+            .add_residual_jacobian(rod, st, &ev, &mut self.ws)?;
         self.ws.finalize_part(rod, want_jac, part);
         Ok(())
     }
@@ -391,6 +404,12 @@ impl Dynamics {
         self.v_n.clone_from(&self.rates.v);
         self.vdot_n.clone_from(&self.vdot);
         self.a_n.clone_from(&self.a);
+        if let Some(c) = &mut self.contact {
+            c.begin_step(&st.x, Some(h));
+            if c.take_moved() {
+                self.resting.fill(false); // moving geometry wakes the cable
+            }
+        }
         // Clips that stay exactly where they are, at rest.
         self.clip_still.clear();
         self.clip_still
@@ -428,7 +447,8 @@ impl Dynamics {
             self.increments[k] = if self.resting[k] {
                 0.0 // unchanged: Δq = 0
             } else {
-                self.update_kinematics(st, h, seg.blocks.clone())
+                let inc = self.update_kinematics(st, h, seg.blocks.clone());
+                self.limit_predictor(st, h, seg).unwrap_or(inc)
             };
         }
         let mut stats = StepStats {
@@ -529,10 +549,32 @@ impl Dynamics {
             if refactor {
                 last_fresh_norm = norm;
             }
+            // Contact: no dive through the barrier (the correction is shortened).
+            let alpha = match &self.contact {
+                Some(c) => {
+                    let kx = h * self.k_dq * c_mass;
+                    let (delta, half) = (&self.delta, &self.inertial_half);
+                    let dx = |n: usize| {
+                        if half[n][0] {
+                            kx * delta[n].fixed_rows::<3>(0).into_owned()
+                        } else {
+                            Vector3::zeros()
+                        }
+                    };
+                    c.step_bound(&st.x, dx, seg.edges.iter().cloned())
+                }
+                None => 1.0,
+            };
+            if alpha < 1.0 {
+                for d in &mut self.delta[seg.blocks.clone()] {
+                    *d *= alpha;
+                }
+                last_fresh_norm = f64::INFINITY;
+            }
             self.increments[k] = self.apply_correction(rod, st, h, c_mass, seg);
             stats.iterations = it + 1;
             let scale = self.increments.iter().cloned().fold(0.0, f64::max);
-            if norm < (self.opts.tolerance * scale).max(self.opts.abs_tolerance) {
+            if alpha == 1.0 && norm < (self.opts.tolerance * scale).max(self.opts.abs_tolerance) {
                 stats.residual = self
                     .ws
                     .residual_norms_range(seg.blocks.clone(), rod.mean_ds())
@@ -558,6 +600,28 @@ impl Dynamics {
                 .1,
             load_factor: 1.0,
         })
+    }
+
+    /// Shortens the predictor of a segment (from the state at t_n) so that it does not dive
+    /// through the contact barrier: Δq ← α Δq; returns the new increment if it was shortened.
+    fn limit_predictor(&mut self, st: &mut State, h: f64, seg: &Segment) -> Option<f64> {
+        let c = self.contact.as_ref()?;
+        let (x, x_n) = (&st.x, &self.x_n);
+        let alpha = c.step_bound(x_n, |n| x[n] - x_n[n], seg.edges.iter().cloned());
+        if alpha >= 1.0 {
+            return None;
+        }
+        // Δq = dq0 + k_dq v̇ → α Δq.
+        for b in seg.blocks.clone() {
+            let dq = self.dq0[b] + self.k_dq * self.vdot[b];
+            let target = (alpha * dq - self.dq0[b]) / self.k_dq;
+            for i in 0..6 {
+                if self.inertial[b][i] {
+                    self.vdot[b][i] = target[i];
+                }
+            }
+        }
+        Some(self.update_kinematics(st, h, seg.blocks.clone()))
     }
 
     /// Returns to the values at the start of the last (failed) step.
@@ -759,6 +823,7 @@ impl Dynamics {
             })?;
         self.energies.elastic = self.ws.elastic_energy;
         self.energies.load_potential = self.ws.load_potential;
+        self.energies.contact = self.ws.contact_energy;
         self.energies.kinetic = self.kinetic_energy(rod);
         Ok(())
     }
