@@ -24,6 +24,7 @@ from pydantic import (
 )
 
 from cablelife import _core
+from cablelife.contact_settings import ContactSettings, check_bodies
 from cablelife.sections import SectionProperties, from_material, from_measured
 from cablelife.signals.spec import ChannelMotion, TableSignal
 from cablelife.tomlfile import read_toml
@@ -329,6 +330,7 @@ class Scene(_Model):
     simulation: Simulation = Simulation()
     bodies: list[Body] = []
     cables: Annotated[list[Cable], Field(min_length=1)]
+    contact: ContactSettings | None = None  # docs/contact.md
     base_dir: Annotated[Path | None, Field(exclude=True)] = None
 
     @model_validator(mode="after")
@@ -351,6 +353,8 @@ class Scene(_Model):
                         f"cables[{i}].clips[{j}].body = '{clip.body}' is not a body of the scene; "
                         f"allowed: {allowed}"
                     )
+        if self.contact is not None:
+            check_bodies(self.contact, body_names)
         if self.simulation.mode != "static" and self.simulation.duration is None:
             raise ValueError(f"simulation.duration is required in {self.simulation.mode} mode")
         return self

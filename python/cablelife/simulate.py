@@ -16,7 +16,8 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from cablelife import _core
-from cablelife.results import CableResult, ClipReaction, Result
+from cablelife.contact_settings import set_contact
+from cablelife.results import CONTACT_KEYS, CableResult, ClipReaction, Result
 from cablelife.scene import Cable, Scene, SceneError
 from cablelife.signals import body_motion, time_grid
 
@@ -201,6 +202,10 @@ def _warn_moving_start(cable: Cable, kin: dict[str, np.ndarray]) -> None:
 
 def _run_cable(scene: Scene, cable: Cable, times: np.ndarray, mode: str, progress: Progress | None):
     core = build_cable(scene, cable)
+    try:
+        set_contact(core, scene, cable, times)
+    except ValueError as err:
+        raise SceneError(f"cable '{cable.name}': {err}") from None
     callback = (lambda k, n: progress(cable.name, k, n)) if progress else None
     solver: dict = {}
     start = _time.perf_counter()
@@ -284,7 +289,10 @@ def _run_cable(scene: Scene, cable: Cable, times: np.ndarray, mode: str, progres
         section=props.as_attrs(),
         solver=solver,
         energies=energies,
+        contact={k: out[k] for k in CONTACT_KEYS if k in out},
     )
+    if "contact_energy" in out and res.contact:
+        res.energies["contact_energy"] = out["contact_energy"]
     return res, out["error"]
 
 
