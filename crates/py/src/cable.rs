@@ -173,7 +173,10 @@ impl Record {
         }
         if !self.contact_gap.is_empty() {
             let n_bodies = self.body_contact_force.len() / (3 * t).max(1);
-            d.set_item("contact_normal", shaped(self.contact_normal, &[t, n_nodes, 3])?)?;
+            d.set_item(
+                "contact_normal",
+                shaped(self.contact_normal, &[t, n_nodes, 3])?,
+            )?;
             d.set_item(
                 "contact_friction",
                 shaped(self.contact_friction, &[t, n_nodes, 3])?,

@@ -429,6 +429,7 @@ fn dropped_cable_comes_to_rest_without_gaining_energy_or_tunnelling() {
 /// The assembled Jacobian with contact and friction equals the finite-difference derivative
 /// of the residual (a cable pressed onto a sphere, sliding).
 #[test]
+#[allow(clippy::needless_range_loop)]
 fn jacobian_with_contact_matches_finite_differences() {
     let r = 0.004;
     let big_r = 0.05;
