@@ -19,7 +19,7 @@ use crate::assembly::{Elastic, Eval, External, KinkAt, Part, Rates, Term, Worksp
 use crate::block_tridiag::BlockTridiag;
 use crate::contact::Contact;
 use crate::model::{EdgeKind, NodeKind, Pose, Rod, Segment};
-use crate::rotation::{right_jacobian, rotate_body, rotation_matrix, skew, slerp, Quat};
+use crate::rotation::{log_vec, right_jacobian, rotate_body, rotation_matrix, skew, slerp, Quat};
 use crate::state::State;
 use crate::statics::SolveError;
 use nalgebra::{Matrix3, Vector3, Vector6};
@@ -100,6 +100,12 @@ pub struct DynamicOptions {
     /// Assemble the section forces, moments, reactions and energies at the end of every step;
     /// otherwise only when asked (`update_outputs`), e.g. on the steps that are saved.
     pub outputs_every_step: bool,
+    /// With contact: a step (with the clips' work subtracted, obstacles at rest) whose total
+    /// energy grows by more than this fraction of the energies at play is split in two (an
+    /// impact on the stiff barrier), down to the sub-step depth of `advance`.
+    pub energy_tolerance: f64,
+    /// The Newton tolerance (as `tolerance`) with contact.
+    pub contact_tolerance: f64,
 }
 
 impl Default for DynamicOptions {
@@ -113,6 +119,8 @@ impl Default for DynamicOptions {
             abs_tolerance: 1e-13,
             refactor_rate: 0.5,
             outputs_every_step: true,
+            energy_tolerance: 1e-3,
+            contact_tolerance: 1e-5,
         }
     }
 }
@@ -206,6 +214,10 @@ pub struct Dynamics {
     /// Per clip: at the same pose as in the last step, with zero rates.
     clip_still: Vec<bool>,
     pub energies: Energies,
+    /// The outputs (energies, reactions) are those of the current state.
+    outputs_current: bool,
+    /// An obstacle moved in the last step (its work is not accounted: no energy check).
+    obstacles_moved: bool,
     power_n: f64,
     poses: Vec<Pose>,
     length: f64,
@@ -275,6 +287,8 @@ impl Dynamics {
             resting: vec![false; n_seg],
             clip_still: Vec::with_capacity(clips.len()),
             energies: Energies::default(),
+            outputs_current: false,
+            obstacles_moved: false,
             power_n: 0.0,
             poses: Vec::with_capacity(clips.len()),
             length: rod.spec.length,
@@ -404,10 +418,13 @@ impl Dynamics {
         self.v_n.clone_from(&self.rates.v);
         self.vdot_n.clone_from(&self.vdot);
         self.a_n.clone_from(&self.a);
+        self.outputs_current = false;
+        self.obstacles_moved = false;
         if let Some(c) = &mut self.contact {
             c.begin_step(&st.x, Some(h));
             if c.take_moved() {
                 self.resting.fill(false); // moving geometry wakes the cable
+                self.obstacles_moved = true;
             }
         }
         // Clips that stay exactly where they are, at rest.
@@ -514,7 +531,19 @@ impl Dynamics {
         let mut stats = StepStats::default();
         let mut last_norm = f64::INFINITY;
         let mut last_fresh_norm = f64::INFINITY;
-        for it in 0..self.opts.max_iterations {
+        // Iterations whose correction the contact shortened do not count (up to 4× the limit).
+        // With contact, the barrier's stiffness turns a small position error into a large
+        // energy error: a tighter tolerance (`contact_tolerance`).
+        let tolerance = match self.contact {
+            Some(_) => self.opts.tolerance.min(self.opts.contact_tolerance),
+            None => self.opts.tolerance,
+        };
+        let mut budget = self.opts.max_iterations;
+        let mut next = 0;
+        let mut strikes = 0;
+        while next < budget {
+            let it = next;
+            next += 1;
             let f = self.factors[k];
             let refactor = !f.valid || f.h != h;
             self.assemble(rod, st, c_damp, c_mass, refactor, Part::Segment(seg))
@@ -536,7 +565,12 @@ impl Dynamics {
             // Diverging: not finite, or a correction with a fresh matrix no smaller than the
             // last one with a fresh matrix (Newton does not contract: give up early, the step
             // is split).
-            if !norm.is_finite() || (refactor && norm >= last_fresh_norm) {
+            // With contact the barrier's Newton path is not monotone: three strikes.
+            if refactor && norm >= last_fresh_norm {
+                strikes += 1;
+            }
+            let allowed = if self.contact.is_some() { 3 } else { 1 };
+            if !norm.is_finite() || strikes >= allowed {
                 return Err(SolveError::NotConverged {
                     iterations: it + 1,
                     residual: self
@@ -570,11 +604,12 @@ impl Dynamics {
                     *d *= alpha;
                 }
                 last_fresh_norm = f64::INFINITY;
+                budget = (budget + 1).min(4 * self.opts.max_iterations);
             }
             self.increments[k] = self.apply_correction(rod, st, h, c_mass, seg);
             stats.iterations = it + 1;
             let scale = self.increments.iter().cloned().fold(0.0, f64::max);
-            if alpha == 1.0 && norm < (self.opts.tolerance * scale).max(self.opts.abs_tolerance) {
+            if alpha == 1.0 && norm < (tolerance * scale).max(self.opts.abs_tolerance) {
                 stats.residual = self
                     .ws
                     .residual_norms_range(seg.blocks.clone(), rod.mean_ds())
@@ -634,6 +669,7 @@ impl Dynamics {
         self.vdot.clone_from(&self.vdot_n);
         self.a.clone_from(&self.a_n);
         self.invalidate_factors();
+        self.outputs_current = false;
     }
 
     fn invalidate_factors(&mut self) {
@@ -655,7 +691,47 @@ impl Dynamics {
         to: &[ClipMotion],
         max_depth: usize,
     ) -> Result<StepStats, SolveError> {
-        match self.step(rod, st, h, to) {
+        // With contact, the energy at t_n and the clip reactions (for the energy check).
+        let guard = self.contact.is_some() && max_depth > 0;
+        if guard && !self.outputs_current {
+            self.update_outputs(rod, st)?;
+        }
+        let before = guard.then(|| {
+            let reactions: Vec<_> = (0..rod.spec.clips.len())
+                .map(|c| self.ws.clip_reaction(rod, st, c))
+                .collect();
+            (self.energies, reactions, st.clip_pose.clone())
+        });
+        let dissipated = (self.energies.dissipated, self.power_n);
+        let result = self.step(rod, st, h, to);
+        let result = match (result, before) {
+            (Ok(s), Some((e0, r0, poses0))) if !self.obstacles_moved => {
+                self.update_outputs(rod, st)?;
+                let e1 = self.energies;
+                let mut work = 0.0;
+                for (c, (f0, m0)) in r0.iter().enumerate() {
+                    let (f1, m1) = self.ws.clip_reaction(rod, st, c);
+                    let (p0, p1) = (&poses0[c], &st.clip_pose[c]);
+                    let turn = log_vec(&(p1.orientation * p0.orientation.conjugate()));
+                    work += 0.5 * (f0 + f1).dot(&(p1.position - p0.position))
+                        + 0.5 * (m0 + m1).dot(&turn);
+                }
+                let total = |e: &Energies| e.kinetic + e.elastic + e.load_potential + e.contact;
+                let scale = e0.kinetic + e1.kinetic + e0.elastic.abs() + e0.contact + work.abs();
+                if total(&e1) - total(&e0) - work > self.opts.energy_tolerance * scale {
+                    (self.energies.dissipated, self.power_n) = dissipated;
+                    Err(SolveError::NotConverged {
+                        iterations: s.iterations,
+                        residual: s.residual,
+                        load_factor: 1.0,
+                    })
+                } else {
+                    Ok(s)
+                }
+            }
+            (r, _) => r,
+        };
+        match result {
             Ok(s) => Ok(s),
             Err(e) if max_depth == 0 => Err(e),
             Err(_) => {
@@ -825,6 +901,7 @@ impl Dynamics {
         self.energies.load_potential = self.ws.load_potential;
         self.energies.contact = self.ws.contact_energy;
         self.energies.kinetic = self.kinetic_energy(rod);
+        self.outputs_current = true;
         Ok(())
     }
 
