@@ -185,7 +185,6 @@ fn frictionless_wrap_keeps_the_tension() {
 /// The drum holds the cable while the clip end is pulled slowly (dynamics, 5 cm/s: inertia
 /// ρAv² ≈ 1e-4 N against 10 N); once the cable slides, the ratio of the end tensions is e^{μθ}.
 #[test]
-#[ignore = "open: the dynamic Newton iteration stalls once the wrap starts to slip (step bound and stick-zone stiffness); see docs/contact.md"]
 fn capstan_ratio_at_slip_is_exp_mu_theta() {
     let mu = 0.3;
     let (mut c, mut s) = capstan(mu);
@@ -213,10 +212,10 @@ fn capstan_ratio_at_slip_is_exp_mu_theta() {
     dy.start(&c.rod, &c.st).unwrap();
     let h = 1e-3;
     let mut tensions = Vec::new();
-    for k in 1..=300 {
+    for k in 1..=150 {
         let (from, to) = (motion((k - 1) as f64 * h), motion(k as f64 * h));
         dy.advance(&c.rod, &mut c.st, h, &from, &to, 6).unwrap();
-        if k > 200 {
+        if k > 100 {
             tensions.push(-dy.ws.clip_reaction(&c.rod, &c.st, 0).0.z);
         }
     }
