@@ -687,6 +687,15 @@ impl Contact {
         }
     }
 
+    /// Whether a free node of the state lies inside an obstacle (negative gap).
+    pub fn penetrates(&self, rod: &Rod, st: &State) -> bool {
+        self.obstacles.iter().any(|o| {
+            st.x.iter().enumerate().any(|(n, x)| {
+                rod.node_kind[n] == NodeKind::Free && o.query(x).distance - self.opts.radius < 0.0
+            })
+        })
+    }
+
     /// The smallest signed gap between the cable surface (capsules of the edges) and the
     /// geometry, with where it is: (gap, edge, obstacle).
     pub fn surface_gap(&self, st: &State) -> (f64, usize, usize) {

@@ -364,8 +364,27 @@ impl Statics {
     /// Static equilibrium: plain Newton; then pseudo-transient continuation; then load
     /// continuation from the unloaded routed shape (gravity and loads ramped), with plain and
     /// then damped Newton steps.
+    ///
+    /// With contact, a start that runs through the geometry (a routed shape) is first solved
+    /// without contact; the barrier's penalty continuation then pushes the cable out.
     pub fn solve(&mut self, rod: &Rod, st: &mut State) -> Result<SolveStats, SolveError> {
         self.has_prev = false; // a new sequence starts here
+        let mut pre = SolveStats::default();
+        if self.contact.as_ref().is_some_and(|c| c.penetrates(rod, st)) {
+            let contact = self.contact.take();
+            let start = st.clone();
+            match self.solve_from(rod, st) {
+                Ok(s) => pre = s,
+                Err(_) => st.clone_from(&start),
+            }
+            self.contact = contact;
+        }
+        let mut stats = self.solve_from(rod, st)?;
+        stats.iterations += pre.iterations;
+        Ok(stats)
+    }
+
+    fn solve_from(&mut self, rod: &Rod, st: &mut State) -> Result<SolveStats, SolveError> {
         if let Some(c) = &mut self.contact {
             c.begin_step(&st.x, None); // friction acts against the motion from the start
         }
