@@ -513,6 +513,8 @@ pub struct Contact {
     pub body_force: Vec<Vector3<f64>>,
     /// Smallest gap (cable surface to geometry) over the sample points, m.
     pub min_gap: f64,
+    /// Samples inside the barrier (gap below d̂) in the last assembly.
+    pub active: usize,
 }
 
 /// Invalid contact settings.
@@ -608,6 +610,7 @@ impl Contact {
             node_state: vec![NO_CONTACT; n],
             body_force: vec![Vector3::zeros(); n_bodies],
             min_gap: f64::INFINITY,
+            active: 0,
         })
     }
 
@@ -685,6 +688,17 @@ impl Contact {
         } else {
             self.min_gap >= before
         }
+    }
+
+    /// Whether any edge comes within d̂ + `margin` of an obstacle (broad phase only).
+    pub fn near(&self, x: &[Vector3<f64>], margin: f64) -> bool {
+        let reach = self.opts.radius + self.opts.distance + margin;
+        self.obstacles.iter().any(|o| {
+            x.windows(2).any(|w| {
+                let half = 0.5 * (w[1] - w[0]).norm();
+                o.query(&(0.5 * (w[0] + w[1]))).distance - half < reach
+            })
+        })
     }
 
     /// Whether a free node of the state lies inside an obstacle (negative gap).
@@ -766,6 +780,7 @@ impl Contact {
             ) else {
                 continue;
             };
+            self.active += 1;
             ws.contact_energy += s.energy;
             if let Some(h) = self.step {
                 ws.dissipation += s.friction_work / h;
@@ -821,6 +836,7 @@ impl Term for Contact {
         ws: &mut Workspace,
     ) -> Result<(), KinkAt> {
         let outputs = matches!(ev.part, Part::All);
+        self.active = 0;
         if outputs {
             self.normal_force.iter_mut().for_each(|v| v.fill(0.0));
             self.friction_force.iter_mut().for_each(|v| v.fill(0.0));

@@ -534,10 +534,7 @@ impl Dynamics {
         // Iterations whose correction the contact shortened do not count (up to 4× the limit).
         // With contact, the barrier's stiffness turns a small position error into a large
         // energy error: a tighter tolerance (`contact_tolerance`).
-        let tolerance = match self.contact {
-            Some(_) => self.opts.tolerance.min(self.opts.contact_tolerance),
-            None => self.opts.tolerance,
-        };
+        let tight = self.opts.tolerance.min(self.opts.contact_tolerance);
         let mut budget = self.opts.max_iterations;
         let mut next = 0;
         let mut strikes = 0;
@@ -609,6 +606,11 @@ impl Dynamics {
             self.increments[k] = self.apply_correction(rod, st, h, c_mass, seg);
             stats.iterations = it + 1;
             let scale = self.increments.iter().cloned().fold(0.0, f64::max);
+            // The tighter tolerance while samples are inside the barrier.
+            let tolerance = match &self.contact {
+                Some(c) if c.active > 0 => tight,
+                _ => self.opts.tolerance,
+            };
             if alpha == 1.0 && norm < (tolerance * scale).max(self.opts.abs_tolerance) {
                 stats.residual = self
                     .ws
@@ -692,7 +694,16 @@ impl Dynamics {
         max_depth: usize,
     ) -> Result<StepStats, SolveError> {
         // With contact, the energy at t_n and the clip reactions (for the energy check).
-        let guard = self.contact.is_some() && max_depth > 0;
+        // Only near the geometry: within d̂ plus twice the step's travel at the current speed.
+        let travel = 2.0
+            * h
+            * self
+                .rates
+                .v
+                .iter()
+                .map(|v| v.fixed_rows::<3>(0).norm())
+                .fold(0.0, f64::max);
+        let guard = max_depth > 0 && self.contact.as_ref().is_some_and(|c| c.near(&st.x, travel));
         if guard && !self.outputs_current {
             self.update_outputs(rod, st)?;
         }
