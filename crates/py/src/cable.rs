@@ -86,6 +86,7 @@ impl Record {
             kinetic_energy: Vec::with_capacity(n),
             load_potential: Vec::with_capacity(n),
             dissipated_energy: Vec::with_capacity(n),
+            contact_energy: Vec::with_capacity(n),
             ..Default::default()
         }
     }
@@ -115,6 +116,15 @@ impl Record {
         self.elastic_energy.push(ws.elastic_energy);
         self.load_potential.push(ws.load_potential);
         self.contact_energy.push(ws.contact_energy);
+    }
+
+    /// Room for the contact outputs of `n` saved steps.
+    fn reserve_contact(&mut self, n: usize, nodes: usize, bodies: usize) {
+        self.contact_normal.reserve(n * 3 * nodes);
+        self.contact_friction.reserve(n * 3 * nodes);
+        self.contact_state.reserve(n * nodes);
+        self.body_contact_force.reserve(n * 3 * bodies);
+        self.contact_gap.reserve(n);
     }
 
     fn push_contact(&mut self, c: &Contact) {
@@ -607,7 +617,11 @@ impl Cable {
         let every = output_every.max(1);
         let poll_every = progress_every.max(1);
         let (record, error) = py.detach(move || {
-            let mut rec = Record::with_capacity(t.saturating_sub(1) / every + 1, rod);
+            let saved = t.saturating_sub(1) / every + 1;
+            let mut rec = Record::with_capacity(saved, rod);
+            if let Some(c) = &solver.contact {
+                rec.reserve_contact(saved, rod.arc.len(), c.body_force.len());
+            }
             let mut st = initial;
             if let (Some(c), Some(p)) = (&mut solver.contact, obstacle_at(obstacle_poses, 0)) {
                 c.set_obstacle_poses(p);
