@@ -58,6 +58,10 @@ pub struct SegmentQuery {
 pub trait Shape: Send + Sync + fmt::Debug {
     /// Signed distance (positive outside), normal and its gradient at a point (local frame).
     fn query(&self, p: &Vector3<f64>) -> PointQuery;
+    /// The signed distance alone (broad phase).
+    fn distance(&self, p: &Vector3<f64>) -> f64 {
+        self.query(p).distance
+    }
     /// The smallest radius of curvature of the surface that a cable can touch (0: sharp
     /// edges, ∞: flat); it sets the sample spacing along the edges.
     fn min_radius(&self) -> f64;
@@ -117,6 +121,9 @@ impl Shape for Plane {
     fn query(&self, p: &Vector3<f64>) -> PointQuery {
         flat(p.z, Vector3::z())
     }
+    fn distance(&self, p: &Vector3<f64>) -> f64 {
+        p.z
+    }
     fn min_radius(&self) -> f64 {
         f64::INFINITY
     }
@@ -141,6 +148,9 @@ impl Shape for Sphere {
             hessian: (Matrix3::identity() - n * n.transpose()) / rho,
         }
     }
+    fn distance(&self, p: &Vector3<f64>) -> f64 {
+        p.norm() - self.radius
+    }
     fn min_radius(&self) -> f64 {
         self.radius
     }
@@ -153,6 +163,11 @@ impl Shape for Sphere {
 }
 
 impl Shape for Cylinder {
+    fn distance(&self, p: &Vector3<f64>) -> f64 {
+        let qs = (p.x * p.x + p.y * p.y).sqrt() - self.radius;
+        let qc = p.z.abs() - 0.5 * self.length;
+        qs.max(qc).min(0.0) + (qs.max(0.0).powi(2) + qc.max(0.0).powi(2)).sqrt()
+    }
     fn query(&self, p: &Vector3<f64>) -> PointQuery {
         let rho = (p.x * p.x + p.y * p.y).sqrt();
         let (radial, tangential) = if rho > 1e-12 * self.radius {
@@ -207,6 +222,10 @@ impl Shape for Cylinder {
 }
 
 impl Shape for Cuboid {
+    fn distance(&self, p: &Vector3<f64>) -> f64 {
+        let q = p.abs() - self.half;
+        q.max().min(0.0) + q.map(|v| v.max(0.0)).norm()
+    }
     fn query(&self, p: &Vector3<f64>) -> PointQuery {
         let q = p.abs() - self.half;
         let sign = p.map(|v| if v < 0.0 { -1.0 } else { 1.0 });
@@ -300,6 +319,13 @@ impl Obstacle {
                 self.rotation * q.hessian * self.rotation.transpose()
             },
         }
+    }
+
+    /// Signed distance at a global point (broad phase).
+    #[inline]
+    pub fn distance(&self, p: &Vector3<f64>) -> f64 {
+        self.shape
+            .distance(&(self.rotation.transpose() * (p - self.position)))
     }
 
     /// Closest points between the segment [a, b] and the obstacle (the distance along the
@@ -662,7 +688,7 @@ impl Contact {
                 let motion = da.norm().max(db.norm());
                 let mid = 0.5 * (a + b);
                 let half = 0.5 * (b - a).norm();
-                if o.query(&mid).distance - half - r > motion {
+                if o.distance(&mid) - half - r > motion {
                     continue;
                 }
                 for i in 0..=kk {
@@ -696,7 +722,7 @@ impl Contact {
         self.obstacles.iter().any(|o| {
             x.windows(2).any(|w| {
                 let half = 0.5 * (w[1] - w[0]).norm();
-                o.query(&(0.5 * (w[0] + w[1]))).distance - half < reach
+                o.distance(&(0.5 * (w[0] + w[1]))) - half < reach
             })
         })
     }
@@ -750,7 +776,7 @@ impl Contact {
         if far.is_finite() && (mid - o.position).norm() - half - far > reach {
             return;
         }
-        if o.query(&mid).distance - half >= reach {
+        if o.distance(&mid) - half >= reach {
             return;
         }
         let kk = self.samples[k];
@@ -948,6 +974,10 @@ mod tests {
                     );
                 }
                 assert!((q.normal.norm() - 1.0).abs() < 1e-12);
+                assert!(
+                    (o.distance(&p) - q.distance).abs() < 1e-15,
+                    "{name} distance"
+                );
             }
         }
     }
