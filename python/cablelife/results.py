@@ -55,7 +55,30 @@ CHUNK_STEPS = 256
 PRECISIONS = ("float64", "float32")
 HISTORIES = ("positions", "quaternions", "forces", "moments")
 
-ENERGIES = ("kinetic_energy", "elastic_energy", "dissipated_energy", "load_potential")
+ENERGIES = (
+    "kinetic_energy",
+    "elastic_energy",
+    "dissipated_energy",
+    "load_potential",
+    "contact_energy",
+)
+# Contact outputs (docs/contact.md): per node normal and friction force of the geometry on the
+# cable (T, N+1, 3, N, global), node state (T, N+1: 0 none, 1 stick, 2 slip), force per body
+# (T, B, 3; B = world and the scene's bodies), smallest gap of the sampled cable surface (T,).
+CONTACT_KEYS = (
+    "contact_normal",
+    "contact_friction",
+    "contact_state",
+    "body_contact_force",
+    "contact_gap",
+)
+_CONTACT_UNITS = {
+    "contact_normal": "N",
+    "contact_friction": "N",
+    "contact_state": "1",
+    "body_contact_force": "N",
+    "contact_gap": "m",
+}
 
 _UNITS = {
     "time": "s",
@@ -68,6 +91,7 @@ _UNITS = {
     "elastic_energy": "J",
     "dissipated_energy": "J",
     "load_potential": "J",
+    "contact_energy": "J",
 }
 
 
@@ -138,6 +162,7 @@ class CableResult:
     solver: dict = field(default_factory=dict)
     energies: dict[str, np.ndarray] = field(default_factory=dict)
     surroundings: CableClearance | None = None  # clearance to the scene's geometry
+    contact: dict[str, np.ndarray] = field(default_factory=dict)  # CONTACT_KEYS, if enabled
 
     @property
     def clearance(self) -> np.ndarray | None:
@@ -155,6 +180,14 @@ class CableResult:
             f"CableResult({self.name!r}, {self.n_steps} steps, {self.arc_length.size - 1} "
             f"segments, clips {list(self.clips)})"
         )
+
+    @property
+    def contact_force(self) -> np.ndarray | None:
+        """Force of the geometry on the cable per node (T, N+1, 3), N, global: normal plus
+        friction; None without contact."""
+        if not self.contact:
+            return None
+        return self.contact["contact_normal"] + self.contact["contact_friction"]
 
     @property
     def n_steps(self) -> int:
@@ -254,6 +287,10 @@ def save_result(result: Result, path: str | os.PathLike, precision: str | None =
                 _put(g, key, getattr(c, key), dtype=hist)
             for key, value in c.energies.items():
                 _put(g, key, value)
+            if c.contact:
+                cg = g.create_group("contact")
+                for key, value in c.contact.items():
+                    _put(cg, key, value, _CONTACT_UNITS.get(key, "1"))
             clips = g.create_group("clips")
             for clip in c.clips.values():
                 cg = clips.create_group(clip.name)
@@ -315,6 +352,7 @@ def load_result(path: str | os.PathLike, lazy: bool = True) -> Result:
                 solver={k: plain(v) for k, v in solver.items()},
                 energies=energies,
                 surroundings=CableClearance.read(g),
+                contact={k: v[()] for k, v in g["contact"].items()} if "contact" in g else {},
             )
         result = Result(
             mode=str(f.attrs["mode"]),

@@ -23,6 +23,7 @@ from pydantic import (
 )
 
 from cablelife import _core
+from cablelife.contact_settings import ContactSettings, check_bodies
 from cablelife.limits import LIMITS, MAX_SEGMENTS, MIN_SEGMENTS, check_name
 from cablelife.paths import SceneFileError, resolve_scene_file, shown_names
 from cablelife.sections import SectionProperties, from_material, from_measured
@@ -421,6 +422,7 @@ class Scene(_Model):
     bodies: list[Body] = []
     cables: Annotated[list[Cable], Field(min_length=1)]
     clearance: ClearanceSettings | None = None  # settings of the clearance to the geometry
+    contact: ContactSettings | None = None  # docs/contact.md
     base_dir: Annotated[Path | None, Field(exclude=True)] = None
 
     @model_validator(mode="after")
@@ -443,6 +445,8 @@ class Scene(_Model):
                         f"cables[{i}].clips[{j}].body = '{clip.body}' is not a body of the scene; "
                         f"allowed: {allowed}"
                     )
+        if self.contact is not None:
+            check_bodies(self.contact, body_names)
         if self.simulation.mode != "static" and self.simulation.duration is None:
             raise ValueError(f"simulation.duration is required in {self.simulation.mode} mode")
         return self

@@ -15,8 +15,9 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 
 from cablelife import _core, interrupt
+from cablelife.contact_settings import set_contact
 from cablelife.limits import LIMITS, MAX_RUN_BYTES, human_bytes, run_bytes
-from cablelife.results import CableResult, ClipReaction, Result
+from cablelife.results import CONTACT_KEYS, CableResult, ClipReaction, Result
 from cablelife.rotations import euler_matrix, matrix_quaternions
 from cablelife.scene import Cable, Scene, SceneError
 from cablelife.signals import body_motion, time_grid
@@ -288,6 +289,10 @@ def _run_cable(
     stop: _core.StopFlag | None = None,
 ):
     core = build_cable(scene, cable)
+    try:
+        set_contact(core, scene, cable, times)
+    except ValueError as err:
+        raise SceneError(f"cable '{cable.name}': {err}") from None
     callback = (lambda k, n: progress(cable.name, k, n)) if progress else None
     solver: dict = {}
     start = _time.perf_counter()
@@ -376,7 +381,10 @@ def _run_cable(
         section=props.as_attrs(),
         solver=solver,
         energies=energies,
+        contact={k: out[k] for k in CONTACT_KEYS if k in out},
     )
+    if "contact_energy" in out and res.contact:
+        res.energies["contact_energy"] = out["contact_energy"]
     return res, out["error"]
 
 

@@ -7,6 +7,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rod::assembly::Workspace;
+use rod::contact::{Contact, ContactOptions, Cuboid, Cylinder, Obstacle, Plane, Shape, Sphere};
 use rod::routing::route;
 use rod::{
     CableSpec, ClipKind, ClipMotion, ClipSpec, DynamicOptions, Dynamics, NewtonOptions, PointLoad,
@@ -67,6 +68,14 @@ struct Record {
     /// Peaks over the recorded steps of the viscous section loads: |F3|, |F1, F2|, |M1, M2|,
     /// |M3| (body frame).
     viscous_peak: [f64; 4],
+    contact_energy: Vec<f64>,
+    /// Contact outputs (with contact only): per node normal and friction force (global),
+    /// state (0 none, 1 stick, 2 slip); per body total force; smallest gap.
+    contact_normal: Vec<f64>,
+    contact_friction: Vec<f64>,
+    contact_state: Vec<u8>,
+    body_contact_force: Vec<f64>,
+    contact_gap: Vec<f64>,
 }
 
 impl Record {
@@ -93,6 +102,8 @@ impl Record {
             load_potential: Vec::with_capacity(n),
             dissipated_energy: Vec::with_capacity(n),
             viscous_peak: [0.0; 4],
+            contact_energy: Vec::with_capacity(n),
+            ..Default::default()
         }
     }
 
@@ -133,6 +144,28 @@ impl Record {
         });
         self.elastic_energy.push(ws.elastic_energy);
         self.load_potential.push(ws.load_potential);
+        self.contact_energy.push(ws.contact_energy);
+    }
+
+    /// Room for the contact outputs of `n` saved steps.
+    fn reserve_contact(&mut self, n: usize, nodes: usize, bodies: usize) {
+        self.contact_normal.reserve(n * 3 * nodes);
+        self.contact_friction.reserve(n * 3 * nodes);
+        self.contact_state.reserve(n * nodes);
+        self.body_contact_force.reserve(n * 3 * bodies);
+        self.contact_gap.reserve(n);
+    }
+
+    fn push_contact(&mut self, c: &Contact) {
+        for (f, t) in c.normal_force.iter().zip(&c.friction_force) {
+            self.contact_normal.extend_from_slice(f.as_slice());
+            self.contact_friction.extend_from_slice(t.as_slice());
+        }
+        self.contact_state.extend_from_slice(&c.node_state);
+        for f in &c.body_force {
+            self.body_contact_force.extend_from_slice(f.as_slice());
+        }
+        self.contact_gap.push(c.min_gap);
     }
 
     /// Updates the peaks of the viscous section loads (dynamic runs).
@@ -190,10 +223,31 @@ impl Record {
             ("kinetic_energy", self.kinetic_energy),
             ("load_potential", self.load_potential),
             ("dissipated_energy", self.dissipated_energy),
+            ("contact_energy", self.contact_energy),
         ] {
             d.set_item(key, PyArray1::from_vec(py, values))?;
         }
         d.set_item("viscous_peak", self.viscous_peak.to_vec())?;
+        if !self.contact_gap.is_empty() {
+            let n_bodies = self.body_contact_force.len() / (3 * t).max(1);
+            d.set_item(
+                "contact_normal",
+                shaped(self.contact_normal, &[t, n_nodes, 3])?,
+            )?;
+            d.set_item(
+                "contact_friction",
+                shaped(self.contact_friction, &[t, n_nodes, 3])?,
+            )?;
+            d.set_item(
+                "contact_state",
+                PyArray1::from_vec(py, self.contact_state).reshape(vec![t, n_nodes])?,
+            )?;
+            d.set_item(
+                "body_contact_force",
+                shaped(self.body_contact_force, &[t, n_bodies, 3])?,
+            )?;
+            d.set_item("contact_gap", PyArray1::from_vec(py, self.contact_gap))?;
+        }
         d.set_item("steps", t)?;
         Ok(d)
     }
@@ -223,12 +277,57 @@ fn read_poses(
 /// (clip a, clip b, chord, cable length between them) of each span.
 type SpanTuple = (String, String, f64, f64);
 
+/// The obstacle poses at step k (the last given for later steps; None without contact).
+fn obstacle_at(poses: &[Vec<Pose>], k: usize) -> Option<&[Pose]> {
+    poses.get(k).or(poses.last()).map(|p| p.as_slice())
+}
+
+
 /// One cable: mesh, state and solver.
 #[pyclass(module = "cablelife._core")]
 pub struct Cable {
     rod: Rod,
     state: Option<State>,
     solver: Statics,
+    /// Global poses of the contact obstacles per time step (T, O) (empty: no contact).
+    obstacle_poses: Vec<Vec<Pose>>,
+}
+
+/// (name, body index, kind, dimensions, friction): plane [], sphere [radius], cylinder
+/// [radius, length (inf: infinite)], box [half extents x, y, z].
+type ObstacleTuple = (String, usize, String, Vec<f64>, f64);
+
+fn shape(name: &str, kind: &str, dims: &[f64]) -> PyResult<Box<dyn Shape>> {
+    let positive = |i: usize, what: &str| -> PyResult<f64> {
+        match dims.get(i) {
+            Some(&v) if v > 0.0 && !v.is_nan() => Ok(v),
+            v => Err(PyValueError::new_err(format!(
+                "geometry '{name}': {what} = {v:?}: must be a positive length in m"
+            ))),
+        }
+    };
+    Ok(match kind {
+        "plane" => Box::new(Plane),
+        "sphere" => Box::new(Sphere {
+            radius: positive(0, "radius")?,
+        }),
+        "cylinder" => Box::new(Cylinder {
+            radius: positive(0, "radius")?,
+            length: positive(1, "length")?,
+        }),
+        "box" => Box::new(Cuboid {
+            half: Vector3::new(
+                positive(0, "half size x")?,
+                positive(1, "half size y")?,
+                positive(2, "half size z")?,
+            ),
+        }),
+        other => {
+            return Err(PyValueError::new_err(format!(
+                "geometry '{name}': type = {other:?}; allowed: plane, sphere, cylinder, box"
+            )))
+        }
+    })
 }
 
 impl Cable {
@@ -334,7 +433,63 @@ impl Cable {
             rod,
             state: None,
             solver,
+            obstacle_poses: Vec::new(),
         })
+    }
+
+    /// Contact with rigid obstacles (docs/contact.md): `obstacles` as (name, body index,
+    /// type, dimensions, friction μ); their global poses per time step of the next run,
+    /// `positions` (T, O, 3) and `quaternions` (T, O, 4, scalar first) — T = 1: at rest.
+    /// distance/stick_distance ≤ 0: the defaults for the radius (1 % and 0.1 % of r).
+    #[pyo3(signature = (obstacles, n_bodies, radius, positions, quaternions, distance=0.0,
+        stiffness=0.0, stick_distance=0.0, stick_velocity=1e-3, max_samples=8))]
+    #[allow(clippy::too_many_arguments)]
+    fn set_contact(
+        &mut self,
+        obstacles: Vec<ObstacleTuple>,
+        n_bodies: usize,
+        radius: f64,
+        positions: PyReadonlyArray3<'_, f64>,
+        quaternions: PyReadonlyArray3<'_, f64>,
+        distance: f64,
+        stiffness: f64,
+        stick_distance: f64,
+        stick_velocity: f64,
+        max_samples: usize,
+    ) -> PyResult<()> {
+        let pos = positions.as_array();
+        let qs = quaternions.as_array();
+        let (t, o, three) = pos.dim();
+        if o != obstacles.len() || three != 3 || qs.dim() != (t, o, 4) || t == 0 {
+            return Err(PyValueError::new_err(format!(
+                "obstacle poses must be (T, {}, 3) and (T, {}, 4); got {:?} and {:?}",
+                obstacles.len(),
+                obstacles.len(),
+                pos.dim(),
+                qs.dim()
+            )));
+        }
+        let poses = read_poses(&pos, &qs)?;
+        let mut opts = ContactOptions::for_radius(radius);
+        if distance > 0.0 {
+            opts.distance = distance;
+        }
+        if stick_distance > 0.0 {
+            opts.stick_distance = stick_distance;
+        }
+        opts.stiffness = stiffness;
+        opts.stick_velocity = stick_velocity;
+        opts.max_samples = max_samples;
+        let mut list = Vec::with_capacity(obstacles.len());
+        for (k, (name, body, kind, dims, mu)) in obstacles.into_iter().enumerate() {
+            let sh = shape(&name, &kind, &dims)?;
+            list.push(Obstacle::new(&name, body, sh, mu, &poses[0][k]));
+        }
+        let contact = Contact::new(&self.rod, list, opts, n_bodies)
+            .map_err(|e| PyValueError::new_err(e.0))?;
+        self.solver.contact = Some(contact);
+        self.obstacle_poses = poses;
+        Ok(())
     }
 
     /// Arc lengths of the nodes (N+1,).
@@ -382,12 +537,16 @@ impl Cable {
         let solver = &mut self.solver;
         let state_slot = &mut self.state;
         let mut poller = Poller::new(stop.as_ref(), progress, progress_every, poses.len());
+        let obstacle_poses = &self.obstacle_poses;
         let initial = route(rod, poses.first().map(|p| p.as_slice()))
             .map_err(|e| PyValueError::new_err(e.0))?;
         let (record, error) = py.detach(move || {
             let mut rec = Record::default();
             let mut st = initial;
             for (k, target) in poses.iter().enumerate() {
+                if let (Some(c), Some(p)) = (&mut solver.contact, obstacle_at(obstacle_poses, k)) {
+                    c.set_obstacle_poses(p);
+                }
                 let result = if k == 0 {
                     solver.solve(rod, &mut st)
                 } else {
@@ -395,10 +554,13 @@ impl Cable {
                 };
                 match result {
                     Ok(stats) => {
-                        if let Err(kink) = solver.ws.assemble_static(rod, &st, 1.0, false) {
+                        if let Err(kink) = solver.assemble(rod, &st, 1.0, false) {
                             return (rec, Some(format!("kink at node {}", kink.node)));
                         }
                         rec.push(rod, &st, &solver.ws, &stats);
+                        if let Some(c) = &solver.contact {
+                            rec.push_contact(c);
+                        }
                     }
                     Err(e) => {
                         *state_slot = Some(st);
@@ -514,22 +676,37 @@ impl Cable {
         let rod = &self.rod;
         let solver = &mut self.solver;
         let state_slot = &mut self.state;
+        let obstacle_poses = &self.obstacle_poses;
         let every = output_every.max(1);
         let mut poller = Poller::new(stop.as_ref(), progress, progress_every, t);
         let (record, error) = py.detach(move || {
-            let mut rec = Record::with_capacity(t.saturating_sub(1) / every + 1, rod);
+            let saved = t.saturating_sub(1) / every + 1;
+            let mut rec = Record::with_capacity(saved, rod);
+            if let Some(c) = &solver.contact {
+                rec.reserve_contact(saved, rod.arc.len(), c.body_force.len());
+            }
             let mut st = initial;
+            if let (Some(c), Some(p)) = (&mut solver.contact, obstacle_at(obstacle_poses, 0)) {
+                c.set_obstacle_poses(p);
+            }
             let stats = match solver.solve(rod, &mut st) {
                 Ok(s) => s,
                 Err(e) => return (rec, Some(format!("static equilibrium at t = 0: {e}"))),
             };
             let mut dy = Dynamics::new(rod, &st, &motions[0], opts);
+            dy.contact = solver.contact.clone();
             if let Err(e) = dy.start(rod, &st) {
                 return (rec, Some(format!("start: {e}")));
             }
             rec.push(rod, &st, &dy.ws, &stats);
             rec.push_energies(&dy.energies);
+            if let Some(c) = &dy.contact {
+                rec.push_contact(c);
+            }
             for k in 1..t {
+                if let (Some(c), Some(p)) = (&mut dy.contact, obstacle_at(obstacle_poses, k)) {
+                    c.set_obstacle_poses(p);
+                }
                 match dy.advance(rod, &mut st, time_step, &motions[k - 1], &motions[k], 6) {
                     Ok(s) => {
                         if k % every == 0 {
@@ -546,6 +723,9 @@ impl Cable {
                             rec.push(rod, &st, &dy.ws, &stats);
                             rec.push_viscous(&dy.ws);
                             rec.push_energies(&dy.energies);
+                            if let Some(c) = &dy.contact {
+                                rec.push_contact(c);
+                            }
                         }
                     }
                     Err(e) => {

@@ -38,6 +38,82 @@ pub struct Workspace {
     pub dissipation: f64,
     /// Potential of the external loads (−work), at the current load factor.
     pub load_potential: f64,
+    /// Energy of the contact barrier.
+    pub contact_energy: f64,
+}
+
+/// What an assembly evaluates: the part of the cable, whether the Jacobian is wanted, the
+/// rates (viscoelastic and dynamic assemblies) and the load factor of the external loads.
+#[derive(Clone, Copy)]
+pub struct Eval<'a> {
+    pub part: Part<'a>,
+    pub want_jac: bool,
+    pub rates: Option<&'a Rates>,
+    pub load_factor: f64,
+}
+
+/// A term of the assembly (DESIGN.md §3 "One assembly of terms over a topology"): adds its
+/// residual (gradients by node, edge and ghost) and its Jacobian blocks over the cable's
+/// topology. Internal forces, gravity and dead loads, and contact are terms; solvers add their
+/// own (inertia) and sum them in one Newton system.
+pub trait Term {
+    fn add_residual_jacobian(
+        &mut self,
+        rod: &Rod,
+        st: &State,
+        ev: &Eval,
+        ws: &mut Workspace,
+    ) -> Result<(), KinkAt>;
+}
+
+/// Shear/extension and bending/torsion elements (with Kelvin–Voigt damping given rates).
+pub struct Elastic;
+
+/// Gravity and dead point loads, scaled by the load factor.
+pub struct External;
+
+impl Term for Elastic {
+    #[inline]
+    fn add_residual_jacobian(
+        &mut self,
+        rod: &Rod,
+        st: &State,
+        ev: &Eval,
+        ws: &mut Workspace,
+    ) -> Result<(), KinkAt> {
+        ws.add_elastic_part(rod, st, ev.rates, ev.want_jac, ev.part)
+    }
+}
+
+impl Term for External {
+    #[inline]
+    fn add_residual_jacobian(
+        &mut self,
+        rod: &Rod,
+        st: &State,
+        ev: &Eval,
+        ws: &mut Workspace,
+    ) -> Result<(), KinkAt> {
+        ws.add_external_part(rod, st, ev.load_factor, ev.want_jac, ev.part, ev.rates);
+        Ok(())
+    }
+}
+
+/// An optional term (e.g. contact when enabled) adds nothing when absent.
+impl<T: Term> Term for Option<T> {
+    #[inline]
+    fn add_residual_jacobian(
+        &mut self,
+        rod: &Rod,
+        st: &State,
+        ev: &Eval,
+        ws: &mut Workspace,
+    ) -> Result<(), KinkAt> {
+        match self {
+            Some(t) => t.add_residual_jacobian(rod, st, ev, ws),
+            None => Ok(()),
+        }
+    }
 }
 
 /// Velocities and damping for a viscoelastic assembly.
@@ -122,6 +198,7 @@ impl Workspace {
             elastic_energy: 0.0,
             dissipation: 0.0,
             load_potential: 0.0,
+            contact_energy: 0.0,
         }
     }
 
@@ -164,6 +241,7 @@ impl Workspace {
         self.elastic_energy = 0.0;
         self.dissipation = 0.0;
         self.load_potential = 0.0;
+        self.contact_energy = 0.0;
     }
 
     fn add(&mut self, vi: Var, vj: Var, m: &Matrix3<f64>) {
@@ -497,7 +575,7 @@ impl Workspace {
         }
     }
 
-    /// Full static assembly at a load factor.
+    /// Full static assembly at a load factor (internal forces, gravity and dead loads).
     pub fn assemble_static(
         &mut self,
         rod: &Rod,
@@ -505,9 +583,31 @@ impl Workspace {
         load_factor: f64,
         want_jac: bool,
     ) -> Result<(), KinkAt> {
+        self.assemble_terms(rod, st, load_factor, want_jac, &mut [])
+    }
+
+    /// Full static assembly with further terms (e.g. contact) after the internal forces and
+    /// the external loads.
+    pub fn assemble_terms(
+        &mut self,
+        rod: &Rod,
+        st: &State,
+        load_factor: f64,
+        want_jac: bool,
+        more: &mut [&mut dyn Term],
+    ) -> Result<(), KinkAt> {
+        let ev = Eval {
+            part: Part::All,
+            want_jac,
+            rates: None,
+            load_factor,
+        };
         self.clear(want_jac);
-        self.add_elastic(rod, st, None, want_jac)?;
-        self.add_external(rod, st, load_factor, want_jac);
+        Elastic.add_residual_jacobian(rod, st, &ev, self)?;
+        External.add_residual_jacobian(rod, st, &ev, self)?;
+        for t in more.iter_mut() {
+            t.add_residual_jacobian(rod, st, &ev, self)?;
+        }
         self.finalize(rod, want_jac);
         Ok(())
     }

@@ -15,10 +15,11 @@
 //! factorisation, which is reused across iterations and steps while the iteration contracts
 //! fast. Prescribed unknowns follow the clips; the free twist of swivel clips is massless
 //! (quasistatic within the step).
-use crate::assembly::{KinkAt, Part, Rates, Workspace};
+use crate::assembly::{Elastic, Eval, External, KinkAt, Part, Rates, Term, Workspace};
 use crate::block_tridiag::BlockTridiag;
+use crate::contact::Contact;
 use crate::model::{EdgeKind, NodeKind, Pose, Rod, Segment};
-use crate::rotation::{right_jacobian, rotate_body, rotation_matrix, skew, slerp, Quat};
+use crate::rotation::{log_vec, right_jacobian, rotate_body, rotation_matrix, skew, slerp, Quat};
 use crate::state::State;
 use crate::statics::SolveError;
 use nalgebra::{Matrix3, Vector3, Vector6};
@@ -101,6 +102,12 @@ pub struct DynamicOptions {
     /// Assemble the section forces, moments, reactions and energies at the end of every step;
     /// otherwise only when asked (`update_outputs`), e.g. on the steps that are saved.
     pub outputs_every_step: bool,
+    /// With contact: a step (with the clips' work subtracted, obstacles at rest) whose total
+    /// energy grows by more than this fraction of the energies at play is split in two (an
+    /// impact on the stiff barrier), down to the sub-step depth of `advance`.
+    pub energy_tolerance: f64,
+    /// The Newton tolerance (as `tolerance`) with contact.
+    pub contact_tolerance: f64,
 }
 
 impl Default for DynamicOptions {
@@ -114,6 +121,8 @@ impl Default for DynamicOptions {
             abs_tolerance: 1e-13,
             refactor_rate: 0.5,
             outputs_every_step: true,
+            energy_tolerance: 1e-3,
+            contact_tolerance: 1e-5,
         }
     }
 }
@@ -161,8 +170,10 @@ pub struct Energies {
     pub elastic: f64,
     /// Potential of gravity and dead loads (−work).
     pub load_potential: f64,
-    /// Dissipated by the viscous damping since the start.
+    /// Dissipated by the viscous damping and friction since the start.
     pub dissipated: f64,
+    /// Energy of the contact barrier.
+    pub contact: f64,
 }
 
 /// The factorisation state of one segment's iteration matrix.
@@ -177,6 +188,9 @@ struct SegmentFactor {
 pub struct Dynamics {
     pub ws: Workspace,
     pub opts: DynamicOptions,
+    /// Contact with the surroundings (a term of the assembly when set); the obstacles are
+    /// placed at their poses at t_{n+1} before each step.
+    pub contact: Option<Contact>,
     ga: GenAlpha,
     rates: Rates,
     vdot: Vec<Vector6<f64>>,
@@ -217,6 +231,10 @@ pub struct Dynamics {
     /// Per clip: at the same pose as in the last step, with zero rates.
     clip_still: Vec<bool>,
     pub energies: Energies,
+    /// The outputs (energies, reactions) are those of the current state.
+    outputs_current: bool,
+    /// An obstacle moved in the last step (its work is not accounted: no energy check).
+    obstacles_moved: bool,
     power_n: f64,
     poses: Vec<Pose>,
     length: f64,
@@ -250,6 +268,7 @@ impl Dynamics {
         let n_seg = rod.segments.len();
         let mut dynamics = Dynamics {
             ws: Workspace::new(rod),
+            contact: None,
             ga: GenAlpha::new(opts.rho_inf),
             opts,
             rates,
@@ -286,6 +305,8 @@ impl Dynamics {
             resting: vec![false; n_seg],
             clip_still: Vec::with_capacity(clips.len()),
             energies: Energies::default(),
+            outputs_current: false,
+            obstacles_moved: false,
             power_n: 0.0,
             poses: Vec::with_capacity(clips.len()),
             length: rod.spec.length,
@@ -354,8 +375,13 @@ impl Dynamics {
             }
         }
         self.ws.clear_part(part, want_jac);
-        self.ws
-            .add_elastic_part(rod, st, Some(&self.rates), want_jac, part)?;
+        let ev = Eval {
+            part,
+            want_jac,
+            rates: Some(&self.rates),
+            load_factor: 1.0,
+        };
+        Elastic.add_residual_jacobian(rod, st, &ev, &mut self.ws)?;
         // Inertia: m ẍ on nodes, J ω̇ + ω × Jω on edges (prescribed ones enter the reactions).
         let n_edges = rod.n_edges();
         for b in blocks {
@@ -386,8 +412,9 @@ impl Dynamics {
                 self.ws.jac.add3(b, 1, b, 1, &block);
             }
         }
-        self.ws
-            .add_external_part(rod, st, 1.0, want_jac, part, Some(&self.rates));
+        External.add_residual_jacobian(rod, st, &ev, &mut self.ws)?;
+        self.contact
+            .add_residual_jacobian(rod, st, &ev, &mut self.ws)?;
         self.ws.finalize_part(rod, want_jac, part);
         Ok(())
     }
@@ -409,6 +436,15 @@ impl Dynamics {
         self.v_n.clone_from(&self.rates.v);
         self.vdot_n.clone_from(&self.vdot);
         self.a_n.clone_from(&self.a);
+        self.outputs_current = false;
+        self.obstacles_moved = false;
+        if let Some(c) = &mut self.contact {
+            c.begin_step(&st.x, Some(h));
+            if c.take_moved() {
+                self.resting.fill(false); // moving geometry wakes the cable
+                self.obstacles_moved = true;
+            }
+        }
         // Clips that stay exactly where they are, at rest.
         self.clip_still.clear();
         self.clip_still
@@ -446,7 +482,8 @@ impl Dynamics {
             self.increments[k] = if self.resting[k] {
                 0.0 // unchanged: Δq = 0
             } else {
-                self.update_kinematics(st, h, seg.blocks.clone())
+                let inc = self.update_kinematics(st, h, seg.blocks.clone());
+                self.limit_predictor(st, h, seg).unwrap_or(inc)
             };
             self.local_errors[k] = if self.resting[k] {
                 0.0
@@ -518,7 +555,16 @@ impl Dynamics {
         let mut last_norm = f64::INFINITY;
         let mut last_fresh_norm = f64::INFINITY;
         let mut last_applied = f64::INFINITY;
-        for it in 0..self.opts.max_iterations {
+        // Iterations whose correction the contact shortened do not count (up to 4× the limit).
+        // With contact, the barrier's stiffness turns a small position error into a large
+        // energy error: a tighter tolerance (`contact_tolerance`).
+        let tight = self.opts.contact_tolerance;
+        let mut budget = self.opts.max_iterations;
+        let mut next = 0;
+        let mut strikes = 0;
+        while next < budget {
+            let it = next;
+            next += 1;
             let f = self.factors[k];
             let refactor = !f.valid || f.h != h;
             self.assemble(rod, st, c_damp, c_mass, refactor, Part::Segment(seg))
@@ -540,7 +586,12 @@ impl Dynamics {
             // Diverging: not finite, or a correction with a fresh matrix no smaller than the
             // last one with a fresh matrix (Newton does not contract: give up early, the step
             // is split).
-            if !norm.is_finite() || (refactor && norm >= last_fresh_norm) {
+            // With contact the barrier's Newton path is not monotone: three strikes.
+            if refactor && norm >= last_fresh_norm {
+                strikes += 1;
+            }
+            let allowed = if self.contact.is_some() { 3 } else { 1 };
+            if !norm.is_finite() || strikes >= allowed {
                 // … unless the correction that led to the current iterate was already below
                 // `STALL_TOLERANCE` of the step's increment (the former fixed tolerance): the
                 // iteration has reached what it can (round-off, or the strongly non-linear
@@ -567,17 +618,44 @@ impl Dynamics {
             if refactor {
                 last_fresh_norm = norm;
             }
+            // Contact: no dive through the barrier (the correction is shortened).
+            let alpha = match &self.contact {
+                Some(c) => {
+                    let kx = h * self.k_dq * c_mass;
+                    let (delta, half) = (&self.delta, &self.inertial_half);
+                    let dx = |n: usize| {
+                        if half[n][0] {
+                            kx * delta[n].fixed_rows::<3>(0).into_owned()
+                        } else {
+                            Vector3::zeros()
+                        }
+                    };
+                    c.step_bound(&st.x, dx, seg.edges.iter().cloned())
+                }
+                None => 1.0,
+            };
+            if alpha < 1.0 {
+                for d in &mut self.delta[seg.blocks.clone()] {
+                    *d *= alpha;
+                }
+                last_fresh_norm = f64::INFINITY;
+                budget = (budget + 1).min(4 * self.opts.max_iterations);
+            }
             self.increments[k] = self.apply_correction(rod, st, h, c_mass, seg);
             last_applied = norm;
             self.local_errors[k] = self.local_error(seg.blocks.clone());
             stats.iterations = it + 1;
             let scale = self.increments.iter().cloned().fold(0.0, f64::max);
             let error = self.local_errors.iter().cloned().fold(0.0, f64::max);
-            let tolerance = (self.opts.tolerance * error)
+            let mut tolerance = (self.opts.tolerance * error)
                 .min(STALL_TOLERANCE * scale)
                 .max(TOLERANCE_FLOOR * scale)
                 .max(self.opts.abs_tolerance);
-            if norm < tolerance {
+            // The tighter tolerance while samples are inside the contact barrier.
+            if self.contact.as_ref().is_some_and(|c| c.active > 0) {
+                tolerance = tolerance.min((tight * scale).max(self.opts.abs_tolerance));
+            }
+            if alpha == 1.0 && norm < tolerance {
                 stats.residual = self
                     .ws
                     .residual_norms_range(seg.blocks.clone(), rod.mean_ds())
@@ -605,6 +683,28 @@ impl Dynamics {
         })
     }
 
+    /// Shortens the predictor of a segment (from the state at t_n) so that it does not dive
+    /// through the contact barrier: Δq ← α Δq; returns the new increment if it was shortened.
+    fn limit_predictor(&mut self, st: &mut State, h: f64, seg: &Segment) -> Option<f64> {
+        let c = self.contact.as_ref()?;
+        let (x, x_n) = (&st.x, &self.x_n);
+        let alpha = c.step_bound(x_n, |n| x[n] - x_n[n], seg.edges.iter().cloned());
+        if alpha >= 1.0 {
+            return None;
+        }
+        // Δq = dq0 + k_dq v̇ → α Δq.
+        for b in seg.blocks.clone() {
+            let dq = self.dq0[b] + self.k_dq * self.vdot[b];
+            let target = (alpha * dq - self.dq0[b]) / self.k_dq;
+            for i in 0..6 {
+                if self.inertial[b][i] {
+                    self.vdot[b][i] = target[i];
+                }
+            }
+        }
+        Some(self.update_kinematics(st, h, seg.blocks.clone()))
+    }
+
     /// Returns to the values at the start of the last (failed) step.
     fn rollback(&mut self, st: &mut State) {
         st.x.clone_from(&self.x_n);
@@ -615,6 +715,7 @@ impl Dynamics {
         self.vdot.clone_from(&self.vdot_n);
         self.a.clone_from(&self.a_n);
         self.invalidate_factors();
+        self.outputs_current = false;
     }
 
     fn invalidate_factors(&mut self) {
@@ -636,7 +737,56 @@ impl Dynamics {
         to: &[ClipMotion],
         max_depth: usize,
     ) -> Result<StepStats, SolveError> {
-        match self.step(rod, st, h, to) {
+        // With contact, the energy at t_n and the clip reactions (for the energy check).
+        // Only near the geometry: within d̂ plus twice the step's travel at the current speed.
+        let travel = 2.0
+            * h
+            * self
+                .rates
+                .v
+                .iter()
+                .map(|v| v.fixed_rows::<3>(0).norm())
+                .fold(0.0, f64::max);
+        let guard = max_depth > 0 && self.contact.as_ref().is_some_and(|c| c.near(&st.x, travel));
+        if guard && !self.outputs_current {
+            self.update_outputs(rod, st)?;
+        }
+        let before = guard.then(|| {
+            let reactions: Vec<_> = (0..rod.spec.clips.len())
+                .map(|c| self.ws.clip_reaction(rod, st, c))
+                .collect();
+            (self.energies, reactions, st.clip_pose.clone())
+        });
+        let dissipated = (self.energies.dissipated, self.power_n);
+        let result = self.step(rod, st, h, to);
+        let result = match (result, before) {
+            (Ok(s), Some((e0, r0, poses0))) if !self.obstacles_moved => {
+                self.update_outputs(rod, st)?;
+                let e1 = self.energies;
+                let mut work = 0.0;
+                for (c, (f0, m0)) in r0.iter().enumerate() {
+                    let (f1, m1) = self.ws.clip_reaction(rod, st, c);
+                    let (p0, p1) = (&poses0[c], &st.clip_pose[c]);
+                    let turn = log_vec(&(p1.orientation * p0.orientation.conjugate()));
+                    work += 0.5 * (f0 + f1).dot(&(p1.position - p0.position))
+                        + 0.5 * (m0 + m1).dot(&turn);
+                }
+                let total = |e: &Energies| e.kinetic + e.elastic + e.load_potential + e.contact;
+                let scale = e0.kinetic + e1.kinetic + e0.elastic.abs() + e0.contact + work.abs();
+                if total(&e1) - total(&e0) - work > self.opts.energy_tolerance * scale {
+                    (self.energies.dissipated, self.power_n) = dissipated;
+                    Err(SolveError::NotConverged {
+                        iterations: s.iterations,
+                        residual: s.residual,
+                        load_factor: 1.0,
+                    })
+                } else {
+                    Ok(s)
+                }
+            }
+            (r, _) => r,
+        };
+        match result {
             Ok(s) => Ok(s),
             Err(e) if max_depth == 0 => Err(e),
             Err(_) => {
@@ -825,7 +975,9 @@ impl Dynamics {
             })?;
         self.energies.elastic = self.ws.elastic_energy;
         self.energies.load_potential = self.ws.load_potential;
+        self.energies.contact = self.ws.contact_energy;
         self.energies.kinetic = self.kinetic_energy(rod);
+        self.outputs_current = true;
         Ok(())
     }
 

@@ -2,6 +2,7 @@
 //! search on the scaled residual, load continuation when plain Newton fails, and sub-stepped
 //! clip motions for sequences of equilibria.
 use crate::assembly::{KinkAt, Workspace};
+use crate::contact::Contact;
 use crate::model::{NodeKind, Pose, Rod};
 use crate::rotation::slerp;
 use crate::stability::{free_rigid_motions, Inertia, StabilityCheck};
@@ -165,6 +166,8 @@ const SNAP_JUMP: f64 = 0.01;
 pub struct Statics {
     pub ws: Workspace,
     pub opts: NewtonOptions,
+    /// Contact with the surroundings (a term of the assembly when set).
+    pub contact: Option<Contact>,
     delta: Vec<Vector6<f64>>,
     trial: Vec<Vector6<f64>>,
     base: State,
@@ -196,6 +199,7 @@ impl Statics {
         Statics {
             ws: Workspace::new(rod),
             opts,
+            contact: None,
             delta: vec![Vector6::zeros(); rod.n_edges() + 1],
             trial: vec![Vector6::zeros(); rod.n_edges() + 1],
             base: State::empty(),
@@ -209,6 +213,37 @@ impl Statics {
             before: State::empty(),
             relax_start: State::empty(),
         }
+    }
+
+    /// The static assembly: internal forces, external loads and contact.
+    pub fn assemble(
+        &mut self,
+        rod: &Rod,
+        st: &State,
+        load_factor: f64,
+        want_jac: bool,
+    ) -> Result<(), KinkAt> {
+        self.ws
+            .assemble_terms(rod, st, load_factor, want_jac, &mut [&mut self.contact])
+    }
+
+    /// Limits the step fraction `alpha` of the Newton correction so that the cable does not
+    /// dive through the contact barrier; returns the smallest gap at the current state (from
+    /// its assembly), for the acceptance test of the trial.
+    fn contact_bound(&self, rod: &Rod, st: &State, alpha: &mut f64) -> f64 {
+        let Some(c) = &self.contact else {
+            return f64::INFINITY;
+        };
+        let a = *alpha;
+        let dx = |n: usize| {
+            if rod.mask[n][0] {
+                a * self.delta[n].fixed_rows::<3>(0).into_owned()
+            } else {
+                nalgebra::Vector3::zeros()
+            }
+        };
+        *alpha *= c.step_bound(&st.x, dx, 0..rod.n_edges());
+        c.min_gap
     }
 
     fn kink_err(rod: &Rod, k: KinkAt) -> SolveError {
@@ -230,8 +265,7 @@ impl Statics {
     ) -> Result<SolveStats, SolveError> {
         let h = rod.mean_ds();
         let l = rod.spec.length;
-        self.ws
-            .assemble_static(rod, st, load_factor, true)
+        self.assemble(rod, st, load_factor, true)
             .map_err(|k| Self::kink_err(rod, k))?;
         let (_, mut rinf) = self.ws.residual_norms(h);
         let mut stats = SolveStats::default();
@@ -250,6 +284,10 @@ impl Statics {
             let step = (dx / l).max(dth);
             let norm0 = scaled_norm(&self.delta, l);
             let mut alpha = 1.0f64.min(self.opts.max_rotation_step / dth.max(1e-300));
+            let gap0 = self.contact_bound(rod, st, &mut alpha);
+            if std::env::var_os("ROD_DEBUG").is_some() {
+                eprintln!("  bound alpha {alpha:.3e} gap {gap0:.3e}");
+            }
             // Damped: Deuflhard's natural monotonicity test, the simplified Newton correction
             // J⁻¹ r(x ⊕ αΔ) with the factorisation at hand must shrink. It is invariant to the
             // scaling of the equations, so a stiff EA does not distort it. (Residual-norm line
@@ -258,7 +296,7 @@ impl Statics {
             let mut accepted = false;
             for _ in 0..16 {
                 st.apply_increment(rod, &self.delta, alpha);
-                if self.ws.assemble_static(rod, st, load_factor, false).is_ok() {
+                if self.assemble(rod, st, load_factor, false).is_ok() {
                     for (d, r) in self.trial.iter_mut().zip(&self.ws.rhs) {
                         *d = -r;
                     }
@@ -266,7 +304,8 @@ impl Statics {
                     let theta = scaled_norm(&self.trial, l) / norm0.max(1e-300);
                     let monotone =
                         theta <= 1.0 - 0.25 * alpha || step * alpha < self.opts.step_tolerance;
-                    if theta.is_finite() && (!damped || monotone) {
+                    let feasible = self.contact.as_ref().is_none_or(|c| c.gap_acceptable(gap0));
+                    if theta.is_finite() && (!damped || monotone) && feasible {
                         accepted = true;
                         break;
                     }
@@ -281,8 +320,7 @@ impl Statics {
                     load_factor,
                 });
             }
-            self.ws
-                .assemble_static(rod, st, load_factor, true)
+            self.assemble(rod, st, load_factor, true)
                 .map_err(|k| Self::kink_err(rod, k))?;
             (_, rinf) = self.ws.residual_norms(h);
             if std::env::var_os("ROD_DEBUG").is_some() {
@@ -324,8 +362,7 @@ impl Statics {
                 rod.ds_edge[b.min(nb - 2)].powi(3) / 12.0
             }
         };
-        self.ws
-            .assemble_static(rod, st, load_factor, true)
+        self.assemble(rod, st, load_factor, true)
             .map_err(|k| Self::kink_err(rod, k))?;
         let (mut r_old, mut rinf) = self.ws.residual_norms(h);
         // Start where the damping term matches the largest stiffness on the diagonal.
@@ -357,10 +394,12 @@ impl Statics {
             self.ws.factor(rod)?;
             let (dx, dth) = self.ws.newton_correction(&mut self.delta);
             let step = (dx / l).max(dth);
-            let alpha = 1.0f64.min(self.opts.max_rotation_step / dth.max(1e-300));
+            let mut alpha = 1.0f64.min(self.opts.max_rotation_step / dth.max(1e-300));
+            let gap0 = self.contact_bound(rod, st, &mut alpha);
             self.base.clone_from(st);
             st.apply_increment(rod, &self.delta, alpha);
-            let ok = self.ws.assemble_static(rod, st, load_factor, true).is_ok();
+            let ok = self.assemble(rod, st, load_factor, true).is_ok()
+                && self.contact.as_ref().is_none_or(|c| c.gap_acceptable(gap0));
             let (r_new, r_inf_new) = if ok {
                 self.ws.residual_norms(h)
             } else {
@@ -369,8 +408,7 @@ impl Statics {
             if !(step.is_finite() && r_new.is_finite()) || r_new > 10.0 * r_old.max(1e-300) {
                 // Too bold: back off and damp more.
                 st.clone_from(&self.base);
-                self.ws
-                    .assemble_static(rod, st, load_factor, true)
+                self.assemble(rod, st, load_factor, true)
                     .map_err(|k| Self::kink_err(rod, k))?;
                 sigma = (sigma * 10.0).max(1e-6 * sigma0);
                 continue;
@@ -405,10 +443,23 @@ impl Statics {
     /// The equilibrium found is checked for stability and, if unstable, left for a stable one
     /// (`ensure_stable`); a singular system is diagnosed (a rigid-body motion the clips leave
     /// free, or a zero stiffness).
+    /// With contact, a start that runs through the geometry (a routed shape) is first solved
+    /// without contact; the barrier's penalty continuation then pushes the cable out.
     pub fn solve(&mut self, rod: &Rod, st: &mut State) -> Result<SolveStats, SolveError> {
         self.has_prev = false; // a new sequence starts here
         self.check_held(rod, st)?;
+        let mut pre = SolveStats::default();
+        if self.contact.as_ref().is_some_and(|c| c.penetrates(rod, st)) {
+            let contact = self.contact.take();
+            let start = st.clone();
+            match self.solve_any(rod, st) {
+                Ok(s) => pre = s,
+                Err(_) => st.clone_from(&start),
+            }
+            self.contact = contact;
+        }
         let mut stats = self.solve_any(rod, st)?;
+        stats.iterations += pre.iterations;
         self.ensure_stable(rod, st, &mut stats, 0.0)?;
         stats.snap = None; // leaving an unstable first solution is no jump of the cable
         Ok(stats)
@@ -447,6 +498,9 @@ impl Statics {
 
     /// Any equilibrium: plain Newton, pseudo-transient, load continuation (see `solve`).
     fn solve_any(&mut self, rod: &Rod, st: &mut State) -> Result<SolveStats, SolveError> {
+        if let Some(c) = &mut self.contact {
+            c.begin_step(&st.x, None); // friction acts against the motion from the start
+        }
         let start = st.clone();
         // Plain Newton converges in a handful of iterations from a good guess; a slow start
         // means a poor guess, for which the pseudo-transient path is the better use of time.
@@ -490,8 +544,8 @@ impl Statics {
         assemble: bool,
     ) -> Result<Inertia, SolveError> {
         if assemble {
-            self.ws
-                .assemble_static(rod, st, 1.0, true)
+            self
+                .assemble(rod, st, 1.0, true)
                 .map_err(|k| Self::kink_err(rod, k))?;
         }
         Ok(self.stability.inertia(&self.ws.jac, 0..rod.arc.len()))
@@ -545,7 +599,7 @@ impl Statics {
             for sign in [1.0, -1.0] {
                 st.clone_from(&self.before);
                 st.apply_increment(rod, &self.trial, sign * amp);
-                if self.ws.assemble_static(rod, st, 1.0, false).is_ok() {
+                if self.assemble(rod, st, 1.0, false).is_ok() {
                     let e = self.ws.elastic_energy + self.ws.load_potential;
                     if e < best.0 {
                         best = (e, sign);
@@ -758,8 +812,7 @@ impl Statics {
                 }
             }
         };
-        self.ws
-            .assemble_static(rod, st, 1.0, true)
+        self.assemble(rod, st, 1.0, true)
             .map_err(|k| Self::kink_err(rod, k))?;
         let mut energy = self.ws.elastic_energy + self.ws.load_potential;
         let (_, mut rinf) = self.ws.residual_norms(h);
@@ -816,7 +869,7 @@ impl Statics {
             let mut accepted = false;
             for _ in 0..30 {
                 st.apply_increment(rod, &self.delta, alpha);
-                if self.ws.assemble_static(rod, st, 1.0, false).is_ok() {
+                if self.assemble(rod, st, 1.0, false).is_ok() {
                     let e = self.ws.elastic_energy + self.ws.load_potential;
                     let armijo = conservative && e <= energy + 1e-4 * alpha * slope;
                     for (d, r) in self.trial.iter_mut().zip(&self.ws.rhs) {
@@ -835,13 +888,12 @@ impl Statics {
             }
             if !accepted {
                 sigma = (sigma * 10.0).max(floor);
-                self.ws
-                    .assemble_static(rod, st, 1.0, true)
+                self.assemble(rod, st, 1.0, true)
                     .map_err(|k| Self::kink_err(rod, k))?;
                 continue;
             }
-            self.ws
-                .assemble_static(rod, st, 1.0, true)
+            self
+                .assemble(rod, st, 1.0, true)
                 .map_err(|k| Self::kink_err(rod, k))?;
             (_, rinf) = self.ws.residual_norms(h);
             if std::env::var_os("ROD_DEBUG").is_some() {
@@ -864,8 +916,7 @@ impl Statics {
                 }
                 next_newton = it + 10;
                 st.clone_from(&self.base);
-                self.ws
-                    .assemble_static(rod, st, 1.0, true)
+                self.assemble(rod, st, 1.0, true)
                     .map_err(|k| Self::kink_err(rod, k))?;
             }
             sigma = if sigma <= floor { 0.0 } else { 0.1 * sigma };
@@ -937,6 +988,9 @@ impl Statics {
     ) -> Result<SolveStats, SolveError> {
         self.start_poses.clone_from(&st.clip_pose);
         self.saved.clone_from(st);
+        if let Some(c) = &mut self.contact {
+            c.begin_step(&st.x, None); // friction against the motion since the last equilibrium
+        }
         st.set_clip_poses(rod, target);
         match self.newton(rod, st, 1.0, false) {
             Ok(mut s) => {

@@ -116,6 +116,8 @@ def volume_command(
         st.add_column(escape("least distance [mm]"), justify="right")
         st.add_column(escape("volume inside the body [l]"), justify="right")
         for chk in volume_vs_surroundings(res, h):
-            st.add_row(escape(chk.body), f"{chk.min_distance * 1e3:.2f}", f"{chk.intersection * 1e3:.4g}")
+            st.add_row(
+                escape(chk.body), f"{chk.min_distance * 1e3:.2f}", f"{chk.intersection * 1e3:.4g}"
+            )
         console.print(st)
     console.print(escape(f"mesh saved to {output}"))

@@ -1,0 +1,118 @@
+"""Contact speed (issue 15): the dynamic benchmark scene (1.2 m cable, 100 segments, four clips,
+a bracket excited by 10–200 Hz random motion of 2 mm RMS, 1 ms steps) with a table (plane) and
+a pipe (cylinder) under the sagging spans so that 10–30 nodes touch, side by side with the same
+run without contact; and the static equilibrium with and without contact. Analytic primitives:
+the 100 000-triangle mesh case comes with the mesh-distance crate (after the merge).
+
+Figures are medians over --repeat K runs (solver wall time: the Rust run, including the static
+equilibrium at t = 0; one core: OpenBLAS held to one thread).
+Run: python benchmarks/bench_contact.py [--quick] [--repeat K]
+"""
+
+from __future__ import annotations
+
+import os
+import statistics
+import sys
+import time
+
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+import numpy as np  # noqa: E402
+
+sys.path.insert(0, os.path.dirname(__file__))
+from bench_dynamic import scene as dynamic_scene  # noqa: E402
+from cablelife.scene import scene_from_dict  # noqa: E402
+from cablelife.simulate import simulate  # noqa: E402
+
+GEOMETRY = [
+    {"type": "plane", "name": "table", "center": [0.0, 0.0, -0.30], "normal": [0, 0, 1]},
+    {
+        "type": "cylinder",
+        "name": "pipe",
+        "center": [0.2, 0.0, -0.1],
+        "axis": [0, 1, 0],
+        "radius": 0.02,
+        "length": 0.6,
+        "friction": 0.3,
+    },
+]
+
+
+YOUNG = 2e7  # a soft hose: it drapes over the table
+
+
+def scene(duration: float, contact: bool, mode: str = "dynamic") -> dict:
+    """The benchmark scene of bench_dynamic with a slack span draped on a table over a pipe:
+    the cable is 1.2 m between clips 0.9 m apart (bracket-2 moved in)."""
+    d = dynamic_scene(100, duration)
+    d["simulation"]["mode"] = mode
+    clips = d["cables"][0]["clips"]
+    d["cables"][0]["clips"] = [clips[0], clips[3]]
+    clips[3]["position"] = [0.9, 0.0, 0.0]
+    d["bodies"][0]["origin"] = [0.9, 0.0, 0.0]
+    d["cables"][0]["material"]["youngs_modulus"] = YOUNG
+    if contact:
+        d["contact"] = {"enabled": True, "friction": 0.2, "geometry": GEOMETRY}
+    return d
+
+
+def run(duration: float, contact: bool, mode: str = "dynamic") -> dict:
+    sc = scene_from_dict(scene(duration, contact, mode))
+    t0 = time.perf_counter()
+    res = simulate(sc).cable
+    total = time.perf_counter() - t0
+    out = {
+        "wall": res.solver["wall_time"],
+        "total": total,
+        "iterations": float(np.mean(res.solver["iterations"][1:] if mode == "dynamic" else 0)),
+        "static_iterations": int(res.solver["iterations"][0]),
+    }
+    if contact:
+        active = (res.contact["contact_state"] > 0).sum(axis=1)
+        out["contacts"] = (int(active.min()), float(active.mean()), int(active.max()))
+        out["gap"] = float(res.contact["contact_gap"].min())
+    return out
+
+
+def median(runs: list[dict], key: str) -> float:
+    return statistics.median(r[key] for r in runs)
+
+
+def main() -> None:
+    quick = "--quick" in sys.argv
+    repeat = int(sys.argv[sys.argv.index("--repeat") + 1]) if "--repeat" in sys.argv else 1
+    duration = 1.0 if quick else 5.0
+    steps = int(round(duration / 1e-3))
+    print(
+        f"dynamic: N = 100, {duration:g} s at 1 ms ({steps} steps), 10–200 Hz, 2 mm RMS; "
+        f"median of {repeat}"
+    )
+    print(
+        f"{'':>16} {'solver wall [s]':>16} {'µs/step':>9} {'× real time':>12} {'it/step':>8}"
+        f" {'contacts min/mean/max':>22} {'min gap [µm]':>13}"
+    )
+    for contact in (False, True):
+        runs = [run(duration, contact) for _ in range(repeat)]
+        wall = median(runs, "wall")
+        extra = ""
+        if contact:
+            lo, mean, hi = runs[0]["contacts"]
+            extra = f" {f'{lo}/{mean:.1f}/{hi}':>22} {runs[0]['gap'] * 1e6:>13.2f}"
+        print(
+            f"{'with contact' if contact else 'without contact':>16} {wall:>16.3f}"
+            f" {wall / steps * 1e6:>9.1f} {duration / wall:>12.1f}"
+            f" {median(runs, 'iterations'):>8.2f}{extra}"
+        )
+    print(f"static equilibrium (same scene at t = 0), median of {max(repeat, 5)}:")
+    for contact in (False, True):
+        runs = [run(0.1, contact, "static") for _ in range(max(repeat, 5))]
+        print(
+            f"{'with contact' if contact else 'without contact':>16}"
+            f" {median(runs, 'wall') * 1e3:>8.2f} ms, {runs[0]['static_iterations']} iterations"
+            + (f", {runs[0]['contacts'][1]:.0f} nodes in contact" if contact else "")
+        )
+
+
+if __name__ == "__main__":
+    main()

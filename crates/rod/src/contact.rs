@@ -1,0 +1,1100 @@
+//! Contact of the cable with rigid surroundings (docs/contact.md): obstacles answer
+//! closest-point queries (signed distance, outward normal and its gradient), and the contact
+//! term adds a smooth barrier on the gap between the cable surface and the obstacle, with
+//! smoothed Coulomb friction, to the assembly.
+//!
+//! Gap at a point x of the centreline: g = φ(x) − r (φ the obstacle's signed distance, r the
+//! cable radius). Energy per edge: κ Σ_k w_k b(g(x_k)) over sample points x_k = (1−t_k)a + t_k b
+//! of the edge (composite trapezoid rule, w_k the arc-length weights), with the IPC barrier
+//! b(g) = −(g − d̂)² ln(g/d̂) on (0, d̂), zero beyond d̂, continued below g_s = d̂/1000 by its
+//! second-order Taylor polynomial (C², defined for any gap: a penetrated start, a predictor or a
+//! moving obstacle never make it undefined).
+//!
+//! Friction (smoothed Coulomb, IPC's f₁ with a stick zone of width ε): per sample the force
+//! μ λ f₁(|u_T|) u_T/|u_T| opposes the tangential displacement u_T = (I − n nᵀ)(x − x_ref) since
+//! the start of the step (statics: since the last equilibrium, ε = `stick_distance`; dynamics:
+//! within the time step, ε = `stick_velocity` · h), with λ = −κ w b'(g) the sample's normal force
+//! and n the normal, both at the current iterate (not lagged; the Jacobian is exact and
+//! non-symmetric). Contact with a rigid obstacle couples only the two nodes of an edge: the
+//! block-tridiagonal structure stays.
+use crate::assembly::{Eval, KinkAt, Part, Term, Workspace};
+use crate::model::{NodeKind, Pose, Rod};
+use crate::rotation::rotation_matrix;
+use crate::state::State;
+use nalgebra::{Matrix3, Vector3};
+use std::fmt;
+
+/// Signed distance of a point to a shape, its gradient (the outward normal) and the gradient of
+/// the normal (the Hessian of the distance; zero on flat parts).
+#[derive(Clone, Copy, Debug)]
+pub struct PointQuery {
+    pub distance: f64,
+    pub normal: Vector3<f64>,
+    pub hessian: Matrix3<f64>,
+}
+
+impl PointQuery {
+    /// The closest point on the surface.
+    pub fn closest_point(&self, p: &Vector3<f64>) -> Vector3<f64> {
+        p - self.distance * self.normal
+    }
+}
+
+/// Closest points between a segment and a shape.
+#[derive(Clone, Copy, Debug)]
+pub struct SegmentQuery {
+    /// Signed distance of the segment to the surface (negative: the segment penetrates).
+    pub distance: f64,
+    /// Parameter of the segment's closest point, in [0, 1].
+    pub t: f64,
+    pub point: Vector3<f64>,
+    /// Closest point on the surface and outward normal there.
+    pub closest: Vector3<f64>,
+    pub normal: Vector3<f64>,
+}
+
+/// A solid convex shape in its own frame: the geometry an obstacle answers queries with.
+/// Meshes implement this too (after the merge with the mesh-distance crate).
+pub trait Shape: Send + Sync + fmt::Debug {
+    /// Signed distance (positive outside), normal and its gradient at a point (local frame).
+    fn query(&self, p: &Vector3<f64>) -> PointQuery;
+    /// The signed distance alone (broad phase).
+    fn distance(&self, p: &Vector3<f64>) -> f64 {
+        self.query(p).distance
+    }
+    /// The smallest radius of curvature of the surface that a cable can touch (0: sharp
+    /// edges, ∞: flat); it sets the sample spacing along the edges.
+    fn min_radius(&self) -> f64;
+    /// A bound on the distance from the local origin to any surface point (∞: unbounded).
+    fn bounding_radius(&self) -> f64;
+    fn clone_box(&self) -> Box<dyn Shape>;
+}
+
+impl Clone for Box<dyn Shape> {
+    fn clone(&self) -> Self {
+        self.clone_box()
+    }
+}
+
+/// Half-space below the plane z = 0 of its frame (normal +z).
+#[derive(Clone, Copy, Debug)]
+pub struct Plane;
+
+/// Sphere of a radius about the origin.
+#[derive(Clone, Copy, Debug)]
+pub struct Sphere {
+    pub radius: f64,
+}
+
+/// Solid cylinder about the z axis, centred at the origin, with flat caps at z = ±length/2
+/// (length = ∞: infinite, no caps).
+#[derive(Clone, Copy, Debug)]
+pub struct Cylinder {
+    pub radius: f64,
+    pub length: f64,
+}
+
+/// Box with half extents along the axes, centred at the origin.
+#[derive(Clone, Copy, Debug)]
+pub struct Cuboid {
+    pub half: Vector3<f64>,
+}
+
+fn flat(distance: f64, normal: Vector3<f64>) -> PointQuery {
+    PointQuery {
+        distance,
+        normal,
+        hessian: Matrix3::zeros(),
+    }
+}
+
+/// Distance to a point c at distance d > 0 with unit direction n: Hessian (I − n nᵀ)/d.
+fn around_point(d: f64, n: Vector3<f64>) -> PointQuery {
+    PointQuery {
+        distance: d,
+        normal: n,
+        hessian: (Matrix3::identity() - n * n.transpose()) / d,
+    }
+}
+
+impl Shape for Plane {
+    fn query(&self, p: &Vector3<f64>) -> PointQuery {
+        flat(p.z, Vector3::z())
+    }
+    fn distance(&self, p: &Vector3<f64>) -> f64 {
+        p.z
+    }
+    fn min_radius(&self) -> f64 {
+        f64::INFINITY
+    }
+    fn bounding_radius(&self) -> f64 {
+        f64::INFINITY
+    }
+    fn clone_box(&self) -> Box<dyn Shape> {
+        Box::new(*self)
+    }
+}
+
+impl Shape for Sphere {
+    fn query(&self, p: &Vector3<f64>) -> PointQuery {
+        let rho = p.norm();
+        if rho < 1e-12 * self.radius {
+            return flat(-self.radius, Vector3::z());
+        }
+        let n = p / rho;
+        PointQuery {
+            distance: rho - self.radius,
+            normal: n,
+            hessian: (Matrix3::identity() - n * n.transpose()) / rho,
+        }
+    }
+    fn distance(&self, p: &Vector3<f64>) -> f64 {
+        p.norm() - self.radius
+    }
+    fn min_radius(&self) -> f64 {
+        self.radius
+    }
+    fn bounding_radius(&self) -> f64 {
+        self.radius
+    }
+    fn clone_box(&self) -> Box<dyn Shape> {
+        Box::new(*self)
+    }
+}
+
+impl Shape for Cylinder {
+    fn distance(&self, p: &Vector3<f64>) -> f64 {
+        let qs = (p.x * p.x + p.y * p.y).sqrt() - self.radius;
+        let qc = p.z.abs() - 0.5 * self.length;
+        qs.max(qc).min(0.0) + (qs.max(0.0).powi(2) + qc.max(0.0).powi(2)).sqrt()
+    }
+    fn query(&self, p: &Vector3<f64>) -> PointQuery {
+        let rho = (p.x * p.x + p.y * p.y).sqrt();
+        let (radial, tangential) = if rho > 1e-12 * self.radius {
+            let r = Vector3::new(p.x / rho, p.y / rho, 0.0);
+            (r, Vector3::new(-r.y, r.x, 0.0))
+        } else {
+            (Vector3::x(), Vector3::y())
+        };
+        let qs = rho - self.radius;
+        let qc = p.z.abs() - 0.5 * self.length;
+        let axial = Vector3::new(0.0, 0.0, p.z.signum());
+        let side = |d: f64| PointQuery {
+            distance: d,
+            normal: radial,
+            // Distance to the axis: curvature 1/ρ about it.
+            hessian: tangential * tangential.transpose() / rho.max(1e-300),
+        };
+        if qs <= 0.0 && qc <= 0.0 {
+            // Inside: the nearer of side and cap.
+            return if qs >= qc { side(qs) } else { flat(qc, axial) };
+        }
+        if qc <= 0.0 {
+            return side(qs);
+        }
+        if qs <= 0.0 {
+            return flat(qc, axial);
+        }
+        // Outside beyond the rim circle: distance to the circle.
+        let d = (qs * qs + qc * qc).sqrt();
+        let n = (qs * radial + qc * axial) / d;
+        let in_plane =
+            Matrix3::identity() - n * n.transpose() - tangential * tangential.transpose();
+        PointQuery {
+            distance: d,
+            normal: n,
+            hessian: in_plane / d + (qs / (d * rho)) * tangential * tangential.transpose(),
+        }
+    }
+    fn min_radius(&self) -> f64 {
+        if self.length.is_finite() {
+            0.0 // sharp rims
+        } else {
+            self.radius
+        }
+    }
+    fn bounding_radius(&self) -> f64 {
+        (self.radius * self.radius + 0.25 * self.length * self.length).sqrt()
+    }
+    fn clone_box(&self) -> Box<dyn Shape> {
+        Box::new(*self)
+    }
+}
+
+impl Shape for Cuboid {
+    fn distance(&self, p: &Vector3<f64>) -> f64 {
+        let q = p.abs() - self.half;
+        q.max().min(0.0) + q.map(|v| v.max(0.0)).norm()
+    }
+    fn query(&self, p: &Vector3<f64>) -> PointQuery {
+        let q = p.abs() - self.half;
+        let sign = p.map(|v| if v < 0.0 { -1.0 } else { 1.0 });
+        let out = q.map(|v| v.max(0.0));
+        let n_out = (0..3).filter(|&k| q[k] > 0.0).count();
+        if n_out == 0 {
+            // Inside: the nearest face.
+            let k = q.imax();
+            let mut n = Vector3::zeros();
+            n[k] = sign[k];
+            return flat(q[k], n);
+        }
+        let d = out.norm();
+        let n = sign.component_mul(&out) / d;
+        match n_out {
+            1 => flat(d, n),
+            2 => {
+                // Distance to an edge line along the axis that is inside.
+                let k = (0..3).find(|&k| q[k] <= 0.0).unwrap();
+                let mut l = Vector3::zeros();
+                l[k] = 1.0;
+                PointQuery {
+                    distance: d,
+                    normal: n,
+                    hessian: (Matrix3::identity() - n * n.transpose() - l * l.transpose()) / d,
+                }
+            }
+            _ => around_point(d, n),
+        }
+    }
+    fn min_radius(&self) -> f64 {
+        0.0
+    }
+    fn bounding_radius(&self) -> f64 {
+        self.half.norm()
+    }
+    fn clone_box(&self) -> Box<dyn Shape> {
+        Box::new(*self)
+    }
+}
+
+/// A shape on a body, placed by a pose (its frame in the global frame), with its friction
+/// coefficient.
+#[derive(Clone, Debug)]
+pub struct Obstacle {
+    pub name: String,
+    /// Index of the body that carries it (for the per-body force totals).
+    pub body: usize,
+    pub shape: Box<dyn Shape>,
+    /// Coulomb friction coefficient μ.
+    pub friction: f64,
+    position: Vector3<f64>,
+    rotation: Matrix3<f64>,
+    moved: bool,
+}
+
+impl Obstacle {
+    pub fn new(name: &str, body: usize, shape: Box<dyn Shape>, friction: f64, pose: &Pose) -> Self {
+        Obstacle {
+            name: name.into(),
+            body,
+            shape,
+            friction,
+            position: pose.position,
+            rotation: rotation_matrix(&pose.orientation),
+            moved: true,
+        }
+    }
+
+    /// Moves the obstacle rigidly (the pose of its frame in the global frame).
+    pub fn set_pose(&mut self, pose: &Pose) {
+        let rotation = rotation_matrix(&pose.orientation);
+        if pose.position != self.position || rotation != self.rotation {
+            self.moved = true;
+        }
+        self.position = pose.position;
+        self.rotation = rotation;
+    }
+
+    /// Signed distance, outward normal and its gradient at a global point.
+    #[inline]
+    pub fn query(&self, p: &Vector3<f64>) -> PointQuery {
+        let local = self.rotation.transpose() * (p - self.position);
+        let q = self.shape.query(&local);
+        PointQuery {
+            distance: q.distance,
+            normal: self.rotation * q.normal,
+            hessian: if q.hessian == Matrix3::zeros() {
+                q.hessian
+            } else {
+                self.rotation * q.hessian * self.rotation.transpose()
+            },
+        }
+    }
+
+    /// Signed distance at a global point (broad phase).
+    #[inline]
+    pub fn distance(&self, p: &Vector3<f64>) -> f64 {
+        self.shape
+            .distance(&(self.rotation.transpose() * (p - self.position)))
+    }
+
+    /// Closest points between the segment [a, b] and the obstacle (the distance along the
+    /// segment is convex for convex shapes: golden-section search to 1e-12 of the length).
+    pub fn segment_query(&self, a: &Vector3<f64>, b: &Vector3<f64>) -> SegmentQuery {
+        let at = |t: f64| self.query(&(a + t * (b - a))).distance;
+        let golden = 0.5 * (5f64.sqrt() - 1.0);
+        let (mut lo, mut hi) = (0.0f64, 1.0f64);
+        let mut x1 = hi - golden * (hi - lo);
+        let mut x2 = lo + golden * (hi - lo);
+        let (mut f1, mut f2) = (at(x1), at(x2));
+        while hi - lo > 1e-12 {
+            if f1 <= f2 {
+                hi = x2;
+                x2 = x1;
+                f2 = f1;
+                x1 = hi - golden * (hi - lo);
+                f1 = at(x1);
+            } else {
+                lo = x1;
+                x1 = x2;
+                f1 = f2;
+                x2 = lo + golden * (hi - lo);
+                f2 = at(x2);
+            }
+        }
+        let mut t = 0.5 * (lo + hi);
+        for end in [0.0, 1.0] {
+            if at(end) <= at(t) {
+                t = end;
+            }
+        }
+        let point = a + t * (b - a);
+        let q = self.query(&point);
+        SegmentQuery {
+            distance: q.distance,
+            t,
+            point,
+            closest: q.closest_point(&point),
+            normal: q.normal,
+        }
+    }
+}
+
+/// Parameters of the contact term (docs/contact.md).
+#[derive(Clone, Debug)]
+pub struct ContactOptions {
+    /// Cable radius r, m.
+    pub radius: f64,
+    /// Activation distance d̂ of the barrier, m (the gap stays in (0, d̂) in contact).
+    pub distance: f64,
+    /// Barrier stiffness κ, N/m² (≤ 0: automatic, from the cable's weight per length).
+    pub stiffness: f64,
+    /// Width of the stick zone of static and quasistatic friction, m.
+    pub stick_distance: f64,
+    /// Width of the stick zone of dynamic friction, m/s.
+    pub stick_velocity: f64,
+    /// Largest number of sample intervals per edge (on curved and sharp geometry).
+    pub max_samples: usize,
+}
+
+impl ContactOptions {
+    /// Defaults for a cable of radius r: d̂ = 1 % of r, ε_x = 0.1 % of r, ε_v = 0.1 mm/s.
+    pub fn for_radius(radius: f64) -> Self {
+        ContactOptions {
+            radius,
+            distance: 0.01 * radius,
+            stiffness: 0.0,
+            stick_distance: 1e-3 * radius,
+            stick_velocity: 1e-3,
+            max_samples: 8,
+        }
+    }
+}
+
+/// Barrier b(g), b'(g), b''(g) (times κ elsewhere), zero beyond d̂, C² Taylor continuation
+/// below g_s = d̂/1000.
+#[inline]
+pub fn barrier(g: f64, dhat: f64) -> (f64, f64, f64) {
+    if g >= dhat {
+        return (0.0, 0.0, 0.0);
+    }
+    let gs = 1e-3 * dhat;
+    let exact = |g: f64| {
+        let d = g - dhat;
+        let l = (g / dhat).ln();
+        (
+            -d * d * l,
+            -2.0 * d * l - d * d / g,
+            -2.0 * l - 4.0 * d / g + d * d / (g * g),
+        )
+    };
+    if g >= gs {
+        exact(g)
+    } else {
+        let (b, b1, b2) = exact(gs);
+        let dg = g - gs;
+        (b + b1 * dg + 0.5 * b2 * dg * dg, b1 + b2 * dg, b2)
+    }
+}
+
+/// Per node: no contact, sticking (tangential motion within the stick zone), slipping.
+pub const NO_CONTACT: u8 = 0;
+pub const STICK: u8 = 1;
+pub const SLIP: u8 = 2;
+
+/// Residual, Jacobian and energy contributions of one sample point of an edge.
+#[derive(Clone, Copy, Debug)]
+pub struct SampleTerms {
+    pub energy: f64,
+    /// Contact force gradient (∂E/∂x) and the friction force (as a gradient: the force on the
+    /// cable is minus these).
+    pub normal_grad: Vector3<f64>,
+    pub friction_grad: Vector3<f64>,
+    /// ∂(normal_grad + friction_grad)/∂x.
+    pub jac: Matrix3<f64>,
+    /// Tangential displacement |u_T| relative to the stick width.
+    pub slip_ratio: f64,
+    /// Work of friction over the step (≥ 0).
+    pub friction_work: f64,
+}
+
+/// The contact term at a point x with weight w (arc length, m), reference x_ref, obstacle
+/// query q: barrier and friction (μ, stick width ε).
+#[allow(clippy::too_many_arguments)]
+#[inline]
+pub fn sample_terms(
+    q: &PointQuery,
+    x: &Vector3<f64>,
+    x_ref: &Vector3<f64>,
+    w: f64,
+    radius: f64,
+    dhat: f64,
+    kappa: f64,
+    mu: f64,
+    eps: f64,
+    want_jac: bool,
+) -> Option<SampleTerms> {
+    let g = q.distance - radius;
+    if g >= dhat {
+        return None;
+    }
+    let (b, b1, b2) = barrier(g, dhat);
+    let kw = kappa * w;
+    let n = q.normal;
+    let normal_grad = kw * b1 * n;
+    let mut jac = if want_jac {
+        kw * (b2 * n * n.transpose() + b1 * q.hessian)
+    } else {
+        Matrix3::zeros()
+    };
+    let mut friction_grad = Vector3::zeros();
+    let mut slip_ratio = 0.0;
+    let mut friction_work = 0.0;
+    if mu > 0.0 {
+        let lambda = -kw * b1; // ≥ 0
+        let u = x - x_ref;
+        let un = n.dot(&u);
+        let wt = u - un * n;
+        let s = wt.norm();
+        slip_ratio = s / eps;
+        // φ₁(s) = f₁(s)/s and φ₁'(s).
+        let (phi, dphi) = if s < eps {
+            (2.0 / eps - s / (eps * eps), -1.0 / (eps * eps))
+        } else {
+            (1.0 / s, -1.0 / (s * s))
+        };
+        friction_grad = mu * lambda * phi * wt;
+        friction_work = friction_grad.dot(&u);
+        if want_jac {
+            // ∂w_T/∂x = T − n (H u)ᵀ − (n·u) H;  ∂λ/∂x = −κ w b'' nᵀ.
+            let t = Matrix3::identity() - n * n.transpose();
+            let dw = t - n * (q.hessian * u).transpose() - un * q.hessian;
+            let mut dphiw = phi * Matrix3::identity();
+            if s > 0.0 {
+                dphiw += (dphi / s) * wt * wt.transpose();
+            }
+            jac += mu * lambda * dphiw * dw + (mu * phi * (-kw * b2)) * wt * n.transpose();
+        }
+    }
+    Some(SampleTerms {
+        energy: kw * b,
+        normal_grad,
+        friction_grad,
+        jac,
+        slip_ratio,
+        friction_work,
+    })
+}
+
+/// The contact term of one cable: obstacles, parameters, the friction reference and the
+/// outputs of the last full assembly.
+#[derive(Clone, Debug)]
+pub struct Contact {
+    pub obstacles: Vec<Obstacle>,
+    pub opts: ContactOptions,
+    /// κ in use, N/m².
+    pub kappa: f64,
+    /// Node positions at the start of the step (friction reference).
+    reference: Vec<Vector3<f64>>,
+    /// Stick width of the current step (m) and the step duration (dynamics).
+    eps: f64,
+    step: Option<f64>,
+    /// Sample intervals per edge for each obstacle.
+    samples: Vec<usize>,
+    /// Outputs of the last assembly of the whole cable: forces of the geometry on the cable
+    /// per node (global, N), split into normal and friction parts, node states, totals per body.
+    pub normal_force: Vec<Vector3<f64>>,
+    pub friction_force: Vec<Vector3<f64>>,
+    pub node_state: Vec<u8>,
+    pub body_force: Vec<Vector3<f64>>,
+    /// Smallest gap (cable surface to geometry) over the sample points, m.
+    pub min_gap: f64,
+    /// Samples inside the barrier (gap below d̂) in the last assembly.
+    pub active: usize,
+}
+
+/// Invalid contact settings.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ContactError(pub String);
+
+impl fmt::Display for ContactError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+impl std::error::Error for ContactError {}
+
+impl Contact {
+    /// The term for a cable; `n_bodies` sizes the per-body totals.
+    pub fn new(
+        rod: &Rod,
+        obstacles: Vec<Obstacle>,
+        opts: ContactOptions,
+        n_bodies: usize,
+    ) -> Result<Contact, ContactError> {
+        let bad = |what: &str, v: f64, allowed: &str| {
+            Err(ContactError(format!("contact {what} = {v}: {allowed}")))
+        };
+        if !(opts.radius.is_finite() && opts.radius > 0.0) {
+            return bad("radius", opts.radius, "must be a positive length in m");
+        }
+        if !(opts.distance.is_finite() && opts.distance > 0.0) {
+            return bad("distance", opts.distance, "must be a positive length in m");
+        }
+        if !(opts.stiffness.is_finite() && opts.stiffness >= 0.0) {
+            return bad(
+                "stiffness",
+                opts.stiffness,
+                "must be ≥ 0 N/m² (0: automatic)",
+            );
+        }
+        if !(opts.stick_distance.is_finite() && opts.stick_distance > 0.0) {
+            return bad("stick_distance", opts.stick_distance, "must be > 0 m");
+        }
+        if !(opts.stick_velocity.is_finite() && opts.stick_velocity > 0.0) {
+            return bad("stick_velocity", opts.stick_velocity, "must be > 0 m/s");
+        }
+        if opts.max_samples < 1 {
+            return Err(ContactError("contact max_samples = 0: must be ≥ 1".into()));
+        }
+        for o in &obstacles {
+            if !(o.friction.is_finite() && o.friction >= 0.0) {
+                return Err(ContactError(format!(
+                    "geometry '{}': friction = {}: must be a number ≥ 0",
+                    o.name, o.friction
+                )));
+            }
+            if o.body >= n_bodies {
+                return Err(ContactError(format!(
+                    "geometry '{}': body index {} out of range (0..{n_bodies})",
+                    o.name, o.body
+                )));
+            }
+        }
+        let kappa = if opts.stiffness > 0.0 {
+            opts.stiffness
+        } else {
+            // The weight per length (standard gravity) at a gap of about d̂/2.
+            rod.spec.section.mass_per_length * 9.81 / opts.distance
+        };
+        let ds = rod.ds_edge.iter().cloned().fold(0.0, f64::max);
+        // Sample spacing: the chord between samples dips into a surface of radius R by at
+        // most spacing²/(8R); keep that below half the 1 %-of-r tolerance.
+        let samples = obstacles
+            .iter()
+            .map(|o| {
+                let radius = o.shape.min_radius();
+                if radius.is_infinite() {
+                    1
+                } else {
+                    let spacing = (8.0 * radius * 0.005 * opts.radius).sqrt();
+                    ((ds / spacing).ceil() as usize).clamp(1, opts.max_samples)
+                }
+            })
+            .collect();
+        let n = rod.arc.len();
+        Ok(Contact {
+            obstacles,
+            kappa,
+            eps: opts.stick_distance,
+            opts,
+            reference: vec![Vector3::zeros(); n],
+            step: None,
+            samples,
+            normal_force: vec![Vector3::zeros(); n],
+            friction_force: vec![Vector3::zeros(); n],
+            node_state: vec![NO_CONTACT; n],
+            body_force: vec![Vector3::zeros(); n_bodies],
+            min_gap: f64::INFINITY,
+            active: 0,
+        })
+    }
+
+    /// Starts a step from the positions `x`: the friction reference; `h` the time step of a
+    /// dynamic step (None: static or quasistatic).
+    pub fn begin_step(&mut self, x: &[Vector3<f64>], h: Option<f64>) {
+        self.reference.copy_from_slice(x);
+        self.step = h;
+        self.eps = match h {
+            Some(h) => self.opts.stick_velocity * h,
+            None => self.opts.stick_distance,
+        };
+    }
+
+    /// Whether an obstacle moved since the last call (and clears the flags).
+    pub fn take_moved(&mut self) -> bool {
+        let mut any = false;
+        for o in &mut self.obstacles {
+            any |= o.moved;
+            o.moved = false;
+        }
+        any
+    }
+
+    /// Moves the obstacles of body `b` to the body pose (their frames relative to the body are
+    /// given by `local`, one per obstacle).
+    pub fn set_obstacle_poses(&mut self, poses: &[Pose]) {
+        for (o, p) in self.obstacles.iter_mut().zip(poses) {
+            o.set_pose(p);
+        }
+    }
+
+    /// The largest fraction α ∈ (0, 1] of a motion `dx(n)` of the nodes from the positions `x`
+    /// that keeps every sample's gap above a tenth of its current value, by the gap's
+    /// linearisation along the normal (exact for planes); for the edges `edges`.
+    pub fn step_bound(
+        &self,
+        x: &[Vector3<f64>],
+        dx: impl Fn(usize) -> Vector3<f64>,
+        edges: impl Iterator<Item = usize> + Clone,
+    ) -> f64 {
+        let mut alpha = 1.0f64;
+        let r = self.opts.radius;
+        for (k, o) in self.obstacles.iter().enumerate() {
+            let kk = self.samples[k];
+            for e in edges.clone() {
+                let (a, b) = (x[e], x[e + 1]);
+                let (da, db) = (dx(e), dx(e + 1));
+                let motion = da.norm().max(db.norm());
+                let mid = 0.5 * (a + b);
+                let half = 0.5 * (b - a).norm();
+                if o.distance(&mid) - half - r > motion {
+                    continue;
+                }
+                for i in 0..=kk {
+                    let t = i as f64 / kk as f64;
+                    let q = o.query(&(a + t * (b - a)));
+                    let g = q.distance - r;
+                    let approach = -q.normal.dot(&(da + t * (db - da)));
+                    if g > 0.0 && approach * alpha > 0.9 * g {
+                        alpha = 0.9 * g / approach;
+                    }
+                }
+            }
+        }
+        alpha
+    }
+
+    /// Whether a trial state is acceptable after one with the smallest gap `before`: its
+    /// smallest gap (from the last full assembly) stays above a tenth of min(before, d̂), or
+    /// does not shrink if the cable already penetrated.
+    pub fn gap_acceptable(&self, before: f64) -> bool {
+        if before > 0.0 {
+            self.min_gap >= 0.1 * before.min(self.opts.distance)
+        } else {
+            self.min_gap >= before
+        }
+    }
+
+    /// Whether any edge comes within d̂ + `margin` of an obstacle (broad phase only).
+    pub fn near(&self, x: &[Vector3<f64>], margin: f64) -> bool {
+        let reach = self.opts.radius + self.opts.distance + margin;
+        self.obstacles.iter().any(|o| {
+            x.windows(2).any(|w| {
+                let half = 0.5 * (w[1] - w[0]).norm();
+                o.distance(&(0.5 * (w[0] + w[1]))) - half < reach
+            })
+        })
+    }
+
+    /// Whether a free node of the state lies inside an obstacle (negative gap).
+    pub fn penetrates(&self, rod: &Rod, st: &State) -> bool {
+        self.obstacles.iter().any(|o| {
+            st.x.iter().enumerate().any(|(n, x)| {
+                rod.node_kind[n] == NodeKind::Free && o.query(x).distance - self.opts.radius < 0.0
+            })
+        })
+    }
+
+    /// The smallest signed gap between the cable surface (capsules of the edges) and the
+    /// geometry, with where it is: (gap, edge, obstacle).
+    pub fn surface_gap(&self, st: &State) -> (f64, usize, usize) {
+        let mut best = (f64::INFINITY, 0, 0);
+        for (k, o) in self.obstacles.iter().enumerate() {
+            for e in 0..st.x.len().saturating_sub(1) {
+                let g = o.segment_query(&st.x[e], &st.x[e + 1]).distance - self.opts.radius;
+                if g < best.0 {
+                    best = (g, e, k);
+                }
+            }
+        }
+        best
+    }
+
+    /// Energy, gradient and Jacobian of edge e (nodes a = x_e, b = x_{e+1}) against obstacle k;
+    /// adds into the workspace (Jacobian rows of free nodes only) and, with `outputs`, the
+    /// force outputs.
+    #[allow(clippy::too_many_arguments)]
+    fn add_edge(
+        &mut self,
+        rod: &Rod,
+        st: &State,
+        ws: &mut Workspace,
+        e: usize,
+        k: usize,
+        want_jac: bool,
+        outputs: bool,
+    ) {
+        let o = &self.obstacles[k];
+        let (a, b) = (st.x[e], st.x[e + 1]);
+        let ds = rod.ds_edge[e];
+        let reach = self.opts.radius + self.opts.distance;
+        // Broad phase: every point of the edge is within |b − a|/2 of its midpoint.
+        let mid = 0.5 * (a + b);
+        let half = 0.5 * (b - a).norm();
+        let far = o.shape.bounding_radius();
+        if far.is_finite() && (mid - o.position).norm() - half - far > reach {
+            return;
+        }
+        if o.distance(&mid) - half >= reach {
+            return;
+        }
+        let kk = self.samples[k];
+        let (ra, rb) = (self.reference[e], self.reference[e + 1]);
+        let a_free = rod.node_kind[e] == NodeKind::Free;
+        let b_free = rod.node_kind[e + 1] == NodeKind::Free;
+        for i in 0..=kk {
+            let t = i as f64 / kk as f64;
+            let w = if i == 0 || i == kk { 0.5 } else { 1.0 } * ds / kk as f64;
+            let x = a + t * (b - a);
+            let q = o.query(&x);
+            if outputs {
+                self.min_gap = self.min_gap.min(q.distance - self.opts.radius);
+            }
+            let xr = ra + t * (rb - ra);
+            let Some(s) = sample_terms(
+                &q,
+                &x,
+                &xr,
+                w,
+                self.opts.radius,
+                self.opts.distance,
+                self.kappa,
+                o.friction,
+                self.eps,
+                want_jac,
+            ) else {
+                continue;
+            };
+            self.active += 1;
+            ws.contact_energy += s.energy;
+            if let Some(h) = self.step {
+                ws.dissipation += s.friction_work / h;
+            }
+            let grad = s.normal_grad + s.friction_grad;
+            let ta = 1.0 - t;
+            ws.node_grad[e] += ta * grad;
+            ws.node_grad[e + 1] += t * grad;
+            if want_jac {
+                if a_free {
+                    ws.jac.add3(e, 0, e, 0, &(ta * ta * s.jac));
+                }
+                if b_free {
+                    ws.jac.add3(e + 1, 0, e + 1, 0, &(t * t * s.jac));
+                }
+                if a_free && b_free && t > 0.0 && t < 1.0 {
+                    let m = ta * t * s.jac;
+                    ws.jac.add3(e, 0, e + 1, 0, &m);
+                    ws.jac.add3(e + 1, 0, e, 0, &m);
+                }
+            }
+            if outputs {
+                self.body_force[o.body] -= grad;
+                for (n, c) in [(e, ta), (e + 1, t)] {
+                    if c == 0.0 {
+                        continue;
+                    }
+                    self.normal_force[n] -= c * s.normal_grad;
+                    self.friction_force[n] -= c * s.friction_grad;
+                }
+                // Node states from the samples at the nodes.
+                for (n, at_node) in [(e, i == 0), (e + 1, i == kk)] {
+                    if at_node && s.normal_grad != Vector3::zeros() {
+                        let state = if o.friction > 0.0 && s.slip_ratio >= 1.0 {
+                            SLIP
+                        } else {
+                            STICK
+                        };
+                        self.node_state[n] = self.node_state[n].max(state);
+                    }
+                }
+            }
+        }
+    }
+}
+
+impl Term for Contact {
+    fn add_residual_jacobian(
+        &mut self,
+        rod: &Rod,
+        st: &State,
+        ev: &Eval,
+        ws: &mut Workspace,
+    ) -> Result<(), KinkAt> {
+        let outputs = matches!(ev.part, Part::All);
+        self.active = 0;
+        if outputs {
+            self.normal_force.iter_mut().for_each(|v| v.fill(0.0));
+            self.friction_force.iter_mut().for_each(|v| v.fill(0.0));
+            self.body_force.iter_mut().for_each(|v| v.fill(0.0));
+            self.node_state.fill(NO_CONTACT);
+            self.min_gap = f64::INFINITY;
+        }
+        for k in 0..self.obstacles.len() {
+            match ev.part {
+                Part::All => {
+                    for e in 0..rod.n_edges() {
+                        self.add_edge(rod, st, ws, e, k, ev.want_jac, outputs);
+                    }
+                }
+                Part::Segment(seg) => {
+                    for &e in &seg.edges {
+                        self.add_edge(rod, st, ws, e, k, ev.want_jac, outputs);
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fd_check::check_derivatives;
+    use crate::rotation::frame_quaternion;
+
+    fn shapes() -> Vec<(&'static str, Box<dyn Shape>)> {
+        vec![
+            ("plane", Box::new(Plane)),
+            ("sphere", Box::new(Sphere { radius: 0.05 })),
+            (
+                "cylinder",
+                Box::new(Cylinder {
+                    radius: 0.04,
+                    length: 0.1,
+                }),
+            ),
+            (
+                "box",
+                Box::new(Cuboid {
+                    half: Vector3::new(0.03, 0.04, 0.05),
+                }),
+            ),
+        ]
+    }
+
+    fn tilted() -> Pose {
+        Pose {
+            position: Vector3::new(0.01, -0.02, 0.03),
+            orientation: frame_quaternion(
+                &Vector3::new(0.3, 0.2, 1.0).normalize(),
+                &Vector3::new(1.0, 0.0, -0.3).normalize(),
+            )
+            .unwrap(),
+        }
+    }
+
+    /// Points just outside the surface (gap within the barrier) of each region of a shape.
+    fn probes(o: &Obstacle, gap: f64) -> Vec<Vector3<f64>> {
+        let mut out = Vec::new();
+        let dirs = [
+            Vector3::new(0.1, 0.2, 1.0),
+            Vector3::new(1.0, 0.1, 0.05),
+            Vector3::new(1.0, 1.0, 0.1),
+            Vector3::new(1.0, 0.9, 1.1),
+            Vector3::new(-0.4, 1.0, 0.2),
+            Vector3::new(0.7, 0.0, 1.2),
+        ];
+        for d in dirs {
+            // March from far out along d (in the obstacle frame) to the gap.
+            let dir = o.rotation * d.normalize();
+            let mut s = 1.0;
+            for _ in 0..200 {
+                let p = o.position + s * dir;
+                let g = o.query(&p).distance;
+                s -= g - gap;
+                if (g - gap).abs() < 1e-14 {
+                    break;
+                }
+            }
+            out.push(o.position + s * dir);
+        }
+        out
+    }
+
+    #[test]
+    fn signed_distance_normal_and_hessian_match_finite_differences() {
+        for (name, shape) in shapes() {
+            let o = Obstacle::new(name, 0, shape, 0.0, &tilted());
+            for p in probes(&o, 0.003) {
+                let q = o.query(&p);
+                let h = 1e-6;
+                for k in 0..3 {
+                    let mut dp = Vector3::zeros();
+                    dp[k] = h;
+                    let (qp, qm) = (o.query(&(p + dp)), o.query(&(p - dp)));
+                    let fd = (qp.distance - qm.distance) / (2.0 * h);
+                    assert!((fd - q.normal[k]).abs() < 1e-7, "{name} normal {k} at {p}");
+                    let fdn = (qp.normal - qm.normal) / (2.0 * h);
+                    let an = q.hessian.column(k);
+                    assert!(
+                        (fdn - an).amax() < 1e-5 * (1.0 + an.amax()),
+                        "{name} hessian col {k} at {p}: fd {fdn} analytic {an}"
+                    );
+                }
+                assert!((q.normal.norm() - 1.0).abs() < 1e-12);
+                assert!(
+                    (o.distance(&p) - q.distance).abs() < 1e-15,
+                    "{name} distance"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn segment_query_finds_interior_closest_points() {
+        let o = Obstacle::new(
+            "s",
+            0,
+            Box::new(Sphere { radius: 0.1 }),
+            0.0,
+            &Pose {
+                position: Vector3::zeros(),
+                orientation: crate::rotation::Quat::identity(),
+            },
+        );
+        let q = o.segment_query(&Vector3::new(-1.0, 0.0, 0.2), &Vector3::new(1.0, 0.0, 0.2));
+        assert!((q.distance - 0.1).abs() < 1e-9 && (q.t - 0.5).abs() < 1e-6);
+        assert!((q.normal - Vector3::z()).norm() < 1e-6);
+        // Endpoint closest.
+        let q = o.segment_query(&Vector3::new(0.0, 0.0, 0.3), &Vector3::new(0.0, 0.0, 0.5));
+        assert!(q.t == 0.0 && (q.distance - 0.2).abs() < 1e-12);
+    }
+
+    #[test]
+    fn barrier_is_c2_and_vanishes_at_the_activation_distance() {
+        let d = 1e-4;
+        let (b, b1, b2) = barrier(d * (1.0 - 1e-9), d);
+        assert!(b.abs() < 1e-25 && b1.abs() < 1e-12 && b2.abs() < 1e-6);
+        for g in [0.5 * d, 2e-3 * d, -0.2 * d] {
+            let h = 1e-5 * g.abs();
+            let (bp, b1p, _) = barrier(g + h, d);
+            let (bm, b1m, _) = barrier(g - h, d);
+            let (_, b1, b2) = barrier(g, d);
+            assert!(((bp - bm) / (2.0 * h) - b1).abs() < 1e-6 * b1.abs());
+            assert!(((b1p - b1m) / (2.0 * h) - b2).abs() < 1e-5 * b2.abs());
+        }
+    }
+
+    /// The energy of an edge against each shape, as a function of its two end points: gradient
+    /// and Hessian against finite differences (frictionless), and the friction force's
+    /// Jacobian against finite differences of the force.
+    #[test]
+    fn edge_energy_and_friction_derivatives_match_finite_differences() {
+        let radius = 0.004;
+        let dhat = 0.01;
+        for (name, shape) in shapes() {
+            let o = Obstacle::new(name, 0, shape, 0.4, &tilted());
+            for p in probes(&o, radius + 0.3 * dhat) {
+                let q0 = o.query(&p);
+                let t = Matrix3::identity() - q0.normal * q0.normal.transpose();
+                let along = (t * Vector3::new(0.3, -0.5, 0.8)).normalize() * 0.004;
+                let (a0, b0) = (p - along, p + 1.1 * along);
+                for slip in [1e-4, 2e-3] {
+                    let (ra, rb) = (a0 + Vector3::new(0.5, 1.0, -0.5) * slip, b0);
+                    let eval = |z: &[f64; 6], mu: f64, jac: bool| {
+                        // Coordinates in units of 1 mm (the FD steps of check_derivatives).
+                        let a = a0 + 1e-3 * Vector3::new(z[0], z[1], z[2]);
+                        let b = b0 + 1e-3 * Vector3::new(z[3], z[4], z[5]);
+                        let mut e = 0.0;
+                        let mut g = [0.0; 6];
+                        let mut m = [[0.0; 6]; 6];
+                        for i in 0..=4 {
+                            let tt = i as f64 / 4.0;
+                            let x = a + tt * (b - a);
+                            let xr = ra + tt * (rb - ra);
+                            let q = o.query(&x);
+                            let w = 0.002;
+                            if let Some(s) =
+                                sample_terms(&q, &x, &xr, w, radius, dhat, 50.0, mu, 1e-3, jac)
+                            {
+                                e += s.energy;
+                                let gr = s.normal_grad + s.friction_grad;
+                                let c = [1.0 - tt, tt];
+                                for r in 0..2 {
+                                    for k in 0..3 {
+                                        g[3 * r + k] += c[r] * gr[k];
+                                        for cc in 0..2 {
+                                            for l in 0..3 {
+                                                m[3 * r + k][3 * cc + l] +=
+                                                    c[r] * c[cc] * s.jac[(k, l)];
+                                            }
+                                        }
+                                    }
+                                }
+                            }
+                        }
+                        (e, g, m)
+                    };
+                    let (_, g, m) = eval(&[0.0; 6], 0.0, true);
+                    assert!(g.iter().any(|v| *v != 0.0), "{name}: no contact");
+                    check_derivatives::<6>(
+                        |z| eval(z, 0.0, false).0,
+                        |i| 1e-3 * g[i],
+                        |i, j| 1e-6 * m[i][j],
+                    );
+                    // Friction: the Jacobian of the force.
+                    let (_, _, m) = eval(&[0.0; 6], 0.4, true);
+                    let scale = m.iter().flatten().fold(0.0f64, |s, v| s.max(v.abs()));
+                    let h = 1e-5; // 10 nm
+                    for j in 0..6 {
+                        let mut zp = [0.0; 6];
+                        let mut zm = [0.0; 6];
+                        zp[j] = h;
+                        zm[j] = -h;
+                        let (gp, gm) = (eval(&zp, 0.4, false).1, eval(&zm, 0.4, false).1);
+                        for i in 0..6 {
+                            let fd = (gp[i] - gm[i]) / (2.0 * h * 1e-3);
+                            assert!(
+                                (fd - m[i][j]).abs() < 1e-5 * scale,
+                                "{name} friction jac {i},{j}: fd {fd} analytic {}",
+                                m[i][j]
+                            );
+                        }
+                    }
+                }
+            }
+        }
+    }
+}

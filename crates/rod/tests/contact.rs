@@ -1,0 +1,561 @@
+//! Contact with the surroundings against analytical references: the capstan equation, a
+//! frictionless wrap (equal tensions), a cable on a table (contact carries the weight), static
+//! friction on an incline (stick below tan α = μ, sliding with g(sin α − μ cos α) above), a cable
+//! dropped onto a plane (comes to rest, energy never grows, no tunnelling), the Jacobian of the
+//! assembly with contact against finite differences, and bad settings.
+mod common;
+use common::*;
+use nalgebra::{Vector3, Vector6};
+use rod::contact::{
+    Contact, ContactOptions, Cylinder, Obstacle, Plane, Shape, Sphere, NO_CONTACT, SLIP, STICK,
+};
+use rod::rotation::{frame_quaternion, Quat};
+use rod::{
+    CableSpec, ClipKind, ClipMotion, DynamicOptions, Dynamics, NewtonOptions, PointLoad, Pose, Rod,
+    Section, State, Statics,
+};
+use std::f64::consts::PI;
+
+fn at(position: Vector3<f64>, normal: Vector3<f64>) -> Pose {
+    // A frame whose z axis is `normal`.
+    let t = rod::rotation::any_normal(&normal);
+    Pose {
+        position,
+        orientation: frame_quaternion(&normal, &t).unwrap(),
+    }
+}
+
+fn origin() -> Pose {
+    Pose {
+        position: Vector3::zeros(),
+        orientation: Quat::identity(),
+    }
+}
+
+/// A state through the given node positions; edge frames with d3 along the chord and d1
+/// perpendicular to it, as close to `up` as possible; clip poses and ghosts from the spec.
+fn state_through(rod: &Rod, x: Vec<Vector3<f64>>, up: Vector3<f64>) -> State {
+    let p = x
+        .windows(2)
+        .map(|w| {
+            let t = (w[1] - w[0]).normalize();
+            frame_quaternion(&t, &(up - up.dot(&t) * t)).unwrap()
+        })
+        .collect();
+    State {
+        x,
+        p,
+        ghost: rod
+            .ghosts
+            .iter()
+            .map(|g| rod.spec.clips[g.clip].pose.orientation)
+            .collect(),
+        clip_pose: rod.spec.clips.iter().map(|c| c.pose).collect(),
+    }
+}
+
+/// A section with independent stiffnesses (N, N m²) and mass per length.
+fn section(axial: f64, bend: f64, mass: f64) -> Section {
+    Section {
+        shear_stiffness: Vector3::new(axial, axial, axial),
+        bend_stiffness: Vector3::new(bend, bend, 0.7 * bend),
+        mass_per_length: mass,
+        rotary_inertia: Vector3::new(1e-7, 1e-7, 2e-7) * mass,
+    }
+}
+
+fn contact(rod: &Rod, obstacles: Vec<Obstacle>, radius: f64) -> Contact {
+    Contact::new(rod, obstacles, ContactOptions::for_radius(radius), 1).unwrap()
+}
+
+/// Cable of radius r over a fixed cylinder (axis y, radius R) with wrap angle π: free end at
+/// s = 0 hanging on the left under a dead load T₁ (down), a fixed clip at the end of the right
+/// span. Returns the rod and the wrapped state.
+struct Capstan {
+    rod: Rod,
+    st: State,
+    r: f64,
+    big_r: f64,
+    load: f64,
+}
+
+fn capstan(mu: f64) -> (Capstan, Statics) {
+    let (r, big_r, span, load) = (0.002, 0.05, 0.1, 10.0);
+    let n = 160;
+    // Nodes on a circle clear of the drum by the chords' sagitta (the chords are the cable)
+    // plus half the barrier's activation distance.
+    let sag = (0.37f64 / n as f64).powi(2) / (8.0 * (big_r + r));
+    let rc = big_r + r + sag + 0.005 * r;
+    let arc = PI * rc;
+    let length = 2.0 * span + arc;
+    let spec = CableSpec {
+        length,
+        segments: n,
+        section: section(1e5, 1e-5, 0.05),
+        natural_curvature: Vector3::zeros(),
+        clips: vec![clip(
+            "pull",
+            length,
+            0.0,
+            ClipKind::Fixed,
+            pose([rc, 0.0, -span], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]),
+        )],
+        loads: vec![PointLoad {
+            s: 0.0,
+            force: Vector3::new(0.0, 0.0, -load),
+            moment: Vector3::zeros(),
+        }],
+        gravity: Vector3::zeros(),
+    };
+    let rod = Rod::new(spec).unwrap();
+    // Stretched by the tension T₁/EA, from the clip backwards.
+    let stretch = 1.0 + load / 1e5;
+    let x = rod
+        .arc
+        .iter()
+        .map(|&s| {
+            let u = (length - s) * stretch; // from the clip
+            if u <= span {
+                Vector3::new(rc, 0.0, -span + u)
+            } else if u <= span + arc {
+                let phi = (u - span) / rc; // from the right, over the top
+                Vector3::new(rc * phi.cos(), 0.0, rc * phi.sin())
+            } else {
+                Vector3::new(-rc, 0.0, -(u - span - arc))
+            }
+        })
+        .collect();
+    let st = state_through(&rod, x, Vector3::new(0.0, 1.0, 0.0));
+    let mut statics = Statics::new(&rod, NewtonOptions::default());
+    let cyl = Cylinder {
+        radius: big_r,
+        length: f64::INFINITY,
+    };
+    // Cylinder axis along global y: its frame's z axis is y.
+    let o = Obstacle::new(
+        "drum",
+        0,
+        Box::new(cyl),
+        mu,
+        &at(Vector3::zeros(), Vector3::y()),
+    );
+    statics.contact = Some(contact(&rod, vec![o], r));
+    (
+        Capstan {
+            rod,
+            st,
+            r,
+            big_r,
+            load,
+        },
+        statics,
+    )
+}
+
+/// Tension at the clip: minus the clip's reaction on the cable (which pulls down).
+fn clip_tension(s: &Statics, c: &Capstan) -> f64 {
+    -s.ws.clip_reaction(&c.rod, &c.st, 0).0.z
+}
+
+#[test]
+fn frictionless_wrap_keeps_the_tension() {
+    let (mut c, mut s) = capstan(0.0);
+    s.solve(&c.rod, &mut c.st).unwrap();
+    let n = c.rod.n_edges();
+    let (t1, t2) = (s.ws.edge_force[n / 8].z, s.ws.edge_force[n - n / 8].z);
+    // Equal but for the rod's bending at the ends of the wrap (EI κ²/2, κ = 1/R).
+    let bending = 0.5 * c.rod.spec.section.bend_stiffness.x / (c.big_r * c.big_r);
+    assert!((t1 - c.load).abs() < 1e-9 * c.load, "T1 = {t1}");
+    assert!((t2 - t1).abs() < bending, "T1 = {t1}, T2 = {t2}");
+    assert!((clip_tension(&s, &c) - t2).abs() < bending);
+    // Section force along the wrap: the same tension everywhere.
+    for e in 0..n {
+        let t = s.ws.edge_force[e].z;
+        assert!((t - c.load).abs() < 2e-3 * c.load, "edge {e}: {t}");
+    }
+    // The contact force balances the pulls: total = 2 T up.
+    let ct = s.contact.as_ref().unwrap();
+    let total: Vector3<f64> = ct.normal_force.iter().sum();
+    assert!((total - Vector3::new(0.0, 0.0, 2.0 * c.load)).norm() < 1e-3 * c.load);
+    // No penetration of the capsules beyond 1 % of r; in contact within d̂ of the surface.
+    let (gap, _, _) = ct.surface_gap(&c.st);
+    assert!(gap > -0.01 * c.r && gap < 0.01 * c.r, "gap {gap}");
+}
+
+/// The drum holds the cable while the clip end is pulled slowly (dynamics, 5 cm/s: inertia
+/// ρAv² ≈ 1e-4 N against 10 N); once the cable slides, the ratio of the end tensions is e^{μθ}.
+#[test]
+fn capstan_ratio_at_slip_is_exp_mu_theta() {
+    let mu = 0.3;
+    let (mut c, mut s) = capstan(mu);
+    s.solve(&c.rod, &mut c.st).unwrap();
+    let v = 0.05;
+    let z0 = c.st.clip_pose[0].position.z;
+    let motion = |t: f64| {
+        let mut pose = c.rod.spec.clips[0].pose;
+        pose.position.z = z0 - v * t;
+        vec![ClipMotion {
+            pose,
+            velocity: Vector3::new(0.0, 0.0, -v),
+            angular_velocity: Vector3::zeros(),
+            acceleration: Vector3::zeros(),
+            angular_acceleration: Vector3::zeros(),
+        }]
+    };
+    let opts = DynamicOptions {
+        tau_shear: Vector3::new(1e-4, 1e-4, 1e-4),
+        tau_bend: Vector3::new(1e-3, 1e-3, 1e-3),
+        ..Default::default()
+    };
+    let mut dy = Dynamics::new(&c.rod, &c.st, &motion(0.0), opts);
+    dy.contact = s.contact.clone();
+    dy.start(&c.rod, &c.st).unwrap();
+    let h = 1e-3;
+    let mut tensions = Vec::new();
+    for k in 1..=150 {
+        let (from, to) = (motion((k - 1) as f64 * h), motion(k as f64 * h));
+        dy.advance(&c.rod, &mut c.st, h, &from, &to, 6).unwrap();
+        if k > 100 {
+            tensions.push(-dy.ws.clip_reaction(&c.rod, &c.st, 0).0.z);
+        }
+    }
+    let ratio = tensions.iter().sum::<f64>() / tensions.len() as f64 / c.load;
+    let exact = (mu * PI).exp();
+    assert!(
+        (ratio - exact).abs() < 0.02 * exact,
+        "ratio {ratio} vs e^(μπ) = {exact}"
+    );
+    let ct = dy.contact.as_ref().unwrap();
+    assert!(ct.node_state.contains(&SLIP));
+    let (gap, _, _) = ct.surface_gap(&c.st);
+    assert!(gap > -0.01 * c.r, "gap {gap}");
+}
+
+/// A cantilever along x clamped at height z₀ over a table, gravity down: the contact forces
+/// and the clip reaction carry the weight, and the cable lies on the table.
+#[test]
+fn cable_on_a_table_carries_its_weight_in_contact() {
+    let r = 0.005;
+    let l = 1.0;
+    let z0 = r + 0.005 * r;
+    let mut spec = cantilever(l, 100, section(1e5, 2e-3, 0.2));
+    spec.clips[0].pose.position = Vector3::new(0.0, 0.0, z0);
+    spec.gravity = Vector3::new(0.0, 0.0, -9.81);
+    let rod = Rod::new(spec).unwrap();
+    let x = rod.arc.iter().map(|&s| Vector3::new(s, 0.0, z0)).collect();
+    let mut st = state_through(&rod, x, Vector3::z());
+    let mut s = Statics::new(&rod, NewtonOptions::default());
+    let table = Obstacle::new("table", 0, Box::new(Plane), 0.0, &origin());
+    s.contact = Some(contact(&rod, vec![table], r));
+    s.solve(&rod, &mut st).unwrap();
+    s.assemble(&rod, &st, 1.0, false).unwrap();
+    let weight = 0.2 * l * 9.81;
+    let ct = s.contact.as_ref().unwrap();
+    let contact_z: f64 = ct.normal_force.iter().map(|f| f.z).sum();
+    let reaction_z = s.ws.clip_reaction(&rod, &st, 0).0.z;
+    assert!(
+        (contact_z + reaction_z - weight).abs() < 1e-6 * weight,
+        "{contact_z} + {reaction_z} vs {weight}"
+    );
+    // Away from the clip (whose bending decays within a few edges) the cable lies flat: each
+    // node's contact force is its weight.
+    for n in 20..rod.arc.len() {
+        let w = rod.node_mass[n] * 9.81;
+        let f = ct.normal_force[n];
+        assert!(
+            (f.z - w).abs() < 1e-6 * w && f.xy().norm() < 1e-9 * w,
+            "node {n}: {f} vs {w}"
+        );
+    }
+    assert!((ct.body_force[0].z - contact_z).abs() < 1e-9 * weight);
+    for n in 1..rod.arc.len() {
+        assert!(
+            ct.node_state[n] != NO_CONTACT,
+            "node {n} not in contact: z = {}",
+            st.x[n].z
+        );
+        assert!(st.x[n].z - r > -0.01 * r && st.x[n].z - r < 0.01 * r);
+    }
+}
+
+/// A free cable lying down the slope of an incline (angle α) at rest, gravity down: dynamics.
+/// Returns the distance slid down the slope after `t` seconds.
+fn incline(alpha: f64, mu: f64, t: f64, r: f64) -> f64 {
+    let l = 0.3;
+    let n = 30;
+    let spec = CableSpec {
+        length: l,
+        segments: n,
+        section: section(1e4, 1e-3, 0.1),
+        natural_curvature: Vector3::zeros(),
+        clips: vec![],
+        loads: vec![],
+        gravity: Vector3::new(0.0, 0.0, -9.81),
+    };
+    let rod = Rod::new(spec).unwrap();
+    let normal = Vector3::new(-alpha.sin(), 0.0, alpha.cos());
+    let down = Vector3::new(-alpha.cos(), 0.0, -alpha.sin());
+    // At the gap where the barrier carries the weight's normal part (κ = ρA g/d̂, automatic).
+    let dhat = ContactOptions::for_radius(r).distance;
+    let (mut lo, mut hi) = (1e-6 * dhat, dhat);
+    for _ in 0..100 {
+        let g = 0.5 * (lo + hi);
+        if -rod::contact::barrier(g, dhat).1 / dhat > alpha.cos() {
+            lo = g;
+        } else {
+            hi = g;
+        }
+    }
+    let lift = (r + lo) * normal;
+    let x = rod.arc.iter().map(|&s| lift - s * down).collect();
+    let mut st = state_through(&rod, x, normal);
+    let slope = Obstacle::new(
+        "slope",
+        0,
+        Box::new(Plane),
+        mu,
+        &at(Vector3::zeros(), normal),
+    );
+    let mut dy = Dynamics::new(&rod, &st, &[], DynamicOptions::default());
+    dy.contact = Some(contact(&rod, vec![slope], r));
+    dy.start(&rod, &st).unwrap();
+    let start = st.x[n / 2];
+    let h = 1e-3;
+    for _ in 0..(t / h).round() as usize {
+        dy.advance(&rod, &mut st, h, &[], &[], 6).unwrap();
+    }
+    let ct = dy.contact.as_ref().unwrap();
+    let (gap, _, _) = ct.surface_gap(&st);
+    assert!(gap > -0.01 * r, "gap {gap}");
+    (st.x[n / 2] - start).dot(&down)
+}
+
+#[test]
+fn friction_holds_on_an_incline_below_the_friction_angle_and_slides_above() {
+    let (mu, t, r) = (0.5, 0.3, 0.003);
+    let g = 9.81;
+    // Sliding: s = ½ g (sin α − μ cos α) t².
+    let alpha = 35f64.to_radians();
+    let exact = 0.5 * g * (alpha.sin() - mu * alpha.cos()) * t * t;
+    let slid = incline(alpha, mu, t, r);
+    assert!(
+        (slid - exact).abs() < 0.02 * exact,
+        "slid {slid} vs {exact}"
+    );
+    // Sticking: tan α = 0.36 < μ: at rest but for the creep within the stick zone, whose
+    // tangential speed is below ε_v.
+    let alpha = 20f64.to_radians();
+    let stuck = incline(alpha, mu, t, r);
+    let creep = ContactOptions::for_radius(r).stick_velocity * t;
+    assert!(
+        stuck.abs() < creep,
+        "moved {stuck} (sliding would be {exact})"
+    );
+    // Frictionless: slides with g sin α.
+    let free = incline(alpha, 0.0, t, r);
+    let exact = 0.5 * g * alpha.sin() * t * t;
+    assert!((free - exact).abs() < 0.02 * exact, "{free} vs {exact}");
+}
+
+/// A cable dropped from 2 cm (tilted) onto a frictionless plane: total energy never grows, the
+/// capsules never go through the plane, and it comes to rest on it.
+fn drop(r: f64) {
+    let l = 0.4;
+    let n = 40;
+    let rho = 1500.0;
+    let sec = circle(r, 5e7, 0.45, rho);
+    let spec = CableSpec {
+        length: l,
+        segments: n,
+        section: sec.clone(),
+        natural_curvature: Vector3::zeros(),
+        clips: vec![],
+        loads: vec![],
+        gravity: Vector3::new(0.0, 0.0, -9.81),
+    };
+    let rod = Rod::new(spec).unwrap();
+    let x = rod
+        .arc
+        .iter()
+        .map(|&s| Vector3::new(s, 0.0, r + 0.02 + 0.01 * s))
+        .collect();
+    let mut st = state_through(&rod, x, Vector3::z());
+    let floor = Obstacle::new("floor", 0, Box::new(Plane), 0.0, &origin());
+    let opts = DynamicOptions {
+        tau_bend: Vector3::new(1e-3, 1e-3, 1e-3),
+        tau_shear: Vector3::new(1e-4, 1e-4, 1e-4),
+        ..Default::default()
+    };
+    let mut dy = Dynamics::new(&rod, &st, &[], opts);
+    dy.contact = Some(contact(&rod, vec![floor], r));
+    dy.start(&rod, &st).unwrap();
+    let total = |d: &Dynamics| {
+        let e = d.energies;
+        e.kinetic + e.elastic + e.load_potential + e.contact
+    };
+    let e0 = total(&dy);
+    let drop_energy = sec.mass_per_length * l * 9.81 * 0.02;
+    let mut last = e0;
+    let (mut last_kinetic, mut last_elastic, mut last_contact) = (0.0, dy.energies.elastic, 0.0);
+    let h = 1e-3;
+    let mut min_gap = f64::INFINITY;
+    for k in 0..3000 {
+        if let Err(e) = dy.advance(&rod, &mut st, h, &[], &[], 6) {
+            panic!("r = {r}: step {k}: {e}");
+        }
+        let e = total(&dy);
+        let en = dy.energies;
+        // Never above the start; per step, within the integrator's fluctuation of the energy
+        // in motion (measured ≤ 0.3 % after the impact excites the cable's bending modes).
+        assert!(
+            e <= e0 + 1e-6 * drop_energy,
+            "r = {r}: step {k}: {e} > {e0}"
+        );
+        let scale = last_kinetic + en.kinetic + last_elastic.abs() + last_contact;
+        assert!(
+            e <= last + 1e-2 * scale,
+            "r = {r}: energy grew at step {k}: {last} → {e} (scale {scale}, {en:?})"
+        );
+        (last, last_kinetic, last_elastic, last_contact) = (e, en.kinetic, en.elastic, en.contact);
+        let ct = dy.contact.as_ref().unwrap();
+        min_gap = min_gap.min(ct.surface_gap(&st).0);
+    }
+    assert!(min_gap > -0.01 * r, "r = {r}: tunnelled to gap {min_gap}");
+    // At rest on the floor after 3 s: vertical motion below 1e-4 of the drop energy (frictionless, the horizontal momentum
+    // the tilted impact gave it stays), lying on the floor within 1 % of r.
+    let vertical: f64 = dy
+        .velocities()
+        .iter()
+        .zip(&rod.node_mass)
+        .map(|(v, m)| 0.5 * m * v[2] * v[2])
+        .sum();
+    assert!(
+        vertical < 1e-4 * drop_energy,
+        "r = {r}: still bouncing, {vertical} J"
+    );
+    assert!(st.x.iter().all(|x| (x.z - r).abs() < 0.01 * r));
+    let ct = dy.contact.as_ref().unwrap();
+    assert!(ct.node_state.iter().all(|&s| s == STICK));
+}
+
+#[test]
+fn dropped_cable_comes_to_rest_without_gaining_energy_or_tunnelling() {
+    for r in [0.001, 0.03] {
+        drop(r);
+    }
+}
+
+/// The assembled Jacobian with contact and friction equals the finite-difference derivative
+/// of the residual (a cable pressed onto a sphere, sliding).
+#[test]
+#[allow(clippy::needless_range_loop)]
+fn jacobian_with_contact_matches_finite_differences() {
+    let r = 0.004;
+    let big_r = 0.05;
+    let spec = CableSpec {
+        length: 0.3,
+        segments: 30,
+        section: section(1e3, 1e-3, 0.1),
+        natural_curvature: Vector3::zeros(),
+        clips: vec![clip(
+            "a",
+            0.0,
+            0.0,
+            ClipKind::Fixed,
+            pose([-0.15, 0.0, big_r + r], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]),
+        )],
+        loads: vec![],
+        gravity: Vector3::new(0.0, 0.0, -9.81),
+    };
+    let rod = Rod::new(spec).unwrap();
+    // Over the sphere's top, some samples inside the barrier, a few penetrating.
+    let x: Vec<Vector3<f64>> = rod
+        .arc
+        .iter()
+        .map(|&s| {
+            let u = s - 0.15;
+            Vector3::new(
+                u,
+                0.002 * u,
+                big_r + r - 3.0 * u * u + 2e-5 * (40.0 * u).sin(),
+            )
+        })
+        .collect();
+    let st = state_through(&rod, x.clone(), Vector3::z());
+    let ball = Obstacle::new(
+        "ball",
+        0,
+        Box::new(Sphere { radius: big_r }),
+        0.4,
+        &origin(),
+    );
+    let mut ct = contact(&rod, vec![ball], r);
+    // Friction reference: shifted along x (sliding) and a little (sticking) at alternate nodes.
+    let reference: Vec<Vector3<f64>> = x
+        .iter()
+        .enumerate()
+        .map(|(i, p)| p - Vector3::new(if i % 2 == 0 { 1e-3 } else { 1e-6 }, 0.0, 0.0))
+        .collect();
+    ct.begin_step(&reference, None);
+    let mut ws = rod::assembly::Workspace::new(&rod);
+    ws.assemble_terms(&rod, &st, 1.0, true, &mut [&mut ct])
+        .unwrap();
+    assert!(ct.normal_force.iter().any(|f| f.norm() > 0.0));
+    let jac = ws.jac.clone();
+    let nb = rod.n_edges() + 1;
+    let h = 1e-8;
+    let mut worst = 0.0f64;
+    let mut scale = 0.0f64;
+    for b in 0..nb {
+        for k in 0..3 {
+            if !rod.mask[b][k] {
+                continue;
+            }
+            let mut rows = Vec::new();
+            for step in [h, -h] {
+                let mut d = vec![Vector6::zeros(); nb];
+                d[b][k] = step;
+                let mut s2 = st.clone();
+                s2.apply_increment(&rod, &d, 1.0);
+                ws.assemble_terms(&rod, &s2, 1.0, false, &mut [&mut ct])
+                    .unwrap();
+                rows.push(ws.rhs.clone());
+            }
+            for rr in b.saturating_sub(1)..(b + 2).min(nb) {
+                let fd = (rows[0][rr] - rows[1][rr]) / (2.0 * h);
+                let an = if rr == b {
+                    jac.diag[b].column(k).into_owned()
+                } else if rr + 1 == b {
+                    jac.upper[rr].column(k).into_owned()
+                } else {
+                    jac.lower[rr].column(k).into_owned()
+                };
+                worst = worst.max((fd - an).amax());
+                scale = scale.max(an.amax());
+            }
+        }
+    }
+    assert!(worst < 1e-5 * scale, "worst {worst:e} of {scale:e}");
+}
+
+#[test]
+fn bad_contact_settings_are_named() {
+    let rod = Rod::new(cantilever(1.0, 10, section(1e4, 1e-3, 0.1))).unwrap();
+    let o = |mu: f64| {
+        Obstacle::new(
+            "bracket",
+            0,
+            Box::new(Plane) as Box<dyn Shape>,
+            mu,
+            &origin(),
+        )
+    };
+    let e = Contact::new(&rod, vec![o(-0.2)], ContactOptions::for_radius(0.005), 1).unwrap_err();
+    assert!(e.0.contains("'bracket'") && e.0.contains("-0.2"), "{e}");
+    let mut opts = ContactOptions::for_radius(0.005);
+    opts.distance = -1.0;
+    let e = Contact::new(&rod, vec![o(0.1)], opts, 1).unwrap_err();
+    assert!(e.0.contains("distance") && e.0.contains("-1"), "{e}");
+    let e = Contact::new(&rod, vec![o(0.1)], ContactOptions::for_radius(f64::NAN), 1).unwrap_err();
+    assert!(e.0.contains("radius"), "{e}");
+}
