@@ -282,7 +282,6 @@ fn obstacle_at(poses: &[Vec<Pose>], k: usize) -> Option<&[Pose]> {
     poses.get(k).or(poses.last()).map(|p| p.as_slice())
 }
 
-
 /// One cable: mesh, state and solver.
 #[pyclass(module = "cablelife._core")]
 pub struct Cable {

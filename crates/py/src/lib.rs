@@ -3,8 +3,8 @@ use pyo3::prelude::*;
 
 mod cable;
 mod fatigue;
-mod stop;
 mod geometry;
+mod stop;
 mod volume;
 
 #[pymodule]

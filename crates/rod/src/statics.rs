@@ -544,8 +544,7 @@ impl Statics {
         assemble: bool,
     ) -> Result<Inertia, SolveError> {
         if assemble {
-            self
-                .assemble(rod, st, 1.0, true)
+            self.assemble(rod, st, 1.0, true)
                 .map_err(|k| Self::kink_err(rod, k))?;
         }
         Ok(self.stability.inertia(&self.ws.jac, 0..rod.arc.len()))
@@ -892,8 +891,7 @@ impl Statics {
                     .map_err(|k| Self::kink_err(rod, k))?;
                 continue;
             }
-            self
-                .assemble(rod, st, 1.0, true)
+            self.assemble(rod, st, 1.0, true)
                 .map_err(|k| Self::kink_err(rod, k))?;
             (_, rinf) = self.ws.residual_norms(h);
             if std::env::var_os("ROD_DEBUG").is_some() {
