@@ -201,6 +201,16 @@ READERS = {
 }
 OUTPUTS = {"lda": "d.h5", "volume": "v.stl", "paraview": "p.pvd", "report": "r.html"}
 
+# Result histories are read when first used (docs/results.md) and checked as they are read: a
+# non-finite value in a dataset that a command does not read cannot reach its outputs, and the
+# command succeeds with finite outputs.
+NOT_READ = {
+    "volume": {"nan-forces", "nan-reaction"},
+    "lda": {"inf-positions", "nan-reaction"},
+    "compare": {"inf-positions", "nan-reaction"},
+    "paraview": {"nan-reaction"},
+}
+
 RESULT_CASES = [
     (reader, name, defect, expect)
     for name, defect, expect in [*RESULT_DEFECTS, *((n, n, e) for n, e in BYTE_DEFECTS)]
@@ -217,9 +227,11 @@ def test_bad_result_file(good, tmp_path, reader, name, defect, expect):
     good_result, _ = good
     bad = make_bad_result(good_result, tmp_path, defect)
     out = tmp_path / OUTPUTS[reader] if reader in OUTPUTS else None
+    unread = name in NOT_READ.get(reader, ())
     cli(
         READERS[reader](bad, good_result, tmp_path),
-        ("bad.h5", *expect),
+        () if unread else ("bad.h5", *expect),
+        code=0 if unread else 2,
         outputs=(out,) if out else (),
         case=f"{reader}:{name}",
     )

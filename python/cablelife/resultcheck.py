@@ -183,30 +183,31 @@ def check_result_file(f: h5py.File, path) -> None:
         )
 
 
+def check_finite(a, where: str, cable: str, key: str) -> None:
+    """Rejects non-finite values (NaN, inf) in one dataset, naming file, cable, dataset, index."""
+    a = np.asarray(a)
+    if a.size and a.dtype.kind == "f" and not np.all(np.isfinite(a)):
+        idx = tuple(int(i) for i in np.argwhere(~np.isfinite(a))[0])
+        raise ResultFileError(
+            f"{where}, cable {cable!r}: dataset {key!r} has the non-finite value "
+            f"{a[idx]} at index {idx}; a result must hold finite numbers"
+        )
+
+
 def check_result_values(result, path) -> None:
-    """Rejects non-finite values (NaN, inf) in a loaded result, naming cable, dataset, step."""
+    """Rejects non-finite values (NaN, inf) in the arrays of a loaded result that are in memory;
+    the histories read on first use (``results.Deferred``) are checked when they are read."""
     where = repr(str(path))
     for name, c in result.cables.items():
-        arrays = {
-            "time": c.time,
-            "arc_length": c.arc_length,
-            "positions": c.positions,
-            "quaternions": c.quaternions,
-            "forces": c.forces,
-            "moments": c.moments,
-            **c.energies,
-        }
+        arrays = {"time": c.time, "arc_length": c.arc_length, **c.energies}
+        for key in ("positions", "quaternions", "forces", "moments"):
+            arrays[key] = c.__dict__.get("_" + key)
         for cn, clip in c.clips.items():
-            arrays[f"clips/{cn}/reaction_force"] = clip.force
-            arrays[f"clips/{cn}/reaction_moment"] = clip.moment
+            arrays[f"clips/{cn}/reaction_force"] = clip.__dict__.get("_force")
+            arrays[f"clips/{cn}/reaction_moment"] = clip.__dict__.get("_moment")
         for key, a in arrays.items():
-            a = np.asarray(a)
-            if a.size and not np.all(np.isfinite(a)):
-                idx = tuple(int(i) for i in np.argwhere(~np.isfinite(a))[0])
-                raise ResultFileError(
-                    f"{where}, cable {name!r}: dataset {key!r} has the non-finite value "
-                    f"{a[idx]} at index {idx}; a result must hold finite numbers"
-                )
+            if isinstance(a, np.ndarray):
+                check_finite(a, where, name, key)
 
 
 def warn_partial(result, path) -> None:

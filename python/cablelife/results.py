@@ -34,7 +34,6 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from cablelife.h5files import atomic_h5, open_h5, plain
-from cablelife.resultcheck import check_result_file, check_result_values, warn_partial
 from cablelife.surroundings.data import CableClearance
 from cablelife.surroundings.display import SurroundingsGeometry
 
@@ -104,9 +103,14 @@ class Deferred:
     def read(self) -> np.ndarray:
         import h5py
 
+        from cablelife.resultcheck import check_finite
+
         with h5py.File(self.path, "r") as f:
             ds = f[self.name]
-            return ds.astype(np.float64)[()] if ds.dtype.kind == "f" else ds[()]
+            a = ds.astype(np.float64)[()] if ds.dtype.kind == "f" else ds[()]
+        _, _, cable, *key = self.name.split("/")  # /cables/<cable>/<dataset…>
+        check_finite(a, repr(self.path), cable, "/".join(key))
+        return a
 
     def __repr__(self) -> str:
         return f"Deferred({self.path!r}, {self.name!r})"
@@ -317,6 +321,8 @@ def load_result(path: str | os.PathLike, lazy: bool = True) -> Result:
     """Read a result written by :func:`save_result`. With ``lazy`` (default) the histories
     (positions, quaternions, forces, moments, clip reactions) are read when first used: the
     file must stay in place until then. Float32 histories are returned as float64."""
+    from cablelife.resultcheck import check_result_file, check_result_values, warn_partial
+
     file = str(Path(path).resolve())
 
     def history(ds):

@@ -40,14 +40,13 @@ def strains(c: CableResult) -> tuple[np.ndarray, np.ndarray]:
     """Axial strain Γ₃ and shear strain |(Γ₁, Γ₂)| per step and edge (T, N) from the saved
     configuration, Γ = Rᵀ (x_{n+1} − x_n)/Δs − e₃ (the model's strain; unlike F/EA it holds no
     damping forces in dynamic runs)."""
-    from scipy.spatial.transform import Rotation
+    from cablelife.export.frames import rotation_matrices
 
     t, n = c.quaternions.shape[:2]
     if t == 0 or n == 0:
         return np.zeros((t, n)), np.zeros((t, n))
     tangent = np.diff(c.positions, axis=1) / np.diff(c.arc_length)[None, :, None]
-    rot = Rotation.from_quat(c.quaternions.reshape(-1, 4), scalar_first=True)
-    gamma = rot.inv().apply(tangent.reshape(-1, 3)).reshape(t, n, 3)
+    gamma = np.einsum("...ji,...j->...i", rotation_matrices(c.quaternions), tangent)  # Rᵀ t
     return gamma[..., 2] - 1.0, np.hypot(gamma[..., 0], gamma[..., 1])
 
 
