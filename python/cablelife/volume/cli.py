@@ -45,6 +45,7 @@ def volume_command(
 ) -> None:
     """Motion volume (union of the tube over all saved steps) as a watertight mesh."""
     from rich.console import Console
+    from rich.progress import Progress
     from rich.table import Table
 
     from cablelife.results import load_result
@@ -65,12 +66,21 @@ def volume_command(
         return res.cables[cable]
 
     a_saved = False
+    bar = Progress(console=err, transient=True)
+
+    def rows(label: str):
+        task = bar.add_task(f"distance field of {label}", total=None)
+        return lambda done, total: bar.update(task, completed=done, total=total)
+
     try:
         h = parse_length(voxel)
-        a = motion_volume(source(result), h)
-        a.save(output, unit=unit)
-        a_saved = True
-        b = motion_volume(source(compare), h) if compare is not None else None
+        with bar:
+            a = motion_volume(source(result), h, progress=rows(result.name))
+            a.save(output, unit=unit)
+            a_saved = True
+            b = None
+            if compare is not None:
+                b = motion_volume(source(compare), h, progress=rows(compare.name))
     except KeyboardInterrupt:
         from cablelife.interrupt import interrupted
 
