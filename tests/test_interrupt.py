@@ -200,11 +200,12 @@ def test_lda_stops_on_ctrl_c_and_writes_no_damage_file(cli, tmp_path, result_fil
 
 def test_volume_stops_on_ctrl_c(cli, tmp_path, result_file):
     mesh = tmp_path / "volume.stl"
-    vol = cli(
-        "volume", str(result_file), "--voxel", "0.7mm", "-o", str(mesh),
-        python_flags=("-X", "importtime"),
-    )  # fmt: skip
-    vol.wait_for(lambda: "cablelife.volume.motion" in vol.stderr, "the command's start")
+    vol = cli("volume", str(result_file), "--voxel", "0.7mm", "-o", str(mesh))
+    under_way = r"distance field of run\.h5.*?(\d+)%"
+    vol.wait_for(
+        lambda: any(int(p) > 0 for p in re.findall(under_way, vol.stderr)),
+        "the distance field under way",
+    )
     vol.interrupt()
     vol.assert_interrupted()
     assert not mesh.exists() and list(tmp_path.glob(".*.tmp")) == []
@@ -216,7 +217,8 @@ def test_report_stops_on_ctrl_c(cli, tmp_path, result_file):
         "report", str(result_file), "-o", str(html), "--voxel", "2mm",
         python_flags=("-X", "importtime"),
     )  # fmt: skip
-    rep.wait_for(lambda: "cablelife.report.html" in rep.stderr, "the command's start")
+    # plotly is imported when the report is being built (after the command line's start-up)
+    rep.wait_for(lambda: re.search(r"\| plotly\.offline$", rep.stderr, re.M), "the report build")
     rep.interrupt()
     rep.assert_interrupted()
     assert not html.exists() and list(tmp_path.glob(".*.tmp")) == []

@@ -459,10 +459,12 @@ def test_a_local_study_runs_no_http_server(tmp_path):
     even without a dashboard. While the study runs, every port its processes listen on is asked
     for a web page: none may answer (only Dask's own protocol listens)."""
     seen: dict[int, bool] = {}
+    me = os.getpid()
+    before = _process_tree(me) - {me}  # e.g. the dask_cluster fixture's processes: not ours
 
     def probe(done: int, total: int, row: dict) -> None:
         if row and not seen:
-            for port in _listening_ports(_process_tree(os.getpid())):
+            for port in _listening_ports(_process_tree(me) - before):
                 seen[port] = _speaks_http(port)
 
     outcome = run_study(write_study(tmp_path, "[0.0]", "[1.25, 1.26]"), tmp_path / "o", workers=1,

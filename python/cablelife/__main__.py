@@ -3,9 +3,22 @@
 Ctrl-C ends every command with exit code 130 and no traceback, also while the modules are
 still being imported (which takes a moment: numpy, scipy, h5py, pydantic, rich, typer)."""
 
+import os
 import sys
 
 EXIT_INTERRUPTED = 130
+
+
+def _exit_interrupted() -> None:
+    """Ends the process with 130 at once. Not ``sys.exit``: CPython ends a process by SIGINT
+    instead when a KeyboardInterrupt passed through an extension module's import, even if it
+    was caught; the command has already stopped its threads and closed its files and clusters."""
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except (OSError, ValueError):
+            pass
+    os._exit(EXIT_INTERRUPTED)
 
 
 def main() -> None:
@@ -14,15 +27,17 @@ def main() -> None:
         from cablelife.interrupt import report_exit
     except KeyboardInterrupt:
         sys.stderr.write("interrupted\n")
-        sys.exit(EXIT_INTERRUPTED)
+        _exit_interrupted()
     try:
         app(prog_name="cablelife")
     except SystemExit as exit_:
         report_exit(exit_.code)
+        if exit_.code == EXIT_INTERRUPTED:
+            _exit_interrupted()
         raise
     except KeyboardInterrupt:  # outside the command (typer turns it into exit code 130 inside)
         report_exit(EXIT_INTERRUPTED)
-        sys.exit(EXIT_INTERRUPTED)
+        _exit_interrupted()
 
 
 if __name__ == "__main__":

@@ -457,13 +457,16 @@ def simulate(scene: Scene, mode: str | None = None, progress: Progress | None = 
         outcomes = [f.result() for f in futures]
     cables = {res.name: res for res, _ in outcomes}
     errors = [f"cable '{res.name}': {err}" for res, err in outcomes if err]
+    stopped = any(err == interrupt.INTERRUPTED for _, err in outcomes) and all(
+        err in (None, interrupt.INTERRUPTED) for _, err in outcomes
+    )
     errors += _check_strains(scene, cables.values())
     result = Result(
         mode=mode,
         cables=cables,
         scene_toml=scene.to_toml(),
         complete=not errors,
-        message=interrupt.INTERRUPTED if errors and stop.is_set else "; ".join(errors),
+        message=interrupt.INTERRUPTED if errors and stopped else "; ".join(errors),
         precision=scene.simulation.output_precision,
     )
     if env is not None:

@@ -98,23 +98,31 @@ impl Poller {
         let progress = &self.progress;
         Python::attach(|py| {
             if let Err(e) = py.check_signals() {
-                if e.is_instance_of::<PyKeyboardInterrupt>(py) {
-                    // Ctrl-C on the main thread (a direct call, as in `cablelife modes`): the run
-                    // stops with what it computed, and the caller still gets its
-                    // KeyboardInterrupt when the call returns (the signal is raised again).
-                    // SAFETY: the GIL is held; the call only sets Python's signal flag.
-                    unsafe { pyo3::ffi::PyErr_SetInterrupt() };
-                }
-                return Some(INTERRUPTED.to_string());
+                return Some(stopped_by(py, e));
             }
             if let Some(cb) = progress {
                 if let Err(e) = cb.call1(py, (done, total)) {
+                    if e.is_instance_of::<PyKeyboardInterrupt>(py) {
+                        return Some(stopped_by(py, e));
+                    }
                     return Some(format!("progress callback failed: {e}"));
                 }
             }
             None
         })
     }
+}
+
+/// Why the run stops after Python raised `e` in the solver thread (its signal check or the
+/// progress callback: Ctrl-C arrives there when the run is a direct call on the main thread,
+/// as in `cablelife modes`). The run stops with what it computed; a KeyboardInterrupt is raised
+/// again, so that the caller still gets it when the call returns.
+fn stopped_by(py: Python<'_>, e: PyErr) -> String {
+    if e.is_instance_of::<PyKeyboardInterrupt>(py) {
+        // SAFETY: the GIL is held; the call only sets Python's pending-signal flag.
+        unsafe { pyo3::ffi::PyErr_SetInterrupt() };
+    }
+    INTERRUPTED.to_string()
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {

@@ -44,6 +44,7 @@ def volume_command(
     unit: Annotated[str, typer.Option(help="length unit in the mesh file: m or mm")] = "m",
 ) -> None:
     """Motion volume (union of the tube over all saved steps) as a watertight mesh."""
+    from rich.progress import Progress
     from rich.table import Table
 
     from cablelife.clitext import console as make_console
@@ -66,15 +67,23 @@ def volume_command(
         return res.cables[cable]
 
     a_saved = False
+    bar = Progress(console=err, transient=True)
+
+    def rows(label: str):
+        task = bar.add_task(escape(f"distance field of {label}"), total=None)
+        return lambda done, total: bar.update(task, completed=done, total=total)
+
     try:
         if unit not in ("m", "mm"):
             raise ValueError(f"unit = {unit!r}: allowed: 'm' or 'mm'")
         h = parse_length(voxel)
-        with printed_warnings(err):
-            a = motion_volume(source(result), h)
+        with bar, printed_warnings(err):
+            a = motion_volume(source(result), h, progress=rows(result.name))
             a.save(output, unit=unit)
             a_saved = True
-            b = motion_volume(source(compare), h) if compare is not None else None
+            b = None
+            if compare is not None:
+                b = motion_volume(source(compare), h, progress=rows(compare.name))
     except KeyboardInterrupt:
         from cablelife.interrupt import interrupted
 

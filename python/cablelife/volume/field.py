@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -101,12 +102,18 @@ def grid_for(bounds: np.ndarray, voxel: float, pad: int = 2) -> tuple[np.ndarray
 
 
 def signed_distance(
-    capsules: Capsules, origin, shape, voxel: float, band: float | None = None
+    capsules: Capsules,
+    origin,
+    shape,
+    voxel: float,
+    band: float | None = None,
+    progress: Callable[[int, int], None] | None = None,
 ) -> VoxelField:
     """The union's signed distance on a grid (parallel compiled kernel, GIL released).
 
     ``band`` (default 3 voxels) bounds the stored magnitude; values are exact inside it, which
-    is all marching cubes needs (a vertex lies within one voxel of the surface)."""
+    is all marching cubes needs (a vertex lies within one voxel of the surface).
+    ``progress(done, total)``: grid rows (axis 0) computed so far."""
     voxel = check_voxel(voxel)
     band = 3.0 * voxel if band is None else float(band)
     origin = np.asarray(origin, dtype=np.float64)
@@ -127,4 +134,6 @@ def signed_distance(
             if values is None:
                 values = np.empty((nx, ny, nz), dtype=part.dtype)
             values[i0 : i0 + n] = part
+        if progress is not None:
+            progress(i0 + n, nx)
     return VoxelField(values=values, origin=origin, spacing=voxel, band=band)

@@ -62,14 +62,14 @@ def save_mesh(mesh: TriangleMesh, path: str | os.PathLike, unit: str = "m", **kw
 
 
 def volume_of_capsules(
-    capsules: Capsules, voxel: float = 0.002, bounds: np.ndarray | None = None
+    capsules: Capsules, voxel: float = 0.002, bounds: np.ndarray | None = None, progress=None
 ) -> MotionVolume:
     """The union of ``capsules`` meshed at ``voxel`` (m) on a grid covering ``bounds``
-    (default: the capsules' own bounds)."""
+    (default: the capsules' own bounds); ``progress(done, total)``: rows of the grid."""
     t0 = time.perf_counter()
     box = capsules.bounding_box if bounds is None else np.asarray(bounds, dtype=np.float64)
     origin, shape = grid_for(box, voxel)
-    f = signed_distance(capsules, origin, shape, voxel)
+    f = signed_distance(capsules, origin, shape, voxel, progress=progress)
     t1 = time.perf_counter()
     mesh = level_set_mesh(f)
     t2 = time.perf_counter()
@@ -84,6 +84,7 @@ def motion_volume(
     steps=None,
     radius: float | None = None,
     bounds: np.ndarray | None = None,
+    progress=None,
 ) -> MotionVolume:
     """The motion volume of a :class:`~cablelife.results.Result` (all its cables), a
     :class:`~cablelife.results.CableResult`, or positions (T, N+1, 3) with ``radius``.
@@ -94,4 +95,4 @@ def motion_volume(
     grid of spacing ``voxel`` (m) and meshed by marching cubes; the mesh is watertight and its
     volume converges like voxel² to the exact volume of the union.
     """
-    return volume_of_capsules(result_capsules(source, steps, radius), voxel, bounds)
+    return volume_of_capsules(result_capsules(source, steps, radius), voxel, bounds, progress)
