@@ -99,7 +99,7 @@ def demo_command(
     if outcome.quasistatic is not None:
         qs = {v.label: v.max_damage for v in outcome.quasistatic.variants}
         parts = [
-            f"{v.label}: {v.max_damage / qs[v.label]:.2f}×"
+            f"{v.label}: {v.max_damage / qs[v.label]:.3g}×"
             for v in cmp.variants
             if qs.get(v.label, 0) > 0
         ]
