@@ -1,4 +1,5 @@
-"""Contact through the scene API: a sagging hose resting on a table (static, dynamic), the
+"""Contact through the scene API: a sagging hose resting on a table (static, dynamic), on a
+mesh table (STL) against the same box as a primitive, on geometry of a moving body, the
 contact outputs in the result and its HDF5 file, and bad contact settings.
 
 The physics of the contact term is tested against analytical references in
@@ -6,6 +7,8 @@ crates/rod/tests/contact.rs; these check that the scene path carries it through.
 """
 
 from __future__ import annotations
+
+import copy
 
 import numpy as np
 import pytest
@@ -17,11 +20,15 @@ TABLE_Z = -0.05
 
 
 def with_table(d, **contact):
-    d["contact"] = {
-        "enabled": True,
-        "geometry": [{"type": "plane", "name": "table", "center": [0.0, 0.0, TABLE_Z]}],
-        **contact,
-    }
+    d["bodies"] = [
+        {
+            "name": "table",
+            "geometry": [
+                {"shape": "plane", "name": "top", "point": [0, 0, TABLE_Z], "normal": [0, 0, 1]}
+            ],
+        }
+    ]
+    d["contact"] = {"enabled": True, **contact}
     return d
 
 
@@ -46,8 +53,9 @@ def test_static_hose_on_a_table_carries_its_weight(scene_dict):
     touching = res.contact["contact_state"][0] > 0
     assert touching.any()
     assert np.all(np.abs(z[touching] - r - TABLE_Z) < 0.01 * r)
-    # Per-body totals: the table is on 'world' (index 0).
-    assert res.contact["body_contact_force"][0, 0] == pytest.approx(f[0].sum(axis=0))
+    # Per-body totals: index 0 is 'world', then the bodies: the table is index 1.
+    assert res.contact["body_contact_force"][0, 1] == pytest.approx(f[0].sum(axis=0))
+    assert np.all(res.contact["body_contact_force"][0, 0] == 0.0)
     # Without contact the hose hangs through the table.
     d = with_table(scene_dict)
     d["contact"]["enabled"] = False
@@ -64,7 +72,7 @@ def test_contact_outputs_are_saved_and_read_back(scene_dict, tmp_path):
     n = res.n_steps
     assert res.contact["contact_normal"].shape == (n, 41, 3)
     assert res.contact["contact_state"].shape == (n, 41)
-    assert res.contact["body_contact_force"].shape == (n, 1, 3)
+    assert res.contact["body_contact_force"].shape == (n, 2, 3)
     assert np.all(res.contact["contact_gap"] > -0.01 * 0.005)
     path = result.save(tmp_path / "r.h5")
     back = load_result(path).cable
@@ -76,22 +84,76 @@ def test_contact_outputs_are_saved_and_read_back(scene_dict, tmp_path):
 @pytest.mark.parametrize(
     ("contact", "message"),
     [
-        ({"enabled": True, "friction": -0.2, "geometry": [{"type": "plane"}]}, "friction"),
-        ({"enabled": True}, "no geometry"),
-        ({"enabled": True, "geometry": [{"type": "sphere"}]}, "radius"),
-        ({"enabled": True, "geometry": [{"type": "cone"}]}, "cone"),
+        ({"enabled": True, "friction": -0.2}, "friction"),
+        ({"enabled": True, "distance": float("nan")}, "distance"),
         (
-            {"enabled": True, "geometry": [{"type": "plane", "friction": -1.0}]},
-            "friction",
+            {"enabled": True, "geometry": [{"type": "plane"}]},
+            r"contact.geometry is no longer read.*\[\[bodies\]\] geometry",
         ),
-        ({"enabled": True, "geometry": [{"type": "plane", "body": "arm"}]}, "'arm'"),
-        ({"enabled": True, "geometry": [{"type": "plane", "normal": [0, 0, 0]}]}, "normal"),
     ],
 )
 def test_bad_contact_settings_are_named(scene_dict, contact, message):
+    with_table(scene_dict)
     scene_dict["contact"] = contact
     with pytest.raises(SceneError, match=message):
         scene_from_dict(scene_dict)
+
+
+@pytest.mark.parametrize("bodies", [[], [{"name": "arm"}]])
+def test_contact_without_geometry_is_an_error(scene_dict, bodies):
+    scene_dict["bodies"] = bodies
+    scene_dict["contact"] = {"enabled": True}
+    with pytest.raises(SceneError, match=r"contact.enabled = true but no body has geometry"):
+        scene_from_dict(scene_dict)
+
+
+def test_part_friction_must_not_be_negative(scene_dict):
+    with_table(scene_dict)
+    scene_dict["bodies"][0]["geometry"][0]["friction"] = -1.0
+    with pytest.raises(SceneError, match="friction"):
+        scene_from_dict(scene_dict)
+
+
+def box_scene(d, part):
+    # A box 0.4 m long under the middle of the hose, its top at TABLE_Z: the hose drapes over
+    # its top and both edges.
+    d["bodies"] = [{"name": "bench", "geometry": [part]}]
+    d["contact"] = {"enabled": True}
+    return d
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="open: the static solve on a box (primitive or mesh: sharp geometry, 8 samples per "
+    "edge) does not converge from the penetrating start; with 1 sample per edge it does",
+)
+def test_hose_on_an_stl_box_matches_the_box_primitive(scene_dict, tmp_path):
+    import trimesh
+
+    center, size = [0.4, 0.1, TABLE_Z - 1.0], [2.0, 2.0, 2.0]
+    box = trimesh.creation.box(extents=size)
+    box.apply_translation(center)
+    box.export(tmp_path / "bench.stl")
+    d = box_scene(scene_dict, {"mesh": "bench.stl"})
+    scene = scene_from_dict(d)
+    scene.base_dir = tmp_path
+    mesh = simulate(scene).cable
+    prim = simulate(
+        scene_from_dict(
+            box_scene(copy.deepcopy(d), {"shape": "box", "center": center, "size": size})
+        )
+    ).cable
+    w = weight(mesh)
+    for res in (mesh, prim):
+        f = res.contact_force[0]
+        clips = sum(c.force[0] for c in res.clips.values())
+        assert f.sum(axis=0) + clips == pytest.approx([0.0, 0.0, w], abs=1e-6 * w)
+        assert f[:, 2].sum() > 0.3 * w  # the box carries part of the weight
+        assert res.contact["body_contact_force"][0, 1] == pytest.approx(f.sum(axis=0))
+    # The mesh answers as the box (distance, normal, Hessian agree to rounding, Rust test
+    # box_mesh_matches_the_box_primitive): the same equilibrium to the solver's tolerance.
+    np.testing.assert_allclose(mesh.positions, prim.positions, atol=1e-9)
+    np.testing.assert_allclose(mesh.contact_force, prim.contact_force, atol=1e-6 * w)
 
 
 def test_quasistatic_hose_lifted_off_and_lowered_onto_a_moving_table(scene_dict):
@@ -116,13 +178,21 @@ def test_quasistatic_hose_lifted_off_and_lowered_onto_a_moving_table(scene_dict)
         },
     ]
     d["cables"][0]["clips"][1]["body"] = "engine"
-    d["contact"]["geometry"][0]["body"] = "shelf"
+    d["bodies"][1]["geometry"] = [
+        {"shape": "plane", "name": "top", "point": [0, 0, TABLE_Z], "normal": [0, 0, 1]}
+    ]
     res = simulate(scene_from_dict(d)).cable
     w = weight(res)
     f = res.contact_force
     clips = sum(c.force for c in res.clips.values())
     np.testing.assert_allclose(f.sum(axis=1)[:, 2] + clips[:, 2], w, atol=1e-6 * w)
     np.testing.assert_allclose(res.contact["body_contact_force"][:, 2], f.sum(axis=1))
+    # The shelf's plane rides on it: the lowest cable surface follows z = TABLE_Z + 5 mm sin.
+    z_shelf = TABLE_Z + 0.005 * np.sin(2 * np.pi * 2.0 * res.time)
+    low = res.positions[:, :, 2].min(axis=1) - 0.005
+    on = (res.contact["contact_state"] > 0).any(axis=1)
+    assert on.any()
+    np.testing.assert_allclose(low[on], z_shelf[on], atol=0.01 * 0.005)
     assert np.all(res.contact["contact_gap"] > -0.01 * 0.005)
     touching = (res.contact["contact_state"] > 0).sum(axis=1)
     assert touching.min() < touching.max()  # the contact changes with the motions

@@ -911,6 +911,12 @@ mod tests {
                     half: Vector3::new(0.03, 0.04, 0.05),
                 }),
             ),
+            (
+                "box mesh",
+                Box::new(crate::contact_mesh::box_mesh(Vector3::new(
+                    0.03, 0.04, 0.05,
+                ))),
+            ),
         ]
     }
 
