@@ -83,6 +83,16 @@ impl Shape for MeshShape {
             hessian,
         }
     }
+    fn distance_within(&self, p: &Vector3<f64>, bound: f64) -> f64 {
+        let hint = self.hint.load(Ordering::Relaxed);
+        match self.mesh.project_point(p, bound, hint) {
+            Some(pr) => {
+                self.hint.store(pr.feature, Ordering::Relaxed);
+                pr.distance
+            }
+            None => f64::INFINITY,
+        }
+    }
     fn min_radius(&self) -> f64 {
         0.0 // sharp edges
     }
