@@ -98,13 +98,18 @@ def obstacles(scene) -> tuple[list, list, list[tuple[np.ndarray, np.ndarray]]]:
                     if isinstance(err, SceneError):
                         raise
                     raise SceneError(f"{what}: {err}") from None
-                v = np.ascontiguousarray(m.vertices @ rot0.T + o)
+                v = m.vertices @ rot0.T + o  # global at rest
                 shells = m.shells or [m.faces]
                 for s, shell in enumerate(shells):
                     label = name if len(shells) == 1 else f"{name}[{s}]"
+                    # the obstacle frame at the shell's bounding-box centre (global axes): its
+                    # bounding sphere rejects far edges before the hierarchy is asked
+                    used = v[np.unique(shell)]
+                    centre = 0.5 * (used.min(axis=0) + used.max(axis=0))
                     tuples.append((label, bi + 1, "mesh", [float(len(meshes))], friction))
-                    frames.append((np.zeros(3), np.eye(3)))  # vertices global at rest
-                    meshes.append((v, np.ascontiguousarray(shell, dtype=np.int64)))
+                    frames.append((centre, np.eye(3)))
+                    faces = np.ascontiguousarray(shell, dtype=np.int64)
+                    meshes.append((np.ascontiguousarray(v - centre), faces))
                 continue
             if isinstance(part, PlanePart):
                 kind, dims = "plane", []
