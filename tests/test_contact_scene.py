@@ -212,3 +212,18 @@ def test_quasistatic_hose_lifted_off_and_lowered_onto_a_moving_table(scene_dict)
     assert np.all(res.contact["contact_gap"] > -0.01 * 0.005)
     touching = (res.contact["contact_state"] > 0).sum(axis=1)
     assert touching.min() < touching.max()  # the contact changes with the motions
+
+
+def test_example_hose_rests_on_the_tray():
+    # examples/surroundings/hose-on-tray-contact.toml: meshes and a box on two bodies, one
+    # moving; the hose rests on the tray (car-body, index 2) at every step without penetrating.
+    from pathlib import Path
+
+    from cablelife.scene import load_scene
+
+    path = Path(__file__).parent.parent / "examples" / "surroundings" / "hose-on-tray-contact.toml"
+    res = simulate(load_scene(path)).cable
+    r = 0.008
+    assert np.all(res.contact["contact_gap"] > -0.01 * r)
+    assert np.all((res.contact["contact_state"] > 0).sum(axis=1) >= 1)
+    assert np.all(res.contact["body_contact_force"][:, 2, 2] > 0.0)
