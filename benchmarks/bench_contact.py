@@ -1,12 +1,13 @@
 """Contact speed (issue 15): the dynamic benchmark scene (1.2 m cable, 100 segments, four clips,
 a bracket excited by 10–200 Hz random motion of 2 mm RMS, 1 ms steps) with a table (plane) and
-a pipe (cylinder) under the sagging spans so that 10–30 nodes touch, side by side with the same
-run without contact; and the static equilibrium with and without contact. Analytic primitives:
-the 100 000-triangle mesh case comes with the mesh-distance crate (after the merge).
+a pipe under the sagging spans so that 10–30 nodes touch, side by side: without contact, with
+the pipe as a cylinder primitive, and with the pipe as a 100 000-triangle mesh (STL, a finely
+tessellated cylinder, the issue's case); and the static equilibrium with and without contact.
+The geometry is on a fixed body (`[[bodies]] geometry`).
 
 Figures are medians over --repeat K runs (solver wall time: the Rust run, including the static
 equilibrium at t = 0; one core: OpenBLAS held to one thread).
-Run: python benchmarks/bench_contact.py [--quick] [--repeat K]
+Run: python benchmarks/bench_contact.py [--quick] [--repeat K] [--only-mesh]
 """
 
 from __future__ import annotations
@@ -25,24 +26,73 @@ from bench_dynamic import scene as dynamic_scene  # noqa: E402
 from cablelife.scene import scene_from_dict  # noqa: E402
 from cablelife.simulate import simulate  # noqa: E402
 
-GEOMETRY = [
-    {"type": "plane", "name": "table", "center": [0.0, 0.0, -0.30], "normal": [0, 0, 1]},
-    {
-        "type": "cylinder",
-        "name": "pipe",
-        "center": [0.2, 0.0, -0.1],
-        "axis": [0, 1, 0],
-        "radius": 0.02,
-        "length": 0.6,
-        "friction": 0.3,
-    },
-]
+TABLE = {"shape": "plane", "name": "table", "point": [0.0, 0.0, -0.30], "normal": [0, 0, 1]}
+PIPE = {
+    "shape": "cylinder",
+    "name": "pipe",
+    "center": [0.2, 0.0, -0.1],
+    "axis": [0, 1, 0],
+    "radius": 0.02,
+    "length": 0.6,
+    "friction": 0.3,
+}
+MESH_TRIANGLES = 100_000
+MESH_DIR = os.path.join(os.environ.get("TMPDIR", "/tmp"), "cablelife_bench_contact")
+
+
+def pipe_mesh() -> str:
+    """The pipe as an STL of MESH_TRIANGLES triangles of CAD-like shape: 250 around × 199
+    along the side (0.5 × 3 mm quads) and fans on the ends."""
+    import trimesh
+
+    path = os.path.join(MESH_DIR, f"pipe_{MESH_TRIANGLES}.stl")
+    if not os.path.exists(path):
+        os.makedirs(MESH_DIR, exist_ok=True)
+        around, along = 250, 199  # 2·250·199 + 2·250 = 100 000 triangles
+        r, length = PIPE["radius"], PIPE["length"]
+        a = 2 * np.pi * np.arange(around) / around
+        z = np.linspace(-length / 2, length / 2, along + 1)
+        ring = np.column_stack([r * np.cos(a), r * np.sin(a)])
+        v = np.concatenate(
+            [np.column_stack([ring, np.full(around, zz)]) for zz in z]
+            + [[[0, 0, -length / 2], [0, 0, length / 2]]]
+        )
+        i, j = np.meshgrid(np.arange(along), np.arange(around), indexing="ij")
+        k00, k01 = i * around + j, i * around + (j + 1) % around
+        k10, k11 = k00 + around, k01 + around
+        side = np.concatenate(
+            [
+                np.stack([k00, k01, k11], -1).reshape(-1, 3),
+                np.stack([k00, k11, k10], -1).reshape(-1, 3),
+            ]
+        )
+        cb, ct, j = len(v) - 2, len(v) - 1, np.arange(around)
+        caps = np.concatenate(
+            [
+                np.column_stack([np.full(around, cb), (j + 1) % around, j]),
+                np.column_stack(
+                    [np.full(around, ct), along * around + j, along * around + (j + 1) % around]
+                ),
+            ]
+        )
+        m = trimesh.Trimesh(v, np.concatenate([side, caps]), process=False)
+        assert len(m.faces) == MESH_TRIANGLES and m.is_watertight and m.volume > 0
+        m.apply_transform(trimesh.transformations.rotation_matrix(np.pi / 2, [1, 0, 0]))
+        m.apply_translation(PIPE["center"])
+        m.export(path)
+    return path
+
+
+def geometry(kind: str) -> list[dict]:
+    if kind == "mesh":
+        return [TABLE, {"mesh": pipe_mesh(), "name": "pipe", "friction": PIPE["friction"]}]
+    return [TABLE, PIPE]
 
 
 YOUNG = 2e7  # a soft hose: it drapes over the table
 
 
-def scene(duration: float, contact: bool, mode: str = "dynamic") -> dict:
+def scene(duration: float, contact: str | None, mode: str = "dynamic") -> dict:
     """The benchmark scene of bench_dynamic with a slack span draped on a table over a pipe:
     the cable is 1.2 m between clips 0.9 m apart (bracket-2 moved in)."""
     d = dynamic_scene(100, duration)
@@ -53,11 +103,12 @@ def scene(duration: float, contact: bool, mode: str = "dynamic") -> dict:
     d["bodies"][0]["origin"] = [0.9, 0.0, 0.0]
     d["cables"][0]["material"]["youngs_modulus"] = YOUNG
     if contact:
-        d["contact"] = {"enabled": True, "friction": 0.2, "geometry": GEOMETRY}
+        d["bodies"].append({"name": "surroundings", "geometry": geometry(contact)})
+        d["contact"] = {"enabled": True, "friction": 0.2}
     return d
 
 
-def run(duration: float, contact: bool, mode: str = "dynamic") -> dict:
+def run(duration: float, contact: str | None, mode: str = "dynamic") -> dict:
     sc = scene_from_dict(scene(duration, contact, mode))
     t0 = time.perf_counter()
     res = simulate(sc).cable
@@ -92,7 +143,9 @@ def main() -> None:
         f"{'':>16} {'solver wall [s]':>16} {'µs/step':>9} {'× real time':>12} {'it/step':>8}"
         f" {'contacts min/mean/max':>22} {'min gap [µm]':>13}"
     )
-    for contact in (False, True):
+    labels = {None: "without contact", "primitive": "cylinder", "mesh": "100k-tri mesh"}
+    kinds = [k for k in (None, "primitive", "mesh") if "--only-mesh" not in sys.argv or k == "mesh"]
+    for contact in kinds:
         runs = [run(duration, contact) for _ in range(repeat)]
         wall = median(runs, "wall")
         extra = ""
@@ -100,15 +153,15 @@ def main() -> None:
             lo, mean, hi = runs[0]["contacts"]
             extra = f" {f'{lo}/{mean:.1f}/{hi}':>22} {runs[0]['gap'] * 1e6:>13.2f}"
         print(
-            f"{'with contact' if contact else 'without contact':>16} {wall:>16.3f}"
+            f"{labels[contact]:>16} {wall:>16.3f}"
             f" {wall / steps * 1e6:>9.1f} {duration / wall:>12.1f}"
             f" {median(runs, 'iterations'):>8.2f}{extra}"
         )
     print(f"static equilibrium (same scene at t = 0), median of {max(repeat, 5)}:")
-    for contact in (False, True):
+    for contact in (None, "primitive", "mesh"):
         runs = [run(0.1, contact, "static") for _ in range(max(repeat, 5))]
         print(
-            f"{'with contact' if contact else 'without contact':>16}"
+            f"{labels[contact]:>16}"
             f" {median(runs, 'wall') * 1e3:>8.2f} ms, {runs[0]['static_iterations']} iterations"
             + (f", {runs[0]['contacts'][1]:.0f} nodes in contact" if contact else "")
         )

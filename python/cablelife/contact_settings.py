@@ -1,82 +1,21 @@
-"""Scene keys of contact with the surroundings (docs/contact.md): ``[contact]`` and its
-geometry primitives, and their global poses over time for the Rust solver.
-
-Until the geometry of ``[[bodies]]`` (the surroundings work) is merged, the primitives are
-listed in ``[[contact.geometry]]`` with the same fields (type plane/box/cylinder/sphere, body,
-center, normal, size, axis, radius, length, friction, frame); the lead unifies them at merge.
-"""
+"""Scene keys of contact with the surroundings (docs/contact.md): ``[contact]``, and the
+contact obstacles built from the geometry of ``[[bodies]]`` (docs/environment.md) with their
+global poses over time for the Rust solver."""
 
 from __future__ import annotations
 
-from typing import Annotated, Literal
+from typing import Annotated
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-Vec3 = tuple[float, float, float]
 
+class ContactSettings(BaseModel):
+    """``[contact]``: off unless ``enabled``; Coulomb ``friction`` μ (a geometry part's own
+    ``friction`` overrides it); barrier and friction-smoothing parameters (0: defaults from the
+    cable radius). The obstacles are the geometry parts of ``[[bodies]]``."""
 
-class _Model(BaseModel):
     model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
-
-
-class Primitive(_Model):
-    """An analytic solid on a body (or on ``world``): plane (half-space below ``normal``),
-    sphere (``radius``), cylinder (``radius``, ``length``, ``axis``; flat caps), box (full
-    ``size``, rotated so that its local z is ``axis``)."""
-
-    type: Literal["plane", "sphere", "cylinder", "box"]
-    name: str = ""
-    body: str = "world"
-    frame: Literal["global", "body"] = "global"
-    center: Vec3 = (0.0, 0.0, 0.0)
-    normal: Vec3 = (0.0, 0.0, 1.0)
-    axis: Vec3 = (0.0, 0.0, 1.0)
-    radius: Annotated[float, Field(gt=0.0)] | None = None
-    length: Annotated[float, Field(gt=0.0)] | None = None
-    size: (
-        tuple[
-            Annotated[float, Field(gt=0.0)],
-            Annotated[float, Field(gt=0.0)],
-            Annotated[float, Field(gt=0.0)],
-        ]
-        | None
-    ) = None
-    friction: Annotated[float, Field(ge=0.0)] | None = None  # overrides [contact] friction
-
-    @model_validator(mode="after")
-    def _dimensions(self):
-        need = {"sphere": ["radius"], "cylinder": ["radius", "length"], "box": ["size"]}
-        missing = [k for k in need.get(self.type, []) if getattr(self, k) is None]
-        if missing:
-            raise ValueError(f"a {self.type} needs {', '.join(missing)}")
-        for key in ("normal", "axis"):
-            if np.linalg.norm(getattr(self, key)) == 0.0:
-                raise ValueError(f"{key} = {getattr(self, key)}: must be a non-zero vector")
-        return self
-
-    def dimensions(self) -> list[float]:
-        if self.type == "sphere":
-            return [self.radius]
-        if self.type == "cylinder":
-            return [self.radius, self.length]
-        if self.type == "box":
-            return [0.5 * s for s in self.size]
-        return []
-
-    def local_frame(self) -> np.ndarray:
-        """Columns: the primitive's axes in its body's (or the global) frame; z = normal/axis."""
-        z = np.asarray(self.normal if self.type == "plane" else self.axis, float)
-        z = z / np.linalg.norm(z)
-        helper = np.array([1.0, 0.0, 0.0]) if abs(z[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
-        x = np.cross(helper, z)
-        x /= np.linalg.norm(x)
-        return np.column_stack([x, np.cross(z, x), z])
-
-
-class ContactSettings(_Model):
-    """``[contact]``: off unless ``enabled``; Coulomb ``friction`` μ (per-primitive override);
-    barrier and friction-smoothing parameters (0: defaults from the cable radius)."""
 
     enabled: bool = False
     friction: Annotated[float, Field(ge=0.0)] = 0.0
@@ -84,70 +23,135 @@ class ContactSettings(_Model):
     stiffness: Annotated[float, Field(ge=0.0)] = 0.0  # κ, N/m² (0: from the weight per length)
     stick_distance: Annotated[float, Field(ge=0.0)] = 0.0  # ε_x, m (0: 0.1 % of r)
     stick_velocity: Annotated[float, Field(gt=0.0)] = 1e-3  # ε_v, m/s
-    geometry: list[Primitive] = []
 
-    @model_validator(mode="after")
-    def _geometry(self):
-        if self.enabled and not self.geometry:
+    @model_validator(mode="before")
+    @classmethod
+    def _no_own_geometry(cls, data):
+        if isinstance(data, dict) and "geometry" in data:
             raise ValueError(
-                "contact.enabled = true but the scene has no geometry; add [[contact.geometry]] "
-                "primitives (plane, sphere, cylinder, box) or set enabled = false"
+                "contact.geometry is no longer read: contact uses the geometry of the bodies; "
+                "move each part to [[bodies]] geometry = [...] of the body that carries it "
+                "(docs/environment.md; plane: shape = 'plane', point, normal)"
             )
-        for i, g in enumerate(self.geometry):
-            if not g.name:
-                g.name = f"{g.type}{i}"
-        return self
+        return data
 
 
-def check_bodies(settings: ContactSettings, body_names: list[str]) -> None:
-    """Raises ValueError if a primitive names an unknown body."""
-    allowed = ["world", *body_names]
-    for i, g in enumerate(settings.geometry):
-        if g.body not in allowed:
-            raise ValueError(
-                f"contact.geometry[{i}].body = '{g.body}' is not a body of the scene; "
-                f"allowed: {allowed}"
-            )
+def check_geometry(scene) -> None:
+    """Raises ValueError if contact is enabled but no body carries geometry."""
+    c = scene.contact
+    if c is None or not c.enabled:
+        return
+    if not any(b.geometry for b in scene.bodies):
+        raise ValueError(
+            "contact.enabled = true but no body has geometry; add geometry parts to "
+            "[[bodies]] (geometry = [{ shape = 'plane', point = [...], normal = [...] }] or "
+            "a mesh file, docs/environment.md) or set contact.enabled = false"
+        )
 
 
-def obstacle_poses(scene, times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Global positions (T, O, 3) and orientations (T, O, 4, scalar first) of the contact
-    primitives on ``times`` (their bodies' motions)."""
+def _frame(z) -> np.ndarray:
+    """Columns x, y, z: a right-handed frame with the unit z given."""
+    z = np.asarray(z, float)
+    z = z / np.linalg.norm(z)
+    helper = np.array([1.0, 0.0, 0.0]) if abs(z[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    x = np.cross(helper, z)
+    x /= np.linalg.norm(x)
+    return np.column_stack([x, np.cross(z, x), z])
+
+
+def obstacles(scene) -> tuple[list, list, list[tuple[np.ndarray, np.ndarray]]]:
+    """The contact obstacles of the scene's geometry: (name, body index in ["world", *bodies],
+    type, dimensions, friction) tuples, their frames at rest (position, 3×3 axes; global), and
+    the meshes (vertices in the obstacle frame, faces). A mesh file with several closed shells
+    gives one obstacle per shell."""
+    from cablelife.scene import SceneError
+    from cablelife.simulate import euler_matrix
+    from cablelife.surroundings.build import scene_size
+    from cablelife.surroundings.meshes import load_mesh
+    from cablelife.surroundings.models import (
+        BoxPart,
+        CylinderPart,
+        MeshPart,
+        PlanePart,
+        part_label,
+    )
+    from cablelife.surroundings.paths import resolve_scene_file
+
+    mu = scene.contact.friction
+    tuples, frames, meshes = [], [], []
+    size = None
+    for bi, body in enumerate(scene.bodies):
+        origin = np.asarray(body.origin, float)
+        r0 = euler_matrix(body.orientation)
+        for k, part in enumerate(body.geometry):
+            name = part_label(body.name, k, part)
+            o, rot0 = (origin, r0) if part.frame == "body" else (np.zeros(3), np.eye(3))
+            friction = mu if part.friction is None else part.friction
+            if isinstance(part, MeshPart):
+                size = scene_size(scene) if size is None else size
+                what = f"bodies[{bi}].geometry[{k}] ('{name}')"
+                try:
+                    m = load_mesh(
+                        resolve_scene_file(scene.base_dir, part.mesh), part.scale, what, size
+                    )
+                except ValueError as err:
+                    if isinstance(err, SceneError):
+                        raise
+                    raise SceneError(f"{what}: {err}") from None
+                v = m.vertices @ rot0.T + o  # global at rest
+                shells = m.shells or [m.faces]
+                for s, shell in enumerate(shells):
+                    label = name if len(shells) == 1 else f"{name}[{s}]"
+                    # the obstacle frame at the shell's bounding-box centre (global axes): its
+                    # bounding sphere rejects far edges before the hierarchy is asked
+                    used = v[np.unique(shell)]
+                    centre = 0.5 * (used.min(axis=0) + used.max(axis=0))
+                    tuples.append((label, bi + 1, "mesh", [float(len(meshes))], friction))
+                    frames.append((centre, np.eye(3)))
+                    faces = np.ascontiguousarray(shell, dtype=np.int64)
+                    meshes.append((np.ascontiguousarray(v - centre), faces))
+                continue
+            if isinstance(part, PlanePart):
+                kind, dims = "plane", []
+                pos, axes = part.point, _frame(part.normal)
+            elif isinstance(part, BoxPart):
+                kind, dims = "box", [0.5 * s for s in part.size]
+                pos, axes = part.center, euler_matrix(part.orientation)
+            elif isinstance(part, CylinderPart):
+                kind, dims = "cylinder", [part.radius, part.length]
+                pos, axes = part.center, _frame(part.axis)
+            else:
+                kind, dims = "sphere", [part.radius]
+                pos, axes = part.center, np.eye(3)
+            tuples.append((name, bi + 1, kind, dims, friction))
+            frames.append((o + rot0 @ np.asarray(pos, float), rot0 @ axes))
+    return tuples, frames, meshes
+
+
+def obstacle_poses(scene, times: np.ndarray, frames: list, bodies: list[int]):
+    """Global positions (T, O, 3) and orientations (T, O, 4, scalar first) of the obstacles on
+    ``times``: each frame at rest moved with its body (simulate.body_motions, as the clips and
+    the clearance): x = o + u + R (X − o)."""
     from scipy.spatial.transform import Rotation
 
-    from cablelife.signals import body_motion
+    from cablelife.simulate import body_motions
 
-    geo = scene.contact.geometry
+    motions = body_motions(scene, times)
     n_t = times.size
-    pos = np.zeros((n_t, len(geo), 3))
-    frames = np.zeros((n_t, len(geo), 3, 3))
-    motions = {}
-    for j, g in enumerate(geo):
-        local = g.local_frame()
-        center = np.asarray(g.center, float)
-        body = scene.body(g.body) if g.body != "world" else None
-        if body is None:
-            pos[:, j], frames[:, j] = center, local
-            continue
-        r0 = Rotation.from_euler("xyz", body.orientation).as_matrix()
-        origin = np.asarray(body.origin, float)
-        if g.frame == "body":
-            center, local = origin + r0 @ center, r0 @ local
-        if body.name not in motions:
-            channels = body.channel_motions(scene.base_dir)
-            grid = times if n_t > 1 else np.array([times[0], times[0] + scene.simulation.time_step])
-            motions[body.name] = (
-                body_motion(channels, grid, scene.base_dir, r0) if channels else None
-            )
-        motion = motions[body.name]
+    pos = np.zeros((n_t, len(frames), 3))
+    axes = np.zeros((n_t, len(frames), 3, 3))
+    for j, ((p, a), b) in enumerate(zip(frames, bodies, strict=True)):
+        body = scene.bodies[b - 1]
+        _, _, motion = motions[body.name]
         if motion is None:
-            pos[:, j], frames[:, j] = center, local
+            pos[:, j], axes[:, j] = p, a
             continue
+        origin = np.asarray(body.origin, float)
         rot = motion.rotation[:n_t]
-        pos[:, j] = origin + motion.translation[:n_t] + rot @ (center - origin)
-        frames[:, j] = rot @ local
-    quats = Rotation.from_matrix(frames.reshape(-1, 3, 3)).as_quat(scalar_first=True)
-    return pos, quats.reshape(n_t, len(geo), 4)
+        pos[:, j] = origin + motion.translation[:n_t] + rot @ (p - origin)
+        axes[:, j] = rot @ a
+    quats = Rotation.from_matrix(axes.reshape(-1, 3, 3)).as_quat(scalar_first=True)
+    return pos, quats.reshape(n_t, len(frames), 4)
 
 
 def set_contact(core, scene, cable, times: np.ndarray) -> None:
@@ -155,21 +159,12 @@ def set_contact(core, scene, cable, times: np.ndarray) -> None:
     c = scene.contact
     if c is None or not c.enabled:
         return
-    pos, quat = obstacle_poses(scene, times)
-    bodies = ["world", *[b.name for b in scene.bodies]]
-    obstacles = [
-        (
-            g.name,
-            bodies.index(g.body),
-            g.type,
-            g.dimensions(),
-            c.friction if g.friction is None else g.friction,
-        )
-        for g in c.geometry
-    ]
+    check_geometry(scene)
+    tuples, frames, meshes = obstacles(scene)
+    pos, quat = obstacle_poses(scene, times, frames, [t[1] for t in tuples])
     core.set_contact(
-        obstacles,
-        len(bodies),
+        tuples,
+        len(scene.bodies) + 1,
         cable.properties().outer_radius,
         pos,
         quat,
@@ -177,4 +172,5 @@ def set_contact(core, scene, cable, times: np.ndarray) -> None:
         stiffness=c.stiffness,
         stick_distance=c.stick_distance,
         stick_velocity=c.stick_velocity,
+        meshes=meshes,
     )

@@ -23,7 +23,7 @@ from pydantic import (
 )
 
 from cablelife import _core
-from cablelife.contact_settings import ContactSettings, check_bodies
+from cablelife.contact_settings import ContactSettings, check_geometry
 from cablelife.limits import LIMITS, MAX_SEGMENTS, MIN_SEGMENTS, check_name
 from cablelife.paths import SceneFileError, resolve_scene_file, shown_names
 from cablelife.sections import SectionProperties, from_material, from_measured
@@ -445,8 +445,7 @@ class Scene(_Model):
                         f"cables[{i}].clips[{j}].body = '{clip.body}' is not a body of the scene; "
                         f"allowed: {allowed}"
                     )
-        if self.contact is not None:
-            check_bodies(self.contact, body_names)
+        check_geometry(self)
         if self.simulation.mode != "static" and self.simulation.duration is None:
             raise ValueError(f"simulation.duration is required in {self.simulation.mode} mode")
         return self

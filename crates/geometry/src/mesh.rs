@@ -200,6 +200,16 @@ impl TriMesh {
         self.triangles.len()
     }
 
+    /// Outward unit normal of triangle `t` (an index as in [`PointProjection::feature`]).
+    pub fn face_normal(&self, t: usize) -> V3 {
+        self.face_normals[t]
+    }
+
+    /// Corners of triangle `t`.
+    pub fn triangle(&self, t: usize) -> [V3; 3] {
+        self.triangles[t]
+    }
+
     /// Axis-aligned bounding box (min, max).
     pub fn bounds(&self) -> (V3, V3) {
         (self.nodes[0].min, self.nodes[0].max)

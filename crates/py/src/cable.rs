@@ -2,12 +2,13 @@
 //! GIL, poll Ctrl-C and report progress through an optional Python callable.
 use crate::stop::{Poller, StopFlag};
 use nalgebra::{Quaternion, Vector3};
-use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray3};
+use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray2, PyReadonlyArray3};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rod::assembly::Workspace;
 use rod::contact::{Contact, ContactOptions, Cuboid, Cylinder, Obstacle, Plane, Shape, Sphere};
+use rod::contact_mesh::MeshShape;
 use rod::routing::route;
 use rod::{
     CableSpec, ClipKind, ClipMotion, ClipSpec, DynamicOptions, Dynamics, NewtonOptions, PointLoad,
@@ -296,6 +297,38 @@ pub struct Cable {
 /// [radius, length (inf: infinite)], box [half extents x, y, z].
 type ObstacleTuple = (String, usize, String, Vec<f64>, f64);
 
+/// A closed triangle mesh (vertices (M, 3), faces (F, 3)) as a contact shape.
+fn mesh_shape(
+    name: &str,
+    vertices: &PyReadonlyArray2<'_, f64>,
+    faces: &PyReadonlyArray2<'_, i64>,
+) -> PyResult<Box<dyn Shape>> {
+    let bad = |msg: String| PyValueError::new_err(format!("geometry '{name}': {msg}"));
+    let v = vertices.as_array();
+    let f = faces.as_array();
+    if v.ncols() != 3 || f.ncols() != 3 {
+        return Err(bad(format!(
+            "mesh arrays have shapes {:?} and {:?}: must be (M, 3) and (F, 3)",
+            v.shape(),
+            f.shape()
+        )));
+    }
+    let verts: Vec<Vector3<f64>> = v
+        .rows()
+        .into_iter()
+        .map(|r| Vector3::new(r[0], r[1], r[2]))
+        .collect();
+    let mut tris = Vec::with_capacity(f.nrows());
+    for r in f.rows() {
+        if r.iter().any(|&k| k < 0 || k as usize >= verts.len()) {
+            return Err(bad(format!("bad vertex index in face {r}")));
+        }
+        tris.push([r[0] as u32, r[1] as u32, r[2] as u32]);
+    }
+    let mesh = ::geometry::TriMesh::new(&verts, &tris).map_err(|e| bad(e.0))?;
+    Ok(Box::new(MeshShape::new(mesh, &verts)))
+}
+
 fn shape(name: &str, kind: &str, dims: &[f64]) -> PyResult<Box<dyn Shape>> {
     let positive = |i: usize, what: &str| -> PyResult<f64> {
         match dims.get(i) {
@@ -323,7 +356,7 @@ fn shape(name: &str, kind: &str, dims: &[f64]) -> PyResult<Box<dyn Shape>> {
         }),
         other => {
             return Err(PyValueError::new_err(format!(
-                "geometry '{name}': type = {other:?}; allowed: plane, sphere, cylinder, box"
+                "geometry '{name}': type = {other:?}; allowed: plane, sphere, cylinder, box, mesh"
             )))
         }
     })
@@ -440,8 +473,10 @@ impl Cable {
     /// type, dimensions, friction μ); their global poses per time step of the next run,
     /// `positions` (T, O, 3) and `quaternions` (T, O, 4, scalar first) — T = 1: at rest.
     /// distance/stick_distance ≤ 0: the defaults for the radius (1 % and 0.1 % of r).
+    /// Type "mesh": dimensions [k], the k-th of `meshes` (vertices (M, 3), faces (F, 3)) in
+    /// the obstacle's frame.
     #[pyo3(signature = (obstacles, n_bodies, radius, positions, quaternions, distance=0.0,
-        stiffness=0.0, stick_distance=0.0, stick_velocity=1e-3, max_samples=8))]
+        stiffness=0.0, stick_distance=0.0, stick_velocity=1e-3, max_samples=8, meshes=vec![]))]
     #[allow(clippy::too_many_arguments)]
     fn set_contact(
         &mut self,
@@ -455,6 +490,7 @@ impl Cable {
         stick_distance: f64,
         stick_velocity: f64,
         max_samples: usize,
+        meshes: Vec<(PyReadonlyArray2<'_, f64>, PyReadonlyArray2<'_, i64>)>,
     ) -> PyResult<()> {
         let pos = positions.as_array();
         let qs = quaternions.as_array();
@@ -481,7 +517,23 @@ impl Cable {
         opts.max_samples = max_samples;
         let mut list = Vec::with_capacity(obstacles.len());
         for (k, (name, body, kind, dims, mu)) in obstacles.into_iter().enumerate() {
-            let sh = shape(&name, &kind, &dims)?;
+            let sh = if kind == "mesh" {
+                match dims
+                    .first()
+                    .map(|&k| k as usize)
+                    .and_then(|k| meshes.get(k))
+                {
+                    Some((v, f)) => mesh_shape(&name, v, f)?,
+                    None => {
+                        return Err(PyValueError::new_err(format!(
+                            "geometry '{name}': mesh index {dims:?} not among the {} meshes",
+                            meshes.len()
+                        )))
+                    }
+                }
+            } else {
+                shape(&name, &kind, &dims)?
+            };
             list.push(Obstacle::new(&name, body, sh, mu, &poses[0][k]));
         }
         let contact = Contact::new(&self.rod, list, opts, n_bodies)

@@ -62,6 +62,12 @@ pub trait Shape: Send + Sync + fmt::Debug {
     fn distance(&self, p: &Vector3<f64>) -> f64 {
         self.query(p).distance
     }
+    /// Broad phase: the signed distance if the point is within `bound` of the surface, else
+    /// any value ≥ `bound` (a mesh prunes its hierarchy with the bound; a point deeper than
+    /// `bound` inside a mesh also reads as far).
+    fn distance_within(&self, p: &Vector3<f64>, _bound: f64) -> f64 {
+        self.distance(p)
+    }
     /// The smallest radius of curvature of the surface that a cable can touch (0: sharp
     /// edges, ∞: flat); it sets the sample spacing along the edges.
     fn min_radius(&self) -> f64;
@@ -326,6 +332,14 @@ impl Obstacle {
     pub fn distance(&self, p: &Vector3<f64>) -> f64 {
         self.shape
             .distance(&(self.rotation.transpose() * (p - self.position)))
+    }
+
+    /// Signed distance at a global point if within `bound` of the surface, else a value ≥
+    /// `bound` (broad phase; [`Shape::distance_within`]).
+    #[inline]
+    pub fn distance_within(&self, p: &Vector3<f64>, bound: f64) -> f64 {
+        self.shape
+            .distance_within(&(self.rotation.transpose() * (p - self.position)), bound)
     }
 
     /// Closest points between the segment [a, b] and the obstacle (the distance along the
@@ -688,7 +702,7 @@ impl Contact {
                 let motion = da.norm().max(db.norm());
                 let mid = 0.5 * (a + b);
                 let half = 0.5 * (b - a).norm();
-                if o.distance(&mid) - half - r > motion {
+                if o.distance_within(&mid, half + r + motion) - half - r > motion {
                     continue;
                 }
                 for i in 0..=kk {
@@ -722,7 +736,7 @@ impl Contact {
         self.obstacles.iter().any(|o| {
             x.windows(2).any(|w| {
                 let half = 0.5 * (w[1] - w[0]).norm();
-                o.distance(&(0.5 * (w[0] + w[1]))) - half < reach
+                o.distance_within(&(0.5 * (w[0] + w[1])), half + reach) - half < reach
             })
         })
     }
@@ -776,7 +790,7 @@ impl Contact {
         if far.is_finite() && (mid - o.position).norm() - half - far > reach {
             return;
         }
-        if o.distance(&mid) - half >= reach {
+        if o.distance_within(&mid, half + reach) - half >= reach {
             return;
         }
         let kk = self.samples[k];
@@ -910,6 +924,12 @@ mod tests {
                 Box::new(Cuboid {
                     half: Vector3::new(0.03, 0.04, 0.05),
                 }),
+            ),
+            (
+                "box mesh",
+                Box::new(crate::contact_mesh::box_mesh(Vector3::new(
+                    0.03, 0.04, 0.05,
+                ))),
             ),
         ]
     }

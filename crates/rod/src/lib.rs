@@ -5,6 +5,7 @@ pub mod assembly;
 pub mod bending;
 pub mod block_tridiag;
 pub mod contact;
+pub mod contact_mesh;
 pub mod dynamics;
 #[cfg(test)]
 mod fd_check;
