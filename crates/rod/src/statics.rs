@@ -563,9 +563,14 @@ impl Statics {
         stats: &mut SolveStats,
         fraction: f64,
     ) -> Result<(), SolveError> {
-        if rod.edge_moment.iter().any(|m| *m != Vector3::zeros()) {
-            // A dead moment is not conservative on the rotation group: the symmetric part of
-            // the tangent is then no stability criterion (that needs the dynamics).
+        let frictional = self
+            .contact
+            .as_ref()
+            .is_some_and(|c| c.active > 0 && c.obstacles.iter().any(|o| o.friction > 0.0));
+        if frictional || rod.edge_moment.iter().any(|m| *m != Vector3::zeros()) {
+            // A dead moment is not conservative on the rotation group, and friction in contact
+            // is not conservative at all: the symmetric part of the tangent is then no
+            // stability criterion (that needs the dynamics).
             stats.unstable = None;
             return Ok(());
         }
