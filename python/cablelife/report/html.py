@@ -237,10 +237,24 @@ def _spot_cells(h) -> list[str]:
     ]
 
 
-def _comparison(page: Page, runs: list[ReportRun], volumes: dict, voxel: float, factor: float):
+def _summary(cache: dict, c) -> dict:
+    """The cable summary of ``c``, computed once per report (``cache``: ("summary", id) →
+    the summary or its future, started in the background by :func:`build_report`)."""
+    key = ("summary", id(c))
+    got = cache.get(key)
+    if got is None:
+        got = cache[key] = cable_summary(c)
+    elif hasattr(got, "result"):
+        got = cache[key] = got.result()
+    return got
+
+
+def _comparison(
+    page: Page, runs: list[ReportRun], volumes: dict, voxel: float, factor: float, cache: dict
+):
     page.h(2, "Comparison of the variants", "comparison")
     plot_runs = _runs_of(runs)
-    summaries = [(run.label, cable_summary(run.cable)) for run in plot_runs]
+    summaries = [(run.label, _summary(cache, run.cable)) for run in plot_runs]
     scales = [_scales(run.cable) for run in plot_runs]
     page.table(
         ["quantity", *[s[0] for s in summaries]],
@@ -392,7 +406,7 @@ def _run_section(page, k, run: ReportRun, volumes, color_by, frames, factor, cac
     if not res.complete:
         page.note(f"incomplete run: {res.message}", "warning")
     for name, c in res.cables.items():
-        s = cable_summary(c)
+        s = _summary(cache, c)
         page.h(3, f"cable {name}")
         sec = c.section
         page.table(
@@ -541,7 +555,7 @@ caption{text-align:left;font-weight:600;padding:.3em 0}
 th,td{border:1px solid #ccd;padding:.25em .6em;text-align:left}th{background:#eef}
 .figure{margin:1em 0}
 .warning{color:#a00;font-weight:600}.note{color:#335}nav a{margin-right:1em}
-.plot{min-height:320px}
+.plot{min-height:320px}.plot:not([data-state]){background:#f4f4f8}
 """
 
 
@@ -578,7 +592,8 @@ def build_report(
     pending = {r.label: pool.submit(volume, r) for r in runs} if voxel is not None else {}
     cache: dict = {}
     for r in runs:
-        for name in r.result.cables:
+        for name, c in r.result.cables.items():
+            cache[("summary", id(c))] = pool.submit(cable_summary, c)
             key = _scene_key(r.result, name)
             if key not in cache:
                 cache[key] = pool.submit(frequency_data, r.result, name)
@@ -596,7 +611,7 @@ def build_report(
     page.add("<nav>" + "".join(f'<a href="#{a}">{html.escape(t)}</a>' for a, t in links) + "</nav>")
     if len(runs) > 1:
         step("comparison")
-        _comparison(page, runs, volumes, voxel or 0.004, bend_factor)
+        _comparison(page, runs, volumes, voxel or 0.004, bend_factor, cache)
     for k, run in enumerate(runs):
         step(f"run {run.label}")
         _run_section(page, k, run, volumes, color_by, frames, bend_factor, cache, len(runs) == 1)

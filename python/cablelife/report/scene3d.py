@@ -96,14 +96,14 @@ def _clip_nodes(cable: CableResult) -> dict[str, int]:
     return {n: int(np.argmin(np.abs(cable.arc_length - c.s))) for n, c in cable.clips.items()}
 
 
-def _scatter3d(points, **kw):
-    """A plotly Scatter3d through ``points``: an (n, 3) array or (x, y, z) lists."""
-    import plotly.graph_objects as go
-
+def _scatter3d(points, **kw) -> dict:
+    """A plotly Scatter3d (as a dict: plotly validates it in a figure, and the frames of the
+    3D view need none, see :func:`cable_figure`) through ``points``: an (n, 3) array or
+    (x, y, z) lists."""
     if isinstance(points, np.ndarray):
         points = (points[:, 0], points[:, 1], points[:, 2])
     x, y, z = points
-    return go.Scatter3d(x=x, y=y, z=z, **kw)
+    return {"type": "scatter3d", "x": x, "y": y, "z": z, **kw}
 
 
 def _clip_trace(cable: CableResult, k: int, bodies: dict[str, str]):
@@ -212,10 +212,13 @@ def cable_figure(
     n_angles: int = 8,
     title: str | None = None,
 ):
-    """A plotly figure: the tube coloured by ``color_by`` (one of the plot quantities) at up
-    to ``frames`` saved steps with a slider and play button, clips marked with their bodies,
-    the bodies of ``scene_toml`` (the result's scene; ``mode`` the run's mode) with their axes
-    and clips, and ``volume`` (a MotionVolume or TriangleMesh) as a translucent mesh."""
+    """A plotly figure as a dict (``go.Figure(fig)`` for the object): the tube coloured by
+    ``color_by`` (one of the plot quantities) at up to ``frames`` saved steps with a slider
+    and play button, clips marked with their bodies, the bodies of ``scene_toml`` (the
+    result's scene; ``mode`` the run's mode) with their axes and clips, and ``volume`` (a
+    MotionVolume or TriangleMesh) as a translucent mesh. The first frame's traces are checked
+    by plotly; the animation frames (the same traces moved) are plain dicts, as checking them
+    cost most of the report's generation time."""
     import plotly.graph_objects as go
 
     if color_by not in QUANTITIES:
@@ -270,23 +273,25 @@ def cable_figure(
             traces.append(volume_trace(mesh, "motion volume", "#1f9e89", 0.18))
             box = np.stack([np.minimum(box[0], vv.min(0)), np.maximum(box[1], vv.max(0))])
     fig = go.Figure(data=traces)
-    fig.frames = [
-        go.Frame(
-            name=f"{cable.time[k]:.4g}",
-            data=[
-                go.Mesh3d(
-                    x=m.vertices[:, 0],
-                    y=m.vertices[:, 1],
-                    z=m.vertices[:, 2],
-                    intensity=v,
-                    meta={"tube": n_angles, "radius": radius},
-                ),
+    names = [f"{cable.time[k]:.4g}" for k in steps]
+    frame_list = [
+        {
+            "name": name,
+            "data": [
+                {
+                    "type": "mesh3d",
+                    "x": m.vertices[:, 0],
+                    "y": m.vertices[:, 1],
+                    "z": m.vertices[:, 2],
+                    "intensity": v,
+                    "meta": {"tube": n_angles, "radius": radius},
+                },
                 _clip_trace(cable, k, bodies),
                 *_body_traces(cable, k, poses, axis_length),
             ],
-            traces=moving,
-        )
-        for k in steps
+            "traces": moving,
+        }
+        for k, name in zip(steps, names, strict=True)
         for m, v in [tube(k)]
     ]
     _layout(fig, title or f"{cable.name}: {label}", box)
@@ -301,14 +306,14 @@ def cable_figure(
                     "currentvalue": {"prefix": "t = ", "suffix": " s", "xanchor": "right"},
                     "steps": [
                         {
-                            "label": f.name,
+                            "label": name,
                             "method": "animate",
                             "args": [
-                                [f.name],
+                                [name],
                                 {"mode": "immediate", "frame": {"duration": 0, "redraw": True}},
                             ],
                         }
-                        for f in fig.frames
+                        for name in names
                     ],
                 }
             ],
@@ -340,7 +345,9 @@ def cable_figure(
                 }
             ],
         )
-    return fig
+    out = fig.to_dict()
+    out["frames"] = frame_list
+    return out
 
 
 def damage_figure(
