@@ -189,8 +189,13 @@ def mixed_report(files, dynamic_files, tmp_path_factory):
 # colour range; per ranking table: its caption and the runs it ranks.
 PAGE_FACTS = {
     "damage": """JSON.stringify([...document.querySelectorAll('.js-plotly-plot')].filter(
-        d => d.data && d.data[0].type === 'mesh3d' && d.data[0].name === 'damage').map(d => {
-        const t = d._fullData[0], v = Array.from(t.intensity);
+        d => d.data && d.data.some(t => t.type === 'mesh3d' && t.name === 'damage')).map(d => {
+        const i = d.data.findIndex(t => t.name === 'damage');
+        const b = [...d.querySelectorAll('.updatemenu-button')].find(
+            e => e.textContent === 'damage on the surface');
+        b.dispatchEvent(new MouseEvent('click', {bubbles: true}));  // the button a person clicks
+        const t = d._fullData[i], v = Array.from(t.intensity);
+        if (!t.visible || d._fullData[0].visible) return {visible: false};
         return {min: Math.min(...v), max: Math.max(...v), cmin: t.cmin, cmax: t.cmax,
                 distinct: new Set(v.map(x => Math.round(x * 4))).size}}))""",
     "rankings": """JSON.stringify([...document.querySelectorAll('table.ranking')].map(t => ({

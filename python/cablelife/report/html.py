@@ -39,7 +39,7 @@ from cablelife.plots.bend_radius import DEFAULT_FACTOR
 from cablelife.plots.fatigue_data import DAMAGE_FLOOR
 from cablelife.report.interactive import maxima_over_time_figure
 from cablelife.report.page import Page
-from cablelife.report.scene3d import FRAMES, cable_figure, damage_figure, volumes_figure
+from cablelife.report.scene3d import FRAMES, cable_figure, volumes_figure, with_damage
 from cablelife.results import Result
 from cablelife.summary import cable_summary
 
@@ -471,12 +471,13 @@ def _run_section(page, k, run: ReportRun, volumes, color_by, frames, factor, cac
                 + " × ".join(f"[{a:.1f}, {b:.1f}]" for a, b in zip(box[0], box[1], strict=True))
                 + " mm"
             )
-        page.plotly(
-            cable_figure(
-                c, color_by, frames=frames, volume=vol, scene_toml=res.scene_toml, mode=res.mode
-            ),
-            f"3D view of {name}",
+        view = cable_figure(
+            c, color_by, frames=frames, volume=vol, scene_toml=res.scene_toml, mode=res.mode
         )
+        dmg = run.damage_of(name)
+        if dmg is not None and dmg[0].damage.max() > 0:  # the damage map: a button of the view
+            view = with_damage(view, c, dmg[0], scene_toml=res.scene_toml, mode=res.mode)
+        page.plotly(view, f"3D view of {name}")
         one = [Run(run.label, c, res.mode, _colours([run])[run.label])]
         if alone:
             page.plotly(maxima_over_time_figure(one), f"maxima over time of {name}")
@@ -494,9 +495,9 @@ def _run_section(page, k, run: ReportRun, volumes, color_by, frames, factor, cac
 
 
 def _damage_section(page: Page, run: ReportRun, name: str, alone: bool = True) -> None:
-    """LDA settings, hot spots, the damage on the surface (3D), along the cable and the
-    rainflow matrix of the most damaged series."""
-    res, c = run.result, run.result.cables[name]
+    """LDA settings, hot spots, the damage along the cable (on the surface: a button of the
+    3D view) and the rainflow matrix of the most damaged series."""
+    c = run.result.cables[name]
     dm, rf = run.damage_of(name)
     a = run.damage
     curve = a.curve
@@ -534,9 +535,9 @@ def _damage_section(page: Page, run: ReportRun, name: str, alone: bool = True) -
         [[i + 1, *_spot_cells(h)] for i, h in enumerate(dm.hot_spots(5))],
         f"damage hot spots (local maxima along the cable above {DAMAGE_FLOOR:g} × the maximum)",
     )
-    page.plotly(
-        damage_figure(c, dm, scene_toml=res.scene_toml, mode=res.mode),
-        f"damage on the surface of {name}",
+    page.note(
+        f"the {kind} on the surface of {name}: the button 'damage on the surface' of its 3D "
+        "view above (log colours from the floor, hot spots labelled)"
     )
     clips = {n: r.s for n, r in c.clips.items()}
     if alone:  # else the comparison draws the runs of a mode together

@@ -474,3 +474,53 @@ def volumes_figure(volumes: dict, cables: dict | None = None, title: str | None 
     p = np.concatenate(points) if points else np.zeros((1, 3))
     _layout(fig, title or "motion volumes", np.stack([p.min(0), p.max(0)]))
     return fig
+
+
+def with_damage(
+    fig: dict,
+    cable: CableResult,
+    damage: DamageMap,
+    *,
+    scene_toml: str = "",
+    mode: str | None = None,
+) -> dict:
+    """The 3D view ``fig`` (a :func:`cable_figure`) with the damage map of
+    :func:`damage_figure` (on the tube at the first saved step, hot spots labelled) as a
+    second view behind two buttons, the quantity the tube is coloured by and "damage on the
+    surface": one WebGL scene in the page instead of two (each costs about a second to draw
+    without a GPU). The view starts with the quantity."""
+    extra = [
+        t
+        for t in damage_figure(cable, damage, scene_toml=scene_toml, mode=mode).to_dict()["data"]
+        if t.get("name") == "damage" or str(t.get("name", "")).startswith("hot spot")
+    ]
+    n, e = len(fig["data"]), len(extra)
+    for t in extra:
+        t["visible"] = False
+    fig["data"] = [*fig["data"], *extra]
+    quantity = [True] * n + [False] * e
+    surface = [i != 0 for i in range(n)] + [True] * e  # trace 0: the coloured tube
+    label = fig["data"][0].get("colorbar", {}).get("title", {}).get("text", "quantity")
+    fig["layout"]["title"] = {"text": fig["layout"]["title"]["text"] + " / damage"}
+    fig["layout"].setdefault("updatemenus", []).append(
+        {
+            "type": "buttons",
+            "direction": "left",
+            "showactive": True,
+            "active": 0,
+            "x": 0.3,
+            "xanchor": "left",
+            "y": 1.0,
+            "yanchor": "top",
+            "pad": {"t": 4, "l": 4},
+            "buttons": [
+                {"label": label, "method": "restyle", "args": [{"visible": quantity}]},
+                {
+                    "label": "damage on the surface",
+                    "method": "restyle",
+                    "args": [{"visible": surface}],
+                },
+            ],
+        }
+    )
+    return fig
