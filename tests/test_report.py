@@ -189,8 +189,13 @@ def mixed_report(files, dynamic_files, tmp_path_factory):
 # colour range; per ranking table: its caption and the runs it ranks.
 PAGE_FACTS = {
     "damage": """JSON.stringify([...document.querySelectorAll('.js-plotly-plot')].filter(
-        d => d.data && d.data[0].type === 'mesh3d' && d.data[0].name === 'damage').map(d => {
-        const t = d._fullData[0], v = Array.from(t.intensity);
+        d => d.data && d.data.some(t => t.type === 'mesh3d' && t.name === 'damage')).map(d => {
+        const i = d.data.findIndex(t => t.name === 'damage');
+        const b = [...d.querySelectorAll('.updatemenu-button')].find(
+            e => e.textContent === 'damage on the surface');
+        b.dispatchEvent(new MouseEvent('click', {bubbles: true}));  // the button a person clicks
+        const t = d._fullData[i], v = Array.from(t.intensity);
+        if (!t.visible || d._fullData[0].visible) return {visible: false};
         return {min: Math.min(...v), max: Math.max(...v), cmin: t.cmin, cmax: t.cmax,
                 distinct: new Set(v.map(x => Math.round(x * 4))).size}}))""",
     "rankings": """JSON.stringify([...document.querySelectorAll('table.ranking')].map(t => ({
@@ -262,12 +267,15 @@ def test_body_poses_follow_the_motion_and_carry_their_clips():
     assert not rest.moving and np.all(rest.origin == [0.8, 0.2, 0.0])
     # The 3D view animates the body with the cable: its origin at each frame's time.
     fig = cable_figure(cable, frames=3, scene_toml=res.scene_toml, mode=res.mode)
-    for frame in fig.frames:
-        k = int(np.argmin(np.abs(cable.time - float(frame.name))))
-        body = next(t for t in frame.data if t.name == "bodies")
-        np.testing.assert_allclose([body.x[0], body.y[0], body.z[0]], engine.origin[k])
-        link = next(t for t in frame.data if t.name == "body → clip")
-        np.testing.assert_allclose([link.x[1], link.y[1], link.z[1]], cable.positions[k, -1])
+    assert len(fig["frames"]) == 3
+    for frame in fig["frames"]:
+        k = int(np.argmin(np.abs(cable.time - float(frame["name"]))))
+        body = next(t for t in frame["data"] if t.get("name") == "bodies")
+        np.testing.assert_allclose([body[a][0] for a in "xyz"], engine.origin[k])
+        link = next(t for t in frame["data"] if t.get("name") == "body → clip")
+        np.testing.assert_allclose([link[a][1] for a in "xyz"], cable.positions[k, -1])
+    go = pytest.importorskip("plotly.graph_objects")
+    assert len(go.Figure(fig).frames) == 3  # a valid plotly figure, frames included
 
 
 def test_excitation_psd_holds_the_clip_acceleration_variance():

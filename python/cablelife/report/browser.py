@@ -67,14 +67,16 @@ def find_browser() -> str | None:
 class PageCheck:
     """What the browser saw."""
 
-    load_s: float  # navigation start → every figure rendered (the page's data-render-ms)
-    wall_s: float  # navigate command → the page reported it had finished
+    load_s: float  # first screen drawn (data-render-ms) + every other figure's drawing time
+    wall_s: float  # navigate command → the page reported its first screen drawn
     expected: int
     rendered: int
     errors: list[str]
     overlaps: list[dict] = field(default_factory=list)
     screenshots: list[Path] = field(default_factory=list)
     values: dict = field(default_factory=dict)
+    first_screen_s: float = -1.0  # navigation start → the figures on the first screen drawn
+    on_demand_ms: list[int] = field(default_factory=list)  # drawing time of each other figure
 
 
 def _free_port() -> int:
@@ -100,6 +102,41 @@ class _Cdp:
     async def evaluate(self, expr: str):
         r = await self.call("Runtime.evaluate", expression=expr, returnByValue=True)
         return r.get("result", {}).get("value")
+
+
+# Figures whose div meets the viewport and are not drawn yet (data-state unset or drawing).
+PENDING_JS = r"""
+[...document.querySelectorAll('.plot')].filter(function(d){var r=d.getBoundingClientRect();
+ return r.top<innerHeight&&r.bottom>0&&d.dataset.state!=='rendered'&&d.dataset.state!=='failed'})
+ .length"""
+
+
+async def _scroll_through(cdp: _Cdp, height: int, t0: float, timeout: float) -> list[int]:
+    """Scrolls down the page a screen at a time as a reader would, waiting at each screen until
+    the figures in view are drawn (the page draws them lazily); back to the top. Returns the
+    drawing time (ms, the page's own data-ms) of every figure not on the first screen; none
+    for a page that draws everything at once (no data-first-screen-figures)."""
+    listed = await cdp.evaluate("document.body.dataset.firstScreenFigures")
+    if listed is None:
+        return []
+    first = set(json.loads(listed))
+    top = 0
+    while top < await cdp.evaluate("document.documentElement.scrollHeight"):
+        await cdp.evaluate(f"window.scrollTo(0, {top})")
+        await asyncio.sleep(0.05)  # the observer's callback
+        while await cdp.evaluate(PENDING_JS):
+            if time.perf_counter() - t0 > timeout:
+                raise TimeoutError(f"the report did not draw its figures within {timeout} s")
+            await asyncio.sleep(0.02)
+        top += height
+    await cdp.evaluate("window.scrollTo(0, 0)")
+    drawn = json.loads(
+        await cdp.evaluate(
+            "JSON.stringify([...document.querySelectorAll('.plot[data-ms]')]"
+            ".map(d => [d.id, +d.dataset.ms]))"
+        )
+    )
+    return [ms for fid, ms in drawn if fid not in first]
 
 
 async def _check(url, port, width, height, timeout, shots, scroll_shots, evaluate) -> PageCheck:
@@ -131,6 +168,7 @@ async def _check(url, port, width, height, timeout, shots, scroll_shots, evaluat
             raise TimeoutError(f"the report did not finish rendering within {timeout} s")
         await asyncio.sleep(0.02)
     wall = time.perf_counter() - t0
+    on_demand = await _scroll_through(cdp, height, t0, timeout)
     data = await cdp.evaluate("JSON.stringify(document.body.dataset)")
     d = json.loads(data)
     overlaps = json.loads(await cdp.evaluate(OVERLAP_JS))
@@ -148,8 +186,11 @@ async def _check(url, port, width, height, timeout, shots, scroll_shots, evaluat
             path.write_bytes(base64.b64decode(png["data"]))
             files.append(path)
     ws.close()
+    first = int(d.get("renderMs", -1)) / 1e3
     return PageCheck(
-        load_s=int(d.get("renderMs", -1)) / 1e3,
+        load_s=first + sum(on_demand) / 1e3 if first >= 0 else first,
+        first_screen_s=first,
+        on_demand_ms=on_demand,
         wall_s=wall,
         expected=int(d.get("expectedFigures", 0)),
         rendered=int(d.get("renderedFigures", 0)),

@@ -39,7 +39,7 @@ from cablelife.plots.bend_radius import DEFAULT_FACTOR
 from cablelife.plots.fatigue_data import DAMAGE_FLOOR
 from cablelife.report.interactive import maxima_over_time_figure
 from cablelife.report.page import Page
-from cablelife.report.scene3d import FRAMES, cable_figure, damage_figure, volumes_figure
+from cablelife.report.scene3d import FRAMES, cable_figure, volumes_figure, with_damage
 from cablelife.results import Result
 from cablelife.summary import cable_summary
 
@@ -237,10 +237,24 @@ def _spot_cells(h) -> list[str]:
     ]
 
 
-def _comparison(page: Page, runs: list[ReportRun], volumes: dict, voxel: float, factor: float):
+def _summary(cache: dict, c) -> dict:
+    """The cable summary of ``c``, computed once per report (``cache``: ("summary", id) →
+    the summary or its future, started in the background by :func:`build_report`)."""
+    key = ("summary", id(c))
+    got = cache.get(key)
+    if got is None:
+        got = cache[key] = cable_summary(c)
+    elif hasattr(got, "result"):
+        got = cache[key] = got.result()
+    return got
+
+
+def _comparison(
+    page: Page, runs: list[ReportRun], volumes: dict, voxel: float, factor: float, cache: dict
+):
     page.h(2, "Comparison of the variants", "comparison")
     plot_runs = _runs_of(runs)
-    summaries = [(run.label, cable_summary(run.cable)) for run in plot_runs]
+    summaries = [(run.label, _summary(cache, run.cable)) for run in plot_runs]
     scales = [_scales(run.cable) for run in plot_runs]
     page.table(
         ["quantity", *[s[0] for s in summaries]],
@@ -392,7 +406,7 @@ def _run_section(page, k, run: ReportRun, volumes, color_by, frames, factor, cac
     if not res.complete:
         page.note(f"incomplete run: {res.message}", "warning")
     for name, c in res.cables.items():
-        s = cable_summary(c)
+        s = _summary(cache, c)
         page.h(3, f"cable {name}")
         sec = c.section
         page.table(
@@ -457,12 +471,13 @@ def _run_section(page, k, run: ReportRun, volumes, color_by, frames, factor, cac
                 + " × ".join(f"[{a:.1f}, {b:.1f}]" for a, b in zip(box[0], box[1], strict=True))
                 + " mm"
             )
-        page.plotly(
-            cable_figure(
-                c, color_by, frames=frames, volume=vol, scene_toml=res.scene_toml, mode=res.mode
-            ),
-            f"3D view of {name}",
+        view = cable_figure(
+            c, color_by, frames=frames, volume=vol, scene_toml=res.scene_toml, mode=res.mode
         )
+        dmg = run.damage_of(name)
+        if dmg is not None and dmg[0].damage.max() > 0:  # the damage map: a button of the view
+            view = with_damage(view, c, dmg[0], scene_toml=res.scene_toml, mode=res.mode)
+        page.plotly(view, f"3D view of {name}")
         one = [Run(run.label, c, res.mode, _colours([run])[run.label])]
         if alone:
             page.plotly(maxima_over_time_figure(one), f"maxima over time of {name}")
@@ -480,9 +495,9 @@ def _run_section(page, k, run: ReportRun, volumes, color_by, frames, factor, cac
 
 
 def _damage_section(page: Page, run: ReportRun, name: str, alone: bool = True) -> None:
-    """LDA settings, hot spots, the damage on the surface (3D), along the cable and the
-    rainflow matrix of the most damaged series."""
-    res, c = run.result, run.result.cables[name]
+    """LDA settings, hot spots, the damage along the cable (on the surface: a button of the
+    3D view) and the rainflow matrix of the most damaged series."""
+    c = run.result.cables[name]
     dm, rf = run.damage_of(name)
     a = run.damage
     curve = a.curve
@@ -520,9 +535,9 @@ def _damage_section(page: Page, run: ReportRun, name: str, alone: bool = True) -
         [[i + 1, *_spot_cells(h)] for i, h in enumerate(dm.hot_spots(5))],
         f"damage hot spots (local maxima along the cable above {DAMAGE_FLOOR:g} × the maximum)",
     )
-    page.plotly(
-        damage_figure(c, dm, scene_toml=res.scene_toml, mode=res.mode),
-        f"damage on the surface of {name}",
+    page.note(
+        f"the {kind} on the surface of {name}: the button 'damage on the surface' of its 3D "
+        "view above (log colours from the floor, hot spots labelled)"
     )
     clips = {n: r.s for n, r in c.clips.items()}
     if alone:  # else the comparison draws the runs of a mode together
@@ -541,7 +556,7 @@ caption{text-align:left;font-weight:600;padding:.3em 0}
 th,td{border:1px solid #ccd;padding:.25em .6em;text-align:left}th{background:#eef}
 .figure{margin:1em 0}
 .warning{color:#a00;font-weight:600}.note{color:#335}nav a{margin-right:1em}
-.plot{min-height:320px}
+.plot{min-height:320px}.plot:not([data-state]){background:#f4f4f8}
 """
 
 
@@ -578,7 +593,8 @@ def build_report(
     pending = {r.label: pool.submit(volume, r) for r in runs} if voxel is not None else {}
     cache: dict = {}
     for r in runs:
-        for name in r.result.cables:
+        for name, c in r.result.cables.items():
+            cache[("summary", id(c))] = pool.submit(cable_summary, c)
             key = _scene_key(r.result, name)
             if key not in cache:
                 cache[key] = pool.submit(frequency_data, r.result, name)
@@ -596,7 +612,7 @@ def build_report(
     page.add("<nav>" + "".join(f'<a href="#{a}">{html.escape(t)}</a>' for a, t in links) + "</nav>")
     if len(runs) > 1:
         step("comparison")
-        _comparison(page, runs, volumes, voxel or 0.004, bend_factor)
+        _comparison(page, runs, volumes, voxel or 0.004, bend_factor, cache)
     for k, run in enumerate(runs):
         step(f"run {run.label}")
         _run_section(page, k, run, volumes, color_by, frames, bend_factor, cache, len(runs) == 1)

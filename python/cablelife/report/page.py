@@ -45,7 +45,11 @@ class Page:
         self.figures.append(compact(d))
         label = f' aria-label="{html.escape(alt)}"' if alt else ""
         n = len(self.figures)
-        self.add(f'<div class="figure"{label}><div id="figure-{n}" class="plot"></div></div>')
+        height = int(d.get("layout", {}).get("height") or 450)  # plotly's default
+        self.add(
+            f'<div class="figure"{label}><div id="figure-{n}" class="plot" '
+            f'style="height:{height}px"></div></div>'
+        )
 
     def table(self, header: list[str], rows: list[list], caption: str = "", cls: str = "") -> None:
         cap = f"<caption>{html.escape(caption)}</caption>" if caption else ""
@@ -134,17 +138,22 @@ window.__errors=[];window.addEventListener('error',function(e){__errors.push(Str
 __errors.push(Array.prototype.join.call(arguments,' '));ce.apply(console,arguments)}})();
 </script>"""
 
-# Inflates plotly.js and the figures, draws them in order (a progress line while it works) and
-# records the outcome: data-rendered-figures, data-errors, data-render-ms (since navigation
-# start), data-checked = yes.
+# Inflates plotly.js and the figures, then draws the figures lazily, one at a time: those on
+# the first screen at once, every other one when it comes near the viewport (an
+# IntersectionObserver), so the page is readable in a second or two and a 3D scene (WebGL, slow
+# without a GPU) costs only when looked at. Records the outcome in <body data-*>:
+# data-render-ms (since navigation start, first screen drawn), data-first-screen-figures (ids),
+# data-rendered-figures (so far), data-errors, data-checked = yes (first screen done); each
+# figure's div gets data-state (rendered/failed) and data-ms (its drawing time).
 LOADER = """<script>
 (async function(){
-var b=document.body.dataset;
+var b=document.body.dataset,figs,queue=Promise.resolve(),first=[];
 async function inflate(id){
- var s=document.getElementById(id).textContent,bin=atob(s),a=new Uint8Array(bin.length);
- for(var i=0;i<bin.length;i++)a[i]=bin.charCodeAt(i);
- var st=new Blob([a]).stream().pipeThrough(new DecompressionStream('gzip'));
- return await new Response(st).text();}
+ var s=document.getElementById(id).textContent,st;
+ try{st=(await fetch('data:application/octet-stream;base64,'+s)).body}
+ catch(e){var bin=atob(s),a=new Uint8Array(bin.length);
+  for(var i=0;i<bin.length;i++)a[i]=bin.charCodeAt(i);st=new Blob([a]).stream()}
+ return await new Response(st.pipeThrough(new DecompressionStream('gzip'))).text();}
 function f32(s){var bin=atob(s),a=new Uint8Array(bin.length);
  for(var i=0;i<bin.length;i++)a[i]=bin.charCodeAt(i);return new Float32Array(a.buffer);}
 function tube(t){var T=t._tube;if(!T)return;delete t._tube;
@@ -157,23 +166,33 @@ function tube(t){var T=t._tube;if(!T)return;delete t._tube;
  t.x=x;t.y=y;t.z=z;
  if(T.v){var v=f32(T.v),w=new Float32Array(N);for(j=0;j<N;j++)w[j]=v[Math.floor(j/g)];
   t.intensity=w;}}
+function div(i){return document.getElementById('figure-'+(i+1))}
+function record(){b.renderedFigures=document.querySelectorAll('.plot[data-state=rendered]').length;
+ b.errors=JSON.stringify(window.__errors);}
+function draw(i){queue=queue.then(async function(){
+ var d=div(i),f=figs[i],t0=performance.now();if(d.dataset.state)return;d.dataset.state='drawing';
+ try{
+  f.data.forEach(tube);(f.frames||[]).forEach(function(fr){fr.data.forEach(tube)});
+  await Plotly.newPlot(d,f.data,f.layout,{displaylogo:false,responsive:true});
+  if(f.frames)await Plotly.addFrames(d,f.frames);
+  var L=d._fullLayout||{},gl=L._has&&L._has('gl3d');
+  d.dataset.state=d.querySelector('.main-svg')&&L.width>0&&(!gl||d.querySelector('canvas'))?
+   'rendered':'failed';
+ }catch(e){__errors.push(String(e&&e.stack||e));d.dataset.state='failed'}
+ figs[i]=null;d.dataset.ms=Math.round(performance.now()-t0);record();});return queue;}
 try{
  var js=document.createElement('script');js.text=await inflate('plotlyjs');
  document.head.appendChild(js);
- var figs=JSON.parse(await inflate('figures')),ok=0,ms=[];
+ figs=JSON.parse(await inflate('figures'));
  b.inflatedMs=Math.round(performance.now());
- var cfg={displaylogo:false,responsive:true};
- for(var i=0;i<figs.length;i++){
-  var f=figs[i],div=document.getElementById('figure-'+(i+1)),t0=performance.now();
-  f.data.forEach(tube);(f.frames||[]).forEach(function(fr){fr.data.forEach(tube)});
-  await Plotly.newPlot(div,f.data,f.layout,cfg);
-  if(f.frames)await Plotly.addFrames(div,f.frames);
-  var L=div._fullLayout||{},gl=L._has&&L._has('gl3d');
-  if(div.querySelector('.main-svg')&&L.width>0&&(!gl||div.querySelector('canvas')))ok++;
-  ms.push(Math.round(performance.now()-t0));}
- b.renderedFigures=ok;b.figureMs=JSON.stringify(ms);
-}catch(e){__errors.push(String(e&&e.stack||e));b.renderedFigures=0}
-b.renderMs=Math.round(performance.now());
-b.errors=JSON.stringify(window.__errors);b.checked='yes';
+ var io=new IntersectionObserver(function(es){es.forEach(function(e){
+  if(e.isIntersecting){io.unobserve(e.target);draw(+e.target.id.slice(7)-1)}})},
+  {rootMargin:'0px 0px 200px 0px'});
+ for(var i=0;i<figs.length;i++){var r=div(i).getBoundingClientRect();
+  if(r.top<innerHeight&&r.bottom>0)first.push(i);else io.observe(div(i));}
+ await Promise.all(first.map(draw));
+}catch(e){__errors.push(String(e&&e.stack||e))}
+record();b.firstScreenFigures=JSON.stringify(first.map(function(i){return 'figure-'+(i+1)}));
+b.renderMs=Math.round(performance.now());b.checked='yes';
 })();
 </script>"""

@@ -96,14 +96,14 @@ def _clip_nodes(cable: CableResult) -> dict[str, int]:
     return {n: int(np.argmin(np.abs(cable.arc_length - c.s))) for n, c in cable.clips.items()}
 
 
-def _scatter3d(points, **kw):
-    """A plotly Scatter3d through ``points``: an (n, 3) array or (x, y, z) lists."""
-    import plotly.graph_objects as go
-
+def _scatter3d(points, **kw) -> dict:
+    """A plotly Scatter3d (as a dict: plotly validates it in a figure, and the frames of the
+    3D view need none, see :func:`cable_figure`) through ``points``: an (n, 3) array or
+    (x, y, z) lists."""
     if isinstance(points, np.ndarray):
         points = (points[:, 0], points[:, 1], points[:, 2])
     x, y, z = points
-    return go.Scatter3d(x=x, y=y, z=z, **kw)
+    return {"type": "scatter3d", "x": x, "y": y, "z": z, **kw}
 
 
 def _clip_trace(cable: CableResult, k: int, bodies: dict[str, str]):
@@ -212,10 +212,13 @@ def cable_figure(
     n_angles: int = 8,
     title: str | None = None,
 ):
-    """A plotly figure: the tube coloured by ``color_by`` (one of the plot quantities) at up
-    to ``frames`` saved steps with a slider and play button, clips marked with their bodies,
-    the bodies of ``scene_toml`` (the result's scene; ``mode`` the run's mode) with their axes
-    and clips, and ``volume`` (a MotionVolume or TriangleMesh) as a translucent mesh."""
+    """A plotly figure as a dict (``go.Figure(fig)`` for the object): the tube coloured by
+    ``color_by`` (one of the plot quantities) at up to ``frames`` saved steps with a slider
+    and play button, clips marked with their bodies, the bodies of ``scene_toml`` (the
+    result's scene; ``mode`` the run's mode) with their axes and clips, and ``volume`` (a
+    MotionVolume or TriangleMesh) as a translucent mesh. The first frame's traces are checked
+    by plotly; the animation frames (the same traces moved) are plain dicts, as checking them
+    cost most of the report's generation time."""
     import plotly.graph_objects as go
 
     if color_by not in QUANTITIES:
@@ -270,23 +273,25 @@ def cable_figure(
             traces.append(volume_trace(mesh, "motion volume", "#1f9e89", 0.18))
             box = np.stack([np.minimum(box[0], vv.min(0)), np.maximum(box[1], vv.max(0))])
     fig = go.Figure(data=traces)
-    fig.frames = [
-        go.Frame(
-            name=f"{cable.time[k]:.4g}",
-            data=[
-                go.Mesh3d(
-                    x=m.vertices[:, 0],
-                    y=m.vertices[:, 1],
-                    z=m.vertices[:, 2],
-                    intensity=v,
-                    meta={"tube": n_angles, "radius": radius},
-                ),
+    names = [f"{cable.time[k]:.4g}" for k in steps]
+    frame_list = [
+        {
+            "name": name,
+            "data": [
+                {
+                    "type": "mesh3d",
+                    "x": m.vertices[:, 0],
+                    "y": m.vertices[:, 1],
+                    "z": m.vertices[:, 2],
+                    "intensity": v,
+                    "meta": {"tube": n_angles, "radius": radius},
+                },
                 _clip_trace(cable, k, bodies),
                 *_body_traces(cable, k, poses, axis_length),
             ],
-            traces=moving,
-        )
-        for k in steps
+            "traces": moving,
+        }
+        for k, name in zip(steps, names, strict=True)
         for m, v in [tube(k)]
     ]
     _layout(fig, title or f"{cable.name}: {label}", box)
@@ -301,14 +306,14 @@ def cable_figure(
                     "currentvalue": {"prefix": "t = ", "suffix": " s", "xanchor": "right"},
                     "steps": [
                         {
-                            "label": f.name,
+                            "label": name,
                             "method": "animate",
                             "args": [
-                                [f.name],
+                                [name],
                                 {"mode": "immediate", "frame": {"duration": 0, "redraw": True}},
                             ],
                         }
-                        for f in fig.frames
+                        for name in names
                     ],
                 }
             ],
@@ -340,7 +345,9 @@ def cable_figure(
                 }
             ],
         )
-    return fig
+    out = fig.to_dict()
+    out["frames"] = frame_list
+    return out
 
 
 def damage_figure(
@@ -466,4 +473,54 @@ def volumes_figure(volumes: dict, cables: dict | None = None, title: str | None 
     fig = go.Figure(data=traces)
     p = np.concatenate(points) if points else np.zeros((1, 3))
     _layout(fig, title or "motion volumes", np.stack([p.min(0), p.max(0)]))
+    return fig
+
+
+def with_damage(
+    fig: dict,
+    cable: CableResult,
+    damage: DamageMap,
+    *,
+    scene_toml: str = "",
+    mode: str | None = None,
+) -> dict:
+    """The 3D view ``fig`` (a :func:`cable_figure`) with the damage map of
+    :func:`damage_figure` (on the tube at the first saved step, hot spots labelled) as a
+    second view behind two buttons, the quantity the tube is coloured by and "damage on the
+    surface": one WebGL scene in the page instead of two (each costs about a second to draw
+    without a GPU). The view starts with the quantity."""
+    extra = [
+        t
+        for t in damage_figure(cable, damage, scene_toml=scene_toml, mode=mode).to_dict()["data"]
+        if t.get("name") == "damage" or str(t.get("name", "")).startswith("hot spot")
+    ]
+    n, e = len(fig["data"]), len(extra)
+    for t in extra:
+        t["visible"] = False
+    fig["data"] = [*fig["data"], *extra]
+    quantity = [True] * n + [False] * e
+    surface = [i != 0 for i in range(n)] + [True] * e  # trace 0: the coloured tube
+    label = fig["data"][0].get("colorbar", {}).get("title", {}).get("text", "quantity")
+    fig["layout"]["title"] = {"text": fig["layout"]["title"]["text"] + " / damage"}
+    fig["layout"].setdefault("updatemenus", []).append(
+        {
+            "type": "buttons",
+            "direction": "left",
+            "showactive": True,
+            "active": 0,
+            "x": 0.3,
+            "xanchor": "left",
+            "y": 1.0,
+            "yanchor": "top",
+            "pad": {"t": 4, "l": 4},
+            "buttons": [
+                {"label": label, "method": "restyle", "args": [{"visible": quantity}]},
+                {
+                    "label": "damage on the surface",
+                    "method": "restyle",
+                    "args": [{"visible": surface}],
+                },
+            ],
+        }
+    )
     return fig
