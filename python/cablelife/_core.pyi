@@ -1,0 +1,202 @@
+"""Type stub of the Rust extension `cablelife._core` (crates/py): thin bindings of the rod
+solver, the fatigue kernels, motion-volume distances, surroundings (clearance) and Ctrl-C stop
+flags. Arrays are numpy float64 unless said otherwise. Kept current by tests/test_core_stub.py."""
+
+from typing import Any
+
+class Cable:
+    """One cable: mesh, state and solver."""
+    def __init__(
+        self,
+        length,
+        segments,
+        shear_stiffness,
+        bend_stiffness,
+        mass_per_length,
+        rotary_inertia,
+        natural_curvature,
+        gravity,
+        clips,
+        loads,
+        max_iterations=40,
+        step_tolerance=1e-9,
+    ) -> None: ...
+    @property
+    def arc_length(self) -> Any: ...
+    def linearize(self) -> Any:
+        """Linearisation about the state of the last run (a static equilibrium): the tangent
+        stiffness K (n × n, dense, active unknowns only), the diagonal mass (n,), and for each
+        unknown its (block, slot); slots 0–2 node displacement, 3–5 edge rotation (body frame).
+        Massless unknowns (swivel twists) have mass 0.
+        """
+        ...
+    def modes(self, count) -> Any:
+        """The `count` lowest natural modes about the state of the last run (a static
+        equilibrium), by the banded shift-invert solver (`rod::modal`). Returns `omega` (k,)
+        rad/s, `displacements` (k, N+1, 3) and `rotations` (k, N, 3) mass-normalised (global
+        frame), `shares` (k, 4) modal energy shares (bending d1, bending d2, torsion, axial)
+        and `kind` (k,) names. An unstable equilibrium is a ValueError.
+        """
+        ...
+    @property
+    def node_mass(self) -> Any: ...
+    def run_dynamic(
+        self,
+        time_step,
+        positions,
+        quaternions,
+        velocities,
+        angular_velocities,
+        accelerations,
+        angular_accelerations,
+        output_every,
+        tau_shear,
+        tau_bend,
+        spectral_radius=0.9,
+        newton_tolerance=...,
+        progress=None,
+        progress_every=100,
+        stop=None,
+    ) -> Any:
+        """Dynamic run: static equilibrium at the clip poses of step 0, then generalized-α steps
+        of `time_step` through the clip kinematics (T, C, ·): positions, quaternions, velocities,
+        angular velocities, accelerations, angular accelerations (global). Every
+        `output_every`-th step is recorded (and step 0). τ: retardation times (GA₁, GA₂, EA),
+        (EI₁, EI₂, GJ). Returns the recorded arrays, energies and `error` as `run_sequence`;
+        `stop` as there.
+        """
+        ...
+    def run_sequence(
+        self, positions, quaternions, progress=None, progress_every=50, stop=None
+    ) -> Any:
+        """Runs a sequence of equilibria through the clip poses `positions` (T, C, 3) and
+        `quaternions` (T, C, 4). Step 0 is a static solve from the routed shape (with load
+        continuation if needed); later steps are warm-started and sub-stepped on failure.
+        Returns a dict of arrays for the completed steps and `error` (None, or why it stopped:
+        the results up to there are kept). `stop`: a `StopFlag` read after every step (the
+        run ends with error "interrupted" when it is set).
+        """
+        ...
+    def set_contact(
+        self,
+        obstacles,
+        n_bodies,
+        radius,
+        positions,
+        quaternions,
+        distance=0.0,
+        stiffness=0.0,
+        stick_distance=0.0,
+        stick_velocity=1e-3,
+        max_samples=8,
+        meshes=...,
+    ) -> Any:
+        """Contact with rigid obstacles (docs/contact.md): `obstacles` as (name, body index,
+        type, dimensions, friction μ); their global poses per time step of the next run,
+        `positions` (T, O, 3) and `quaternions` (T, O, 4, scalar first) — T = 1: at rest.
+        distance/stick_distance ≤ 0: the defaults for the radius (1 % and 0.1 % of r).
+        Type "mesh": dimensions [k], the k-th of `meshes` (vertices (M, 3), faces (F, 3)) in
+        the obstacle's frame.
+        """
+        ...
+
+DEFAULT_NEWTON_TOLERANCE: float
+
+INTERRUPTED: str
+
+class StopFlag:
+    """A flag shared between the thread that wants a run stopped and the solver threads."""
+    def __init__(self) -> None: ...
+    def clear(self) -> Any:
+        """Withdraws the request."""
+        ...
+    @property
+    def is_set(self) -> Any: ...
+    def set(self) -> Any:
+        """Asks every run polling this flag to stop after its current step."""
+        ...
+
+class Surroundings:
+    """Shapes carried by bodies (index 0, 1, …), in each body's reference frame."""
+    def __init__(self) -> None: ...
+    def add_box(self, body, center, rotation, half_extents) -> Any:
+        """Adds a box: centre, rotation (3 × 3, columns = box axes), half extents."""
+        ...
+    def add_cylinder(self, body, center, axis, radius, half_length) -> Any:
+        """Adds a solid cylinder: centre, axis, radius, half length along the axis."""
+        ...
+    def add_mesh(self, body, vertices, faces) -> Any:
+        """Adds a triangle mesh (vertices (V, 3), triangles (F, 3) of vertex indices, merged
+        vertices, no degenerate triangles); builds its hierarchy. Returns the part index.
+        """
+        ...
+    def add_plane(self, body, point, normal) -> Any:
+        """Adds the half-space below the plane through `point` with outward `normal`."""
+        ...
+    def add_sphere(self, body, center, radius) -> Any:
+        """Adds a solid sphere."""
+        ...
+    def clearance(self, positions, radius, to_body) -> Any:
+        """Clearance of a cable of outer `radius` with node positions (T, N, 3) (global);
+        `to_body` (B, T, 3, 4): per body and step the map [M | v] of global points into the
+        body's reference frame, X = M x + v. Returns (clearance (T, N) m, part (T, N) index).
+        """
+        ...
+    def closest_to_segments(self, part, a, b) -> Any:
+        """Closest points of segments [a_i, b_i] ((P, 3) each) and part `part`: dict of
+        distance (P,) (unsigned), t (P,), on_segment, on_surface, normal (P, 3).
+        """
+        ...
+    def project_points(self, part, points) -> Any:
+        """Signed distance of points (P, 3) to part `part` (its body frame): dict of
+        distance (P,), point (P, 3), normal (P, 3).
+        """
+        ...
+
+def capsule_distance(starts, ends, radius, points) -> Any:
+    """Exact signed distance from each of `points` (P, 3) to the union of capsules, (P,) float64."""
+    ...
+
+def capsule_signed_distance(starts, ends, radius, origin, spacing, shape, band) -> Any:
+    """Signed distance to the union of capsules on a grid, clamped to [-band, band], float32 of
+    shape `shape` (voxel (i, j, k) at origin + spacing * (i, j, k)).
+    """
+    ...
+
+def fatigue_cycles(series, residue="half", hysteresis=0.0) -> Any:
+    """Rainflow cycles of a 1-D series: (range, mean, count, from_index, to_index)."""
+    ...
+
+def fatigue_damage_combined(
+    signals,
+    weights,
+    k,
+    alpha,
+    knee_range=None,
+    knee_kind="haibach",
+    residue="half",
+    hysteresis=0.0,
+    threads=None,
+) -> Any:
+    """Miner damage of the linear combinations `signals[g] @ weights[j]` for every group g
+    (signals (n_groups, n_samples, n_channels)) and weight row j (weights (n_series,
+    n_channels)); returns (n_groups, n_series). The combined series are never stored.
+    """
+    ...
+
+def fatigue_damage_many(
+    series,
+    k,
+    alpha,
+    knee_range=None,
+    knee_kind="haibach",
+    residue="half",
+    hysteresis=0.0,
+    threads=None,
+) -> Any:
+    """Miner damage of every row of a 2-D array (n_series, n_samples), in parallel."""
+    ...
+
+def fatigue_turning_points(series, hysteresis=0.0) -> Any:
+    """Turning points of a 1-D series: (indices int64, values float64)."""
+    ...
