@@ -676,15 +676,16 @@ impl Statics {
             }
             sum
         };
-        // Rayleigh quotient zᵀHz / zᵀDz (the skew part of J drops out of zᵀJz).
-        self.ws.jac.mul(&self.trial, &mut self.delta);
-        let zhz: f64 = self
-            .trial
-            .iter()
-            .zip(&self.delta)
-            .map(|(a, b)| a.dot(b))
-            .sum();
-        let rho = zhz / d_norm(&self.trial).max(1e-300);
+        // Rayleigh quotient zᵀHz / zᵀDz of z = trial (the skew part of J drops out of zᵀJz);
+        // `delta` is its scratch.
+        let rayleigh = |jac: &crate::block_tridiag::BlockTridiag,
+                        z: &[Vector6<f64>],
+                        hz: &mut [Vector6<f64>]| {
+            jac.mul(z, hz);
+            let zhz: f64 = z.iter().zip(hz.iter()).map(|(a, b)| a.dot(b)).sum();
+            zhz / d_norm(z).max(1e-300)
+        };
+        let rho = rayleigh(&self.ws.jac, &self.trial, &mut self.delta);
         if !(rho < 0.0 && rho.is_finite()) {
             return true; // keep the LDLᵀ direction
         }
@@ -729,14 +730,7 @@ impl Statics {
         // Nearly equal negative eigenvalues (a round section: one per bending plane, split
         // only by imperfections) need a shift close to the eigenvalue to separate: shift by
         // the Rayleigh quotient less 1 % (10 % if that is not below the spectrum).
-        self.ws.jac.mul(&self.trial, &mut self.delta);
-        let zhz: f64 = self
-            .trial
-            .iter()
-            .zip(&self.delta)
-            .map(|(a, b)| a.dot(b))
-            .sum();
-        let rho = zhz / d_norm(&self.trial).max(1e-300);
+        let rho = rayleigh(&self.ws.jac, &self.trial, &mut self.delta);
         for gap in [0.01, 0.1] {
             let mu = rho * (1.0 + gap);
             shift(&mut self.ws.jac, mu);
