@@ -181,18 +181,19 @@ def _body_traces(cable: CableResult, k: int, bodies: list[BodyPose], length: flo
     return traces
 
 
-def volume_trace(mesh, name: str, color: str, opacity: float):
-    """A translucent plotly mesh of a motion volume's triangle mesh."""
-    v, f = mesh.vertices, mesh.faces
+def mesh_trace(vertices: np.ndarray, faces: np.ndarray, **style):
+    """A plotly Mesh3d of a triangle mesh (vertices (V, 3), faces (F, 3)) with ``style``."""
     import plotly.graph_objects as go
 
-    return go.Mesh3d(
-        x=v[:, 0],
-        y=v[:, 1],
-        z=v[:, 2],
-        i=f[:, 0],
-        j=f[:, 1],
-        k=f[:, 2],
+    v, f = vertices, faces
+    return go.Mesh3d(x=v[:, 0], y=v[:, 1], z=v[:, 2], i=f[:, 0], j=f[:, 1], k=f[:, 2], **style)
+
+
+def volume_trace(mesh, name: str, color: str, opacity: float):
+    """A translucent plotly mesh of a motion volume's triangle mesh."""
+    return mesh_trace(
+        mesh.vertices,
+        mesh.faces,
         color=color,
         opacity=opacity,
         name=name,
@@ -237,13 +238,9 @@ def cable_figure(
         return m, v
 
     m0, v0 = tube(steps[0])
-    tube_trace = go.Mesh3d(
-        x=m0.vertices[:, 0],
-        y=m0.vertices[:, 1],
-        z=m0.vertices[:, 2],
-        i=m0.faces[:, 0],
-        j=m0.faces[:, 1],
-        k=m0.faces[:, 2],
+    tube_trace = mesh_trace(
+        m0.vertices,
+        m0.faces,
         intensity=v0,
         meta={"tube": n_angles, "radius": radius},
         cmin=lo,
@@ -376,13 +373,9 @@ def damage_figure(
     lo, hi = np.log10(floor), np.log10(top) if top > 0 else 1.0
     ticks = np.arange(np.ceil(lo + 0.5), hi + 1e-9)  # whole decades above the floor
     traces = [
-        go.Mesh3d(
-            x=m.vertices[:, 0],
-            y=m.vertices[:, 1],
-            z=m.vertices[:, 2],
-            i=m.faces[:, 0],
-            j=m.faces[:, 1],
-            k=m.faces[:, 2],
+        mesh_trace(
+            m.vertices,
+            m.faces,
             intensity=log,
             meta={"tube": n_angles, "radius": radius},
             cmin=lo,

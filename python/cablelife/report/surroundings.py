@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from cablelife.report.scene3d import mesh_trace
 from cablelife.results import CableResult, Result
 from cablelife.surroundings.summary import clearance_summary
 
@@ -65,13 +66,9 @@ def clearance_3d_figure(cable: CableResult, result: Result, step: int, n_angles:
     m = tube_mesh(cable.positions[step], cable.quaternions[step], radius, n_angles)
     values = np.repeat(cl.value[step], n_angles) * 1e3
     traces = [
-        go.Mesh3d(
-            x=m.vertices[:, 0],
-            y=m.vertices[:, 1],
-            z=m.vertices[:, 2],
-            i=m.faces[:, 0],
-            j=m.faces[:, 1],
-            k=m.faces[:, 2],
+        mesh_trace(
+            m.vertices,
+            m.faces,
             intensity=values,
             colorscale="RdYlGn",
             # the colours resolve the near zone: up to 4 × min_clearance or 5 cm
@@ -92,13 +89,9 @@ def clearance_3d_figure(cable: CableResult, result: Result, step: int, n_angles:
             if not len(f):
                 continue
             traces.append(
-                go.Mesh3d(
-                    x=v[:, 0],
-                    y=v[:, 1],
-                    z=v[:, 2],
-                    i=f[:, 0],
-                    j=f[:, 1],
-                    k=f[:, 2],
+                mesh_trace(
+                    v,
+                    f,
                     color="lightsteelblue",
                     opacity=0.45,
                     name=name,
