@@ -78,7 +78,9 @@ def test_demo_command_end_to_end(tmp_path):
     assert len(page) > 100_000
     # the comparison's clearance table, after the ranking: one row per variant with the least
     # clearance the result file holds, to the part nearest there
-    assert page.index('class="ranking ranking-dynamic"') < page.index('class="clearance-comparison"')
+    assert page.index('class="ranking ranking-dynamic"') < page.index(
+        'class="clearance-comparison"'
+    )
     table = re.search(r'<table class="clearance-comparison">(.*?)</table>', page).group(1)
     rows = {
         cells[0]: cells[1:]
