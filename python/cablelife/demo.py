@@ -56,6 +56,9 @@ class DemoOutcome:
     quasistatic: object | None  # the same for the quasistatic runs
     report: Path | None
     stage_times: dict[str, float] = field(default_factory=dict)
+    #: run label -> :func:`cablelife.surroundings.summary.clearance_summary` of its cable
+    #: (dynamic runs first; empty without geometry in the scene)
+    clearances: dict[str, dict] = field(default_factory=dict)
 
     @property
     def preferred(self) -> str:
@@ -153,6 +156,7 @@ def run_demo(
 
     dynamic = ranking("dynamic")
     qs = ranking("quasistatic") if quasistatic else None
+    clearances = _clearances(out, runs)
     path = None
     if report:
         if on_stage is not None:
@@ -162,7 +166,32 @@ def run_demo(
         path = _write_report(out, runs, report_frames, step)
         times["report"] = time.perf_counter() - t1
     times["total"] = time.perf_counter() - t0
-    return DemoOutcome(out, rows, dynamic, qs, path, times)
+    return DemoOutcome(out, rows, dynamic, qs, path, times, clearances)
+
+
+def _clearances(out: Path, runs: list[Variant]) -> dict[str, dict]:
+    """The clearance summary of every run's cable (dynamic runs first), read from its result
+    file; runs without geometry are left out."""
+    from cablelife.results import load_result
+    from cablelife.surroundings.summary import clearance_summary
+
+    found = {}
+    for mode in MODES:
+        for v in runs:
+            if v.mode != mode:
+                continue
+            res = load_result(variant_dir(out, v.name) / "result.h5")
+            for name, c in res.cables.items():
+                if c.surroundings is not None:
+                    label = v.name if len(res.cables) == 1 else f"{v.name}: {name}"
+                    found[label] = clearance_summary(c)
+    return found
+
+
+def least_clearance(summary: dict) -> tuple[str, dict] | None:
+    """The body nearest of all in a clearance summary and its entry (min, s, t, part)."""
+    near = [(b, v) for b, v in summary["bodies"].items() if v is not None]
+    return min(near, key=lambda bv: bv[1]["min"]) if near else None
 
 
 def _write_report(out: Path, runs: list[Variant], frames: int, on_step=None) -> Path:

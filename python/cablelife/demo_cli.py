@@ -96,6 +96,8 @@ def demo_command(
         ),
         highlight=False,
     )
+    if outcome.clearances:
+        console.print(clearance_table(outcome.clearances), highlight=False)
     if outcome.quasistatic is not None:
         qs = {v.label: v.max_damage for v in outcome.quasistatic.variants}
         parts = [
@@ -120,3 +122,33 @@ def demo_command(
     console.print(escape(f"Runs, damage files and summaries: {outcome.out_dir / 'variants'}"))
     if outcome.report is not None:
         console.print(f"[bold]Report:[/] {escape(str(outcome.report))}")
+
+
+def clearance_table(clearances: dict[str, dict]):
+    """A Rich table: per run the least clearance of its cable to the surroundings, to which
+    part, where and when, and the length closer than min_clearance (the demo's summaries)."""
+    from rich.table import Table
+
+    from cablelife.clitext import escape
+    from cablelife.demo import least_clearance
+
+    limits = {s["min_clearance"] for s in clearances.values()}
+    limit = f"{limits.pop() * 1e3:g} mm" if len(limits) == 1 else "min_clearance"
+    t = Table(
+        title="Clearance to the surroundings (cable surface, least over time and cable)",
+        title_justify="left",
+    )
+    t.add_column("run", no_wrap=True)
+    t.add_column(escape("least [mm]"), justify="right")
+    t.add_column("nearest part", no_wrap=True)
+    t.add_column(escape("s [m]"), justify="right")
+    t.add_column(escape("t [s]"), justify="right")
+    t.add_column(escape(f"length < {limit} [m]"), justify="right")
+    for run, s in clearances.items():
+        near = least_clearance(s)
+        cells = ["–"] * 4
+        if near is not None:
+            v = near[1]
+            cells = [f"{v['min'] * 1e3:.1f}", escape(v["part"]), f"{v['s']:.3f}", f"{v['t']:.3f}"]
+        t.add_row(escape(run), *cells, f"{s['length_below_min']:.3f}")
+    return t

@@ -191,6 +191,59 @@ def _ranking(page: Page, runs: list[ReportRun], summaries) -> None:
     )
 
 
+def _clearances(page: Page, runs: list[ReportRun]) -> None:
+    """Beside the ranking: per run (dynamic first) the least clearance of each cable to the
+    surroundings (which part, s, t) and the largest length closer than min_clearance, from
+    :func:`cablelife.surroundings.summary.clearance_summary`; nothing without geometry."""
+    from cablelife.surroundings.summary import clearance_summary
+
+    rows = []
+    limits = set()
+    for mode in MODE_ORDER:
+        for r in runs:
+            if r.result.mode != mode:
+                continue
+            for name, c in r.result.cables.items():
+                if c.surroundings is None:
+                    continue
+                s = clearance_summary(c)
+                limits.add(s["min_clearance"])
+                label = r.label if len(r.result.cables) == 1 else f"{r.label}: {name}"
+                near = [v for v in s["bodies"].values() if v is not None]
+                v = min(near, key=lambda x: x["min"]) if near else None
+                cells = (
+                    ["–"] * 4
+                    if v is None
+                    else [
+                        f"{v['min'] * 1e3:.1f}",
+                        v["part"],
+                        f"{v['s']:.3f}",
+                        f"{v['t']:.3f}",
+                    ]
+                )
+                close = s["length_below_min"]
+                when = f"{s['length_below_min_t']:.3f}" if close > 0 else "–"
+                rows.append([label, *cells, f"{close:.3f}", when])
+    if not rows:
+        return
+    limit = f"{next(iter(limits)) * 1e3:g} mm" if len(limits) == 1 else "min_clearance"
+    page.table(
+        [
+            "run",
+            "least clearance [mm]",
+            "nearest part",
+            "at s [m]",
+            "at t [s]",
+            f"length closer than {limit} [m]",
+            "at t [s]",
+        ],
+        rows,
+        "clearance to the surroundings: the least over time and cable (of the cable surface; "
+        f"negative: inside) and the largest cable length closer than {limit}",
+        cls="clearance-comparison",
+    )
+
+
 def _inertia(page: Page, runs: list[ReportRun]) -> None:
     """Dynamic over quasistatic maximum damage per variant that has both runs: how much the
     inertia (resonance) adds; not a ranking."""
@@ -271,6 +324,7 @@ def _comparison(
         f"maxima over time and arc length (0: below {ZERO:g} × the largest force or moment)",
     )
     _ranking(page, runs, summaries)
+    _clearances(page, runs)
     if len(volumes) == 2:
         from cablelife.volume import compare_volumes
 
