@@ -89,6 +89,7 @@ pub fn clearance(
             let first = k * chunk_steps;
             // per node and part: the feature nearest to the node, to its two half-edges
             let mut hints = vec![usize::MAX; 3 * n_nodes * parts.len()];
+            let mut dist = vec![f64::INFINITY; parts.len()];
             let mut local = vec![V3::zeros(); n_bodies * n_nodes];
             for (j, (vrow, prow)) in val
                 .chunks_mut(n_nodes)
@@ -103,18 +104,25 @@ pub fn clearance(
                         *l = map.apply(p);
                     }
                 }
-                step(parts, &local, n_nodes, radius, &mut hints, vrow, prow);
+                step(
+                    parts, &local, n_nodes, radius, &mut hints, &mut dist, vrow, prow,
+                );
             }
         });
     Ok(Clearance { value, part })
 }
 
+/// Clearance of the nodes of one step. `dist`: scratch, per part the node's distance. A
+/// half-edge is queried only if it can come nearer than the best so far: the distance is
+/// 1-Lipschitz, so on a half-edge of reach ℓ from the node it is at least d(node) − ℓ.
+#[allow(clippy::too_many_arguments)]
 fn step(
     parts: &[Part],
     local: &[V3],
     n: usize,
     radius: f64,
     hints: &mut [usize],
+    dist: &mut [f64],
     value: &mut [f64],
     part: &mut [u32],
 ) {
@@ -125,8 +133,10 @@ fn step(
         for (k, pt) in parts.iter().enumerate() {
             let x = &local[pt.body * n + i];
             let h = &mut hints[3 * (i * n_parts + k)];
+            dist[k] = f64::INFINITY;
             if let Some(r) = pt.shape.project_point(x, f64::INFINITY, *h) {
                 *h = r.feature;
+                dist[k] = r.distance;
                 if r.distance < best {
                     best = r.distance;
                     nearest = k;
@@ -143,6 +153,9 @@ fn step(
                         continue;
                     }
                     let mid = (x + local[base + nb]) * 0.5;
+                    if dist[k] - (mid - x).norm() >= best {
+                        continue; // cannot come nearer than the best so far
+                    }
                     // warm start: this half-edge's feature at the previous step, else the node's
                     let h = match hints[at + 1 + side] {
                         usize::MAX => hints[at],

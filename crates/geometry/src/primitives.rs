@@ -185,8 +185,10 @@ fn golden_section<S: Convex>(s: &S, a: &V3, b: &V3) -> f64 {
     let mut x1 = hi - g * (hi - lo);
     let mut x2 = lo + g * (hi - lo);
     let (mut f1, mut f2) = (f(x1), f(x2));
-    // stop when the bracket is below round-off of the segment length
-    while (hi - lo) * len > 1e-15 * (1.0 + a.norm()) && hi - lo > 1e-16 {
+    // Stop when the bracket is below 1e-10 m (or round-off): outside a convex set its distance
+    // is C¹ and convex along the segment, so the distance found is within ~(1e-10 m)²/d of the
+    // least one (and the end points are checked exactly below).
+    while (hi - lo) * len > 1e-10_f64.max(1e-15 * (1.0 + a.norm())) && hi - lo > 1e-16 {
         if f1 <= f2 {
             hi = x2;
             x2 = x1;
