@@ -311,7 +311,7 @@ def save_result(result: Result, path: str | os.PathLike, precision: str | None =
                 else:
                     sol.attrs[key] = value
             if c.surroundings is not None:
-                c.surroundings.write(g)
+                c.surroundings.write(g, lambda *a, **k: _put(*a, **k, dtype=hist))
         if result.surroundings is not None:
             result.surroundings.write(f)
     return path

@@ -26,17 +26,17 @@ class CableClearance:
     parts: list[str]
     min_clearance: float = 0.0
 
-    def write(self, group) -> None:
-        ds = group.create_dataset("clearance", data=self.value)
-        ds.attrs["unit"] = "m"
+    def write(self, group, put) -> None:
+        """Writes the datasets with ``put(group, name, data, unit)``: the result file's chunked,
+        compressed writer (and its precision for the clearance values)."""
+        put(group, "clearance", self.value, "m")
+        ds = group["clearance"]
         ds.attrs["min_clearance"] = self.min_clearance
         ds.attrs["definition"] = DEFINITION
-        ds = group.create_dataset("clearance_body", data=self.body.astype(np.int32))
-        ds.attrs["unit"] = "1"
-        ds.attrs["bodies"] = np.array(self.bodies, dtype=object)
-        ds = group.create_dataset("clearance_part", data=self.part.astype(np.int32))
-        ds.attrs["unit"] = "1"
-        ds.attrs["parts"] = np.array(self.parts, dtype=object)
+        put(group, "clearance_body", self.body.astype(np.int32), "1")
+        group["clearance_body"].attrs["bodies"] = np.array(self.bodies, dtype=object)
+        put(group, "clearance_part", self.part.astype(np.int32), "1")
+        group["clearance_part"].attrs["parts"] = np.array(self.parts, dtype=object)
 
     @classmethod
     def read(cls, group) -> CableClearance | None:
@@ -44,7 +44,7 @@ class CableClearance:
             return None
         ds, db, dp = group["clearance"], group["clearance_body"], group["clearance_part"]
         return cls(
-            value=ds[()],
+            value=np.asarray(ds[()], dtype=np.float64),
             body=db[()],
             bodies=[_text(x) for x in db.attrs["bodies"]],
             part=dp[()],
