@@ -20,6 +20,7 @@ class Cable:
         loads,
         max_iterations=40,
         step_tolerance=1e-9,
+        clip_axes=None,
     ) -> None: ...
     @property
     def arc_length(self) -> Any: ...

@@ -158,11 +158,12 @@ class Clip(_Model):
     position: Point  # m
     direction: Direction  # cable tangent d3 at the clip
     normal: Direction | None = None  # d1 at the clip (fixes the twist); default: any normal
-    type: Literal["fixed", "swivel", "ball"] = "fixed"
+    type: Literal["fixed", "swivel", "ball", "hinge"] = "fixed"
     length: NonNegativeFloat = 0.0  # held length; 0 = point clip
+    axis: Direction | None = None  # hinge: the turning axis in the clip frame (d1, d2, d3)
     frame: Literal["global", "body"] = "global"  # frame of position/direction/normal
 
-    @field_validator("direction", "normal")
+    @field_validator("direction", "normal", "axis")
     @classmethod
     def _nonzero(cls, v, info):
         if v is not None and math.hypot(*v) < 1e-9:
@@ -182,8 +183,18 @@ class Clip(_Model):
                     f"normal = {list(self.normal)} is parallel to direction = "
                     f"{list(self.direction)}; it must have a part orthogonal to it"
                 )
-        if self.type == "ball" and self.length > 0:
-            raise ValueError("a ball clip holds a point: its length must be 0")
+        if self.type in ("ball", "hinge") and self.length > 0:
+            raise ValueError(f"a {self.type} clip holds a point: its length must be 0")
+        if self.type == "hinge" and self.axis is None:
+            raise ValueError(
+                "a hinge clip needs its axis = [a1, a2, a3] in the clip frame (d1 = normal, "
+                "d3 = cable direction), e.g. axis = [0, 1, 0] for a hinge about d2"
+            )
+        if self.type != "hinge" and self.axis is not None:
+            raise ValueError(
+                f"axis = {list(self.axis)} is given for a {self.type} clip; only a hinge clip "
+                "has an axis"
+            )
         if self.frame == "body" and self.body == "world":
             raise ValueError(
                 "frame = 'body' needs a clip on a body, but body = 'world' (the fixed frame); "

@@ -387,11 +387,12 @@ impl Cable {
 #[pymethods]
 impl Cable {
     /// clips: list of (name, s, length, kind, position[3], quaternion[4] scalar first);
-    /// loads: list of (s, force[3], moment[3]).
+    /// loads: list of (s, force[3], moment[3]); clip_axes: {clip name: axis[3] in the clip
+    /// frame} of the hinge clips.
     #[new]
     #[pyo3(signature = (length, segments, shear_stiffness, bend_stiffness, mass_per_length,
         rotary_inertia, natural_curvature, gravity, clips, loads, max_iterations=40,
-        step_tolerance=1e-9))]
+        step_tolerance=1e-9, clip_axes=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         length: f64,
@@ -406,7 +407,9 @@ impl Cable {
         loads: Vec<(f64, Vec<f64>, Vec<f64>)>,
         max_iterations: usize,
         step_tolerance: f64,
+        clip_axes: Option<std::collections::HashMap<String, Vec<f64>>>,
     ) -> PyResult<Self> {
+        let clip_axes = clip_axes.unwrap_or_default();
         let section = Section {
             shear_stiffness: vec3(&shear_stiffness, "shear_stiffness")?,
             bend_stiffness: vec3(&bend_stiffness, "bend_stiffness")?,
@@ -419,9 +422,19 @@ impl Cable {
                 "fixed" => ClipKind::Fixed,
                 "swivel" => ClipKind::Swivel,
                 "ball" => ClipKind::Ball,
+                "hinge" => match clip_axes.get(&name) {
+                    Some(a) => ClipKind::Hinge {
+                        axis: vec3(a, &format!("clip '{name}' axis"))?,
+                    },
+                    None => {
+                        return Err(PyValueError::new_err(format!(
+                            "clip '{name}': a hinge needs its axis (clip_axes['{name}'])"
+                        )))
+                    }
+                },
                 other => {
                     return Err(PyValueError::new_err(format!(
-                        "clip '{name}': type = {other:?}; allowed: fixed, swivel, ball"
+                        "clip '{name}': type = {other:?}; allowed: fixed, swivel, ball, hinge"
                     )))
                 }
             };

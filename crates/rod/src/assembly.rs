@@ -135,7 +135,7 @@ pub struct Rates {
 }
 
 impl Rates {
-    /// J_r of a rotation's step (free edges only: the swivel twists and ghosts are moved by
+    /// J_r of a rotation's step (free edges only: the swivel twists and hinge angles are moved by
     /// the Newton update directly).
     #[inline]
     fn tangent_of(&self, r: RotRef, rod: &Rod) -> Option<Matrix3<f64>> {
@@ -175,8 +175,9 @@ pub enum Part<'a> {
 enum Var {
     /// Full 3-vector at (block, half).
     Full(usize, usize),
-    /// Only the d3 component, stored in slot 0 of the block (swivel ghost twist).
-    Axis3(usize),
+    /// Only the component along a unit axis (body frame), stored in slot 0 of the block (the
+    /// free angle of a swivel or hinge ghost).
+    Axis(usize, Vector3<f64>),
     /// Not an unknown.
     None,
 }
@@ -247,18 +248,18 @@ impl Workspace {
     fn add(&mut self, vi: Var, vj: Var, m: &Matrix3<f64>) {
         let (bi, hi, mi) = match vi {
             Var::Full(b, h) => (b, h, *m),
-            Var::Axis3(b) => {
+            Var::Axis(b, a) => {
                 let mut r = Matrix3::zeros();
-                r.set_row(0, &m.row(2));
+                r.set_row(0, &(a.transpose() * m));
                 (b, 0, r)
             }
             Var::None => return,
         };
         match vj {
             Var::Full(b, h) => self.jac.add3(bi, hi, b, h, &mi),
-            Var::Axis3(b) => {
+            Var::Axis(b, a) => {
                 let mut c = Matrix3::zeros();
-                c.set_column(0, &mi.column(2));
+                c.set_column(0, &(mi * a));
                 self.jac.add3(bi, hi, b, 0, &c);
             }
             Var::None => {}
@@ -556,8 +557,10 @@ impl Workspace {
             self.rhs[n] = r;
         }
         for (k, g) in rod.ghosts.iter().enumerate() {
-            if g.twist_free && blocks.contains(&g.node) {
-                self.rhs[g.node][0] = self.ghost_grad[k].z;
+            if let Some(a) = g.free_axis {
+                if blocks.contains(&g.node) {
+                    self.rhs[g.node][0] = self.ghost_grad[k].dot(&a);
+                }
             }
         }
         for n in blocks {
@@ -742,10 +745,9 @@ fn rot_var(rod: &Rod, r: RotRef) -> Var {
         RotRef::Edge(e) => edge_var(rod, e),
         RotRef::Ghost(g) => {
             let gh = rod.ghosts[g];
-            if gh.twist_free {
-                Var::Axis3(gh.node)
-            } else {
-                Var::None
+            match gh.free_axis {
+                Some(a) => Var::Axis(gh.node, a),
+                None => Var::None,
             }
         }
     }

@@ -967,8 +967,10 @@ impl Dynamics {
             }
         }
         for &g in &seg.ghosts {
-            let twist = Vector3::new(0.0, 0.0, self.delta[rod.ghosts[g].node][0]);
-            st.ghost[g] = rotate_body(&st.ghost[g], &twist);
+            if let Some(axis) = rod.ghosts[g].free_axis {
+                let turn = self.delta[rod.ghosts[g].node][0] * axis;
+                st.ghost[g] = rotate_body(&st.ghost[g], &turn);
+            }
         }
     }
 
@@ -1129,8 +1131,9 @@ impl Dynamics {
             self.vdot[b][k] += c_mass * d;
         } else if k == 5 {
             st.p[b] = rotate_body(&st.p[b], &Vector3::new(0.0, 0.0, d));
-        } else if let Some(g) = rod.ghosts.iter().position(|g| g.twist_free && g.node == b) {
-            st.ghost[g] = rotate_body(&st.ghost[g], &Vector3::new(0.0, 0.0, d));
+        } else if let Some(g) = rod.ghosts.iter().position(|g| g.is_free() && g.node == b) {
+            let axis = rod.ghosts[g].free_axis.unwrap_or_else(Vector3::z);
+            st.ghost[g] = rotate_body(&st.ghost[g], &(d * axis));
         }
     }
 

@@ -1,15 +1,15 @@
 //! The discretised cable: mesh on a staggered grid, section data, clips, loads and the map from
 //! unknowns to the blocks of the block-tridiagonal Jacobian.
 //!
-//! Block n (n = 0..N) holds 6 slots: slots 0..3 are Δx_n of node n (or, at a point swivel clip,
-//! slot 0 is the clip's free twist angle), slots 3..6 are θ of edge n+½ (none for n = N).
+//! Block n (n = 0..N) holds 6 slots: slots 0..3 are Δx_n of node n (or, at a point swivel or
+//! hinge clip, slot 0 is the clip's free angle about its axis), slots 3..6 are θ of edge n+½ (none for n = N).
 //! Prescribed unknowns are eliminated: their slots are inactive.
 use crate::rotation::{rotation_matrix, Quat};
 use nalgebra::Vector3;
 use std::fmt;
 
 /// How a clip holds the cable.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum ClipKind {
     /// Position and full orientation prescribed.
     Fixed,
@@ -17,6 +17,20 @@ pub enum ClipKind {
     Swivel,
     /// Position prescribed, rotation free (point clips only).
     Ball,
+    /// Position prescribed, rotation free about `axis` only (clip frame: d1, d2, d3 = cable
+    /// tangent; point clips only). A swivel is the hinge about d3.
+    Hinge { axis: Vector3<f64> },
+}
+
+impl ClipKind {
+    /// The clip-frame axis of the one free rotation of a point clip (unit), if it has one.
+    pub fn free_axis(&self) -> Option<Vector3<f64>> {
+        match self {
+            ClipKind::Swivel => Some(Vector3::z()),
+            ClipKind::Hinge { axis } => Some(axis.normalize()),
+            ClipKind::Fixed | ClipKind::Ball => None,
+        }
+    }
 }
 
 /// A clip's pose in the global frame: the point of the clip centre on the cable axis and the
@@ -118,14 +132,22 @@ pub struct BendTerm {
     pub node: usize,
 }
 
-/// The ghost rotation of a point clip (fixed or swivel): the clip's orientation, which splits
-/// the bending term at the clip node into two half cells.
+/// The ghost rotation of a point clip (fixed, swivel or hinge): the clip's orientation, which
+/// splits the bending term at the clip node into two half cells.
 #[derive(Clone, Copy, Debug)]
 pub struct Ghost {
     pub clip: usize,
     pub node: usize,
-    /// Swivel: the twist angle is an unknown, in slot 0 of the node's block.
-    pub twist_free: bool,
+    /// Swivel or hinge: the unit axis (body frame of the ghost, which is the clip frame turned
+    /// about this same axis) of the free angle, an unknown in slot 0 of the node's block; the
+    /// ghost moves as g ← g ⊗ exp(δ axis).
+    pub free_axis: Option<Vector3<f64>>,
+}
+
+impl Ghost {
+    pub fn is_free(&self) -> bool {
+        self.free_axis.is_some()
+    }
 }
 
 /// A set of consecutive blocks whose unknowns are coupled to no others: the cable splits into
@@ -202,6 +224,25 @@ impl Rod {
                     "{}: a ball clip holds a point; its length must be 0",
                     fmt_clip(c)
                 )));
+            }
+            if let ClipKind::Hinge { axis } = c.kind {
+                if c.length > 0.0 {
+                    return Err(SpecError(format!(
+                        "{}: a hinge holds a point; its length must be 0 (a held length \
+                         turning about the cable axis is a swivel)",
+                        fmt_clip(c)
+                    )));
+                }
+                if !(axis.iter().all(|a| a.is_finite()) && axis.norm() > 1e-12) {
+                    return Err(SpecError(format!(
+                        "{}: hinge axis = [{}, {}, {}]: must be a finite non-zero vector in the \
+                         clip frame",
+                        fmt_clip(c),
+                        axis.x,
+                        axis.y,
+                        axis.z
+                    )));
+                }
             }
             let (a, b) = (c.s - 0.5 * c.length, c.s + 0.5 * c.length);
             if a < -eps || b > l + eps || !c.s.is_finite() {
@@ -280,7 +321,7 @@ impl Rod {
                 ghosts.push(Ghost {
                     clip: ci,
                     node: na,
-                    twist_free: c.kind == ClipKind::Swivel,
+                    free_axis: c.kind.free_axis(),
                 });
             }
         }
@@ -322,7 +363,7 @@ impl Rod {
             if node_kind[n] == NodeKind::Free {
                 mask[n][0..3].copy_from_slice(&[true; 3]);
             } else if let Some(g) = ghost_at[n] {
-                mask[n][0] = ghosts[g].twist_free;
+                mask[n][0] = ghosts[g].is_free();
             }
             if n < n_edges {
                 match edge_kind[n] {
@@ -404,7 +445,7 @@ fn find_segments(
     // The block holding an element variable, if it is an unknown.
     let rot_block = |r: RotRef| match r {
         RotRef::Edge(e) => edge_active(e).then_some(e),
-        RotRef::Ghost(g) => ghosts[g].twist_free.then_some(ghosts[g].node),
+        RotRef::Ghost(g) => ghosts[g].is_free().then_some(ghosts[g].node),
     };
     // coupled[b]: blocks b and b+1.
     let mut coupled: Vec<bool> = (0..n_blocks)
@@ -456,7 +497,7 @@ fn find_segments(
         }
     }
     for (g, ghost) in ghosts.iter().enumerate() {
-        if ghost.twist_free {
+        if ghost.is_free() {
             if let Some(k) = segment_of(ghost.node) {
                 segments[k].ghosts.push(g);
             }
@@ -650,5 +691,31 @@ mod tests {
             e.0.contains("'a'") && e.0.contains("'b'") && e.0.contains("overlap"),
             "{e}"
         );
+        let hinge = |axis: Vector3<f64>| ClipKind::Hinge { axis };
+        let e = Rod::new(spec(vec![clip("h", 0.5, 0.1, hinge(Vector3::y()))])).unwrap_err();
+        assert!(
+            e.0.contains("clip 'h'") && e.0.contains("length must be 0"),
+            "{e}"
+        );
+        let e = Rod::new(spec(vec![clip("h", 0.5, 0.0, hinge(Vector3::zeros()))])).unwrap_err();
+        assert!(
+            e.0.contains("clip 'h'") && e.0.contains("axis = [0, 0, 0]"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn a_hinge_is_a_ghost_with_its_unit_axis_and_couples_both_sides() {
+        let axis = Vector3::new(0.0, 3.0, 4.0);
+        let rod = Rod::new(spec(vec![
+            clip("a", 0.0, 0.0, ClipKind::Fixed),
+            clip("h", 0.5, 0.0, ClipKind::Hinge { axis }),
+        ]))
+        .unwrap();
+        let g = rod.clip_ghost[1].unwrap();
+        assert_eq!(rod.ghosts[g].free_axis, Some(axis / 5.0));
+        assert!(rod.mask[rod.ghosts[g].node][0]);
+        assert_eq!(rod.segments.len(), 1);
+        assert_eq!(ClipKind::Swivel.free_axis(), Some(Vector3::z()));
     }
 }

@@ -193,19 +193,21 @@ pub fn free_rigid_motions(
             .copy_from(&nalgebra::Matrix3::identity());
         point.fixed_view_mut::<3, 3>(0, 3).copy_from(&(-skew(&p)));
         add_rows(&point);
-        let axis = rotation_matrix(&pose.orientation) * Vector3::z();
         let mut rot = nalgebra::Matrix3x6::zeros();
-        match rod.spec.clips[c].kind {
-            ClipKind::Fixed => {
+        let kind = rod.spec.clips[c].kind;
+        match (kind, kind.free_axis()) {
+            (ClipKind::Fixed, _) => {
                 rot.fixed_view_mut::<3, 3>(0, 3)
                     .copy_from(&nalgebra::Matrix3::identity());
                 add_rows(&rot);
             }
-            ClipKind::Swivel => {
+            (_, Some(a)) => {
+                // Free to turn about the axis only (ω ∥ axis).
+                let axis = rotation_matrix(&pose.orientation) * a;
                 rot.fixed_view_mut::<3, 3>(0, 3).copy_from(&skew(&axis));
                 add_rows(&rot);
             }
-            ClipKind::Ball => {}
+            _ => {}
         }
     }
     let eig = SymmetricEigen::new(ata);

@@ -43,15 +43,15 @@ impl State {
             }
         }
         for (g, ghost) in rod.ghosts.iter().enumerate() {
-            if ghost.twist_free {
+            if let Some(axis) = ghost.free_axis {
                 let a = alpha * delta[ghost.node][0];
-                self.ghost[g] = rotate_body(&self.ghost[g], &Vector3::new(0.0, 0.0, a));
+                self.ghost[g] = rotate_body(&self.ghost[g], &(a * axis));
             }
         }
     }
 
-    /// Moves the prescribed unknowns to follow new clip poses; free twists of swivel clips are
-    /// kept (the clip's rotation increment is applied from the left).
+    /// Moves the prescribed unknowns to follow new clip poses; free angles of swivel and hinge
+    /// clips are kept (the clip's rotation increment is applied from the left).
     pub fn set_clip_poses(&mut self, rod: &Rod, poses: &[Pose]) {
         for (c, pose) in poses.iter().enumerate() {
             let old = self.clip_pose[c];
@@ -68,7 +68,7 @@ impl State {
                 };
             }
             if let Some(g) = rod.clip_ghost[c] {
-                self.ghost[g] = if rod.ghosts[g].twist_free {
+                self.ghost[g] = if rod.ghosts[g].is_free() {
                     normalize(delta * self.ghost[g])
                 } else {
                     pose.orientation

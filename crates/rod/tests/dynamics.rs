@@ -380,6 +380,15 @@ fn iteration_matrix_is_the_derivative_of_the_dynamic_residual() {
             ClipKind::Swivel,
             pose([0.7, 0.1, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]),
         ),
+        clip(
+            "f",
+            0.94,
+            0.0,
+            ClipKind::Hinge {
+                axis: Vector3::new(0.5, -0.3, 0.8),
+            },
+            pose([0.71, 0.24, 0.01], [0.2, 1.0, 0.0], [0.0, 0.0, 1.0]),
+        ),
     ];
     let rod = Rod::new(spec).unwrap();
     assert!(

@@ -1,5 +1,5 @@
 //! The assembled Jacobian equals the finite-difference derivative of the residual along the
-//! Newton update (x ← x + δ, p ← p ⊗ exp(δ/2), swivel twists), for every clip type.
+//! Newton update (x ← x + δ, p ← p ⊗ exp(δ/2), swivel and hinge angles), for every clip type.
 mod common;
 use common::*;
 use nalgebra::{Vector3, Vector6};
@@ -9,7 +9,10 @@ use rod::routing::route;
 use rod::{ClipKind, PointLoad, Rod};
 
 fn check(rod: &Rod) {
-    let mut st = route(rod, None).unwrap();
+    check_at(rod, route(rod, None).unwrap());
+}
+
+fn check_at(rod: &Rod, mut st: rod::State) {
     // Move away from the routed shape so every term (incl. the ½[g]× correction) is non-zero.
     for (i, x) in st.x.iter_mut().enumerate() {
         if rod.node_kind[i] == rod::model::NodeKind::Free {
@@ -131,4 +134,52 @@ fn jacobian_swivel_ball_and_finite_clips() {
         ),
     ];
     check(&Rod::new(spec).unwrap());
+}
+
+#[test]
+fn jacobian_hinges_with_oblique_axes() {
+    let mut spec = cantilever(1.0, 16, circle(0.005, 5e7, 0.45, 1500.0));
+    spec.gravity = Vector3::new(0.0, 0.0, -9.81);
+    spec.natural_curvature = Vector3::new(0.4, 0.1, -0.2);
+    spec.loads.push(PointLoad {
+        s: 1.0,
+        force: Vector3::new(0.1, -0.2, 0.05),
+        moment: Vector3::new(0.01, 0.0, -0.02),
+    });
+    spec.clips = vec![
+        clip(
+            "a",
+            0.0,
+            0.0,
+            ClipKind::Hinge {
+                axis: Vector3::new(0.2, 1.0, 0.3),
+            },
+            pose([0.0; 3], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]),
+        ),
+        clip(
+            "b",
+            0.45,
+            0.0,
+            ClipKind::Hinge {
+                axis: Vector3::new(1.0, -0.5, 2.0),
+            },
+            pose([0.4, 0.05, 0.02], [1.0, 0.2, 0.0], [0.0, 0.0, 1.0]),
+        ),
+        clip(
+            "c",
+            0.8,
+            0.0,
+            ClipKind::Ball,
+            pose([0.7, 0.1, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]),
+        ),
+    ];
+    let rod = Rod::new(spec).unwrap();
+    let st = route(&rod, None).unwrap();
+    // Turn the hinge ghosts off the clip frames so that the angle's terms are general.
+    let mut moved = st.clone();
+    for (g, ghost) in rod.ghosts.iter().enumerate() {
+        let a = ghost.free_axis.unwrap();
+        moved.ghost[g] = rotate_body(&moved.ghost[g], &(0.3 * a));
+    }
+    check_at(&rod, moved);
 }

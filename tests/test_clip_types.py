@@ -1,0 +1,118 @@
+"""Hinged clips through the scene API: the pinned–supported beam, the hinge's reaction and
+bad hinge input. (crates/rod/tests/hinge.rs covers convergence order, Jacobian and dynamics.)"""
+
+from __future__ import annotations
+
+import copy
+
+import numpy as np
+import pytest
+from cablelife.scene import SceneError, scene_from_dict
+from cablelife.simulate import simulate
+
+
+def overhang(scene_dict, segments=80, normal=(0.0, 0.0, 1.0), axis=(0.0, 1.0, 0.0)):
+    """A beam along x: a hinge at 0, a ball at a = 0.6, a tip load F = 1e-3 N down at 1 m."""
+    scene_dict = copy.deepcopy(scene_dict)
+    cable = scene_dict["cables"][0]
+    del cable["section"], cable["material"]
+    # Moderate EA: both supports hold positions, so the membrane tension of the deflected span
+    # stays ~1e-5 N (1e-6 of the bending stiffness). GA = 1e5: the shear deflection is 1e-4
+    # of the bending one (in the reference below) and the round-off of the shear forces
+    # (GA · 1e-16 / h) stays ~1e-9 N.
+    cable["stiffness"] = {
+        "EA": 1e4,
+        "GA": 1e5,
+        "EI": 1.0,
+        "GJ": 1.0,
+        "mass_per_length": 0.1,
+        "radius": 0.005,
+    }
+    cable["segments"] = segments
+    cable["clips"] = [
+        {
+            "name": "hinge",
+            "s": 0.0,
+            "position": [0.0, 0.0, 0.0],
+            "direction": [1.0, 0.0, 0.0],
+            "normal": list(normal),
+            "type": "hinge",
+            "axis": list(axis),
+        },
+        {
+            "name": "support",
+            "s": 0.6,
+            "position": [0.6, 0.0, 0.0],
+            "direction": [1.0, 0.0, 0.0],
+            "type": "ball",
+        },
+    ]
+    cable["loads"] = [{"s": 1.0, "force": [0.0, 0.0, -1e-3]}]
+    scene_dict["simulation"]["gravity"] = [0.0, 0.0, 0.0]
+    return scene_dict
+
+
+@pytest.mark.parametrize(
+    "normal, axis",
+    [((0.0, 0.0, 1.0), (0.0, 1.0, 0.0)), ((0.0, 1.0, 0.0), (-1.0, 0.0, 0.0))],
+    ids=["axis-d2", "axis-d1"],
+)
+def test_hinged_overhang_matches_the_pinned_beam(scene_dict, normal, axis):
+    # Both clip frames put the hinge axis along global ±y: the same pinned beam.
+    # Tip deflection F b² L / (3EI) = 5.33e-5 m plus shear F b L / (a GA) (Castigliano);
+    # N = 80: discretisation error 2e-4 (measured convergence in crates/rod/tests/hinge.rs).
+    res = simulate(scene_from_dict(overhang(scene_dict, normal=normal, axis=axis))).cable
+    f, a, b, length = 1e-3, 0.6, 0.4, 1.0
+    exact = f * b * b * length / 3.0 + f * b * length / (a * 1e5)
+    assert -res.positions[0, -1, 2] == pytest.approx(exact, rel=5e-4)
+    # The hinge moment about the axis (global y) is zero; all reactions balance the load.
+    hinge = res.clips["hinge"]
+    assert abs(hinge.moment[0][1]) < 1e-12
+    total = hinge.force[0] + res.clips["support"].force[0]
+    # To the Newton tolerance: residual 1e-10 × the force scale EI/L² = 1 N.
+    np.testing.assert_allclose(total, [0.0, 0.0, f], rtol=0, atol=1e-10)
+    assert hinge.force[0][2] == pytest.approx(-f * b / a, rel=1e-6)
+
+
+def test_hinge_takes_the_moment_across_its_axis(scene_dict):
+    # A hinge about the global z axis under a vertical tip load: it holds the bending moment
+    # about y (a clamp in that plane, with the ball a propped cantilever); the moments of the
+    # reactions and the load about the hinge sum to zero.
+    d = overhang(scene_dict, axis=(1.0, 0.0, 0.0))  # d1 = global z
+    res = simulate(scene_from_dict(d)).cable
+    hinge, support = res.clips["hinge"], res.clips["support"]
+    assert abs(hinge.moment[0][2]) < 1e-12  # none about the axis
+    assert abs(hinge.moment[0][1]) > 1e-5  # the constraint moment across it
+    total = hinge.moment[0] + np.cross([0.6, 0.0, 0.0], support.force[0])
+    total += np.cross(res.positions[0, -1], [0.0, 0.0, -1e-3])
+    np.testing.assert_allclose(total, 0.0, atol=1e-10)  # Newton tolerance (N · 1 m)
+
+
+def error_of(data) -> str:
+    with pytest.raises(SceneError) as info:
+        simulate(scene_from_dict(data))
+    return str(info.value)
+
+
+def test_hinge_without_an_axis(scene_dict):
+    d = overhang(scene_dict)
+    del d["cables"][0]["clips"][0]["axis"]
+    msg = error_of(d)
+    assert "clips[0]" in msg and "needs its axis" in msg
+
+
+def test_axis_on_a_clip_that_is_no_hinge(scene_dict):
+    d = overhang(scene_dict)
+    d["cables"][0]["clips"][0]["type"] = "fixed"
+    msg = error_of(d)
+    assert "clips[0]" in msg and "axis = [0.0, 1.0, 0.0]" in msg and "only a hinge" in msg
+
+
+def test_hinge_with_a_length_or_a_zero_axis(scene_dict):
+    d = overhang(scene_dict)
+    d["cables"][0]["clips"][0].update(length=0.02, s=0.01)
+    assert "hinge clip holds a point" in error_of(d)
+    d = overhang(scene_dict)
+    d["cables"][0]["clips"][0]["axis"] = [0.0, 0.0, 0.0]
+    msg = error_of(d)
+    assert "clips[0]" in msg and "axis must not be the zero vector" in msg
