@@ -116,3 +116,94 @@ def test_hinge_with_a_length_or_a_zero_axis(scene_dict):
     d["cables"][0]["clips"][0]["axis"] = [0.0, 0.0, 0.0]
     msg = error_of(d)
     assert "clips[0]" in msg and "axis must not be the zero vector" in msg
+
+
+def hanging(scene_dict, segments=50):
+    """A soft cable (EA = 50 N, 0.1 kg/m) from a clamp 0.5 m up through a 0.1 m guide."""
+    d = copy.deepcopy(scene_dict)
+    cable = d["cables"][0]
+    del cable["section"], cable["material"]
+    cable["stiffness"] = {
+        "EA": 50.0,
+        "GA": 50.0,
+        "EI": 1e-3,
+        "GJ": 1e-3,
+        "mass_per_length": 0.1,
+        "radius": 0.005,
+    }
+    cable["segments"] = segments
+    down = [0.0, 0.0, -1.0]
+    cable["clips"] = [
+        {
+            "name": "top",
+            "s": 0.0,
+            "body": "lift",
+            "position": [0.0, 0.0, 0.5],
+            "direction": down,
+            "normal": [1.0, 0.0, 0.0],
+        },
+        {
+            "name": "guide",
+            "s": 0.5,
+            "position": [0.0, 0.0, 0.0],
+            "direction": down,
+            "type": "sliding",
+            "length": 0.1,
+        },
+    ]
+    d["bodies"] = [{"name": "lift", "origin": [0.0, 0.0, 0.5]}]
+    return d
+
+
+def sigma_exact(h, w=0.981, ea=50.0, length=1.0):
+    """Material coordinate at the guide with the clamp h above it (stretch under own weight)."""
+    c = w / ea
+    a, b = 0.5 * c, -(1.0 + c * length)
+    return (-b - np.sqrt(b * b - 4 * a * h)) / (2 * a)
+
+
+def test_sliding_clip_slides_to_the_stretch_and_passes_the_tension(scene_dict, tmp_path):
+    from cablelife.results import load_result
+
+    result = simulate(scene_from_dict(hanging(scene_dict)))
+    res = result.cable
+    guide = res.clips["guide"]
+    assert guide.slid_length[0] == pytest.approx(sigma_exact(0.5) - 0.5, abs=1e-6)
+    assert res.clips["top"].slid_length is None
+    np.testing.assert_allclose(guide.force[0], 0.0, atol=1e-9)  # frictionless, no side load
+    path = tmp_path / "r.h5"
+    result.save(path)
+    back = load_result(path).cable.clips["guide"]
+    np.testing.assert_allclose(back.slid_length, guide.slid_length)
+
+
+def test_cable_pulled_out_of_a_sliding_clip_is_a_clear_error(scene_dict):
+    from cablelife.simulate import SimulationError
+
+    d = hanging(scene_dict)
+    d["simulation"].update(mode="quasistatic", duration=1.0, time_step=0.1)
+    d["bodies"][0]["motion"] = [
+        {"channel": "z", "signal": {"type": "table", "t": [0.0, 1.0], "value": [0.0, 0.8]}}
+    ]
+    with pytest.raises(SimulationError) as info:
+        simulate(scene_from_dict(d))
+    msg = str(info.value)
+    assert "'guide'" in msg and "'hose'" in msg and "ran out of sliding clip" in msg
+    assert "step 6 (t = 0.6 s)" in msg  # lift 0.48 m: σ + 0.05 > L
+    res = info.value.result.cable
+    assert res.n_steps >= 5  # kept up to there; the slid length grows with the lift
+    slid = res.clips["guide"].slid_length
+    assert np.all(np.diff(slid) > 0)
+
+
+def test_bad_sliding_clips(scene_dict):
+    d = hanging(scene_dict)
+    d["cables"][0]["clips"][1]["length"] = 0.0
+    assert "give length > 0" in error_of(d)
+    d = hanging(scene_dict)
+    d["cables"][0]["clips"][1]["friction"] = 0.3
+    msg = error_of(d)
+    assert "clips[1]" in msg and "friction = 0.3" in msg and "not implemented" in msg
+    d = hanging(scene_dict, segments=10)
+    msg = error_of(d)
+    assert "'guide'" in msg and "at least three nodes" in msg

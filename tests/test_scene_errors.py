@@ -73,7 +73,7 @@ def test_clip_on_unknown_body(scene_dict):
 def test_unknown_clip_type(scene_dict):
     scene_dict["cables"][0]["clips"][1]["type"] = "clamp"
     msg = error_of(scene_dict)
-    assert "clips[1].type" in msg and "'fixed', 'swivel', 'ball' or 'hinge'" in msg
+    assert "clips[1].type" in msg and "'fixed', 'swivel', 'ball', 'hinge' or 'sliding'" in msg
 
 
 def test_normal_parallel_to_direction(scene_dict):

@@ -12,6 +12,7 @@ HDF5 layout (every dataset carries a ``unit`` attribute)::
     /cables/<name>/moments       (T, N+1, 3) N m    material frame, nodes: M1, M2 bend, M3 torsion
     /cables/<name>/clips/<clip>/reaction_force   (T, 3) N    force of the clip on the cable
     /cables/<name>/clips/<clip>/reaction_moment  (T, 3) N m  moment about the clip point
+    /cables/<name>/clips/<clip>/slid_length      (T,)   m    sliding clips: cable slid through
     /cables/<name>/section       attrs: shape, outer_radius, inner_radius, poisson_ratio,
                                         EA, GA1, GA2, EI1, EI2, GJ, mass_per_length, from_measured
     /cables/<name>/solver        attrs and datasets: iterations (T,), residual (T,), ...
@@ -144,6 +145,7 @@ class ClipReaction:
     s: float
     force: np.ndarray = _LazyArray()  # (T, 3) N
     moment: np.ndarray = _LazyArray()  # (T, 3) N m, about the clip point
+    slid_length: np.ndarray | None = None  # (T,) m, sliding clips: cable slid through since s
 
     def __repr__(self) -> str:
         return f"ClipReaction({self.name!r}, s = {self.s:g} m)"
@@ -301,6 +303,8 @@ def save_result(result: Result, path: str | os.PathLike, precision: str | None =
                 cg.attrs["s"] = clip.s
                 _put(cg, "reaction_force", clip.force, "N", hist)
                 _put(cg, "reaction_moment", clip.moment, "N m", hist)
+                if clip.slid_length is not None:
+                    _put(cg, "slid_length", clip.slid_length, "m", hist)
             sec = g.create_group("section")
             for key, value in c.section.items():
                 sec.attrs[key] = value
@@ -339,6 +343,7 @@ def load_result(path: str | os.PathLike, lazy: bool = True) -> Result:
                     float(cg.attrs["s"]),
                     history(cg["reaction_force"]),
                     history(cg["reaction_moment"]),
+                    cg["slid_length"][()] if "slid_length" in cg else None,
                 )
                 for cn, cg in g["clips"].items()
             }

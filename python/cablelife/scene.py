@@ -158,9 +158,10 @@ class Clip(_Model):
     position: Point  # m
     direction: Direction  # cable tangent d3 at the clip
     normal: Direction | None = None  # d1 at the clip (fixes the twist); default: any normal
-    type: Literal["fixed", "swivel", "ball", "hinge"] = "fixed"
+    type: Literal["fixed", "swivel", "ball", "hinge", "sliding"] = "fixed"
     length: NonNegativeFloat = 0.0  # held length; 0 = point clip
     axis: Direction | None = None  # hinge: the turning axis in the clip frame (d1, d2, d3)
+    friction: NonNegativeFloat = 0.0  # sliding: Coulomb μ (only 0 is implemented)
     frame: Literal["global", "body"] = "global"  # frame of position/direction/normal
 
     @field_validator("direction", "normal", "axis")
@@ -189,6 +190,21 @@ class Clip(_Model):
             raise ValueError(
                 "a hinge clip needs its axis = [a1, a2, a3] in the clip frame (d1 = normal, "
                 "d3 = cable direction), e.g. axis = [0, 1, 0] for a hinge about d2"
+            )
+        if self.type == "sliding" and self.length <= 0:
+            raise ValueError(
+                "a sliding clip is a guide that holds the cable's axis on its line over its "
+                "length: give length > 0 (at least two edges of the cable)"
+            )
+        if self.friction != 0 and self.type != "sliding":
+            raise ValueError(
+                f"friction = {self.friction} is given for a {self.type} clip; only a sliding "
+                "clip has friction"
+            )
+        if self.friction != 0:
+            raise ValueError(
+                f"friction = {self.friction}: friction in sliding clips is not implemented yet; "
+                "allowed: 0 (frictionless)"
             )
         if self.type != "hinge" and self.axis is not None:
             raise ValueError(

@@ -347,7 +347,11 @@ def _run_cable(
     props = cable.properties()
     clips = {
         c.name: ClipReaction(
-            c.name, c.s, out["reaction_force"][:, j].copy(), out["reaction_moment"][:, j].copy()
+            c.name,
+            c.s,
+            out["reaction_force"][:, j].copy(),
+            out["reaction_moment"][:, j].copy(),
+            out["slid_length"][:, j].copy() if c.type == "sliding" else None,
         )
         for j, c in enumerate(cable.clips)
     }
@@ -386,7 +390,16 @@ def _run_cable(
     )
     if "contact_energy" in out and res.contact:
         res.energies["contact_energy"] = out["contact_energy"]
-    return res, out["error"]
+    return res, _with_time(out["error"], saved)
+
+
+def _with_time(error: str | None, times: np.ndarray) -> str | None:
+    """A sequence's error "step k: …" with the time of step k (dynamic errors carry it)."""
+    head, sep, rest = (error or "").partition(": ")
+    k = head.removeprefix("step ")
+    if not (sep and k.isdigit() and int(k) < times.size):
+        return error
+    return f"step {k} (t = {times[int(k)]:g} s): {rest}"
 
 
 def _stability_info(out: dict, times: np.ndarray, arc: np.ndarray, name: str) -> dict:

@@ -10,6 +10,7 @@ use rod::assembly::Workspace;
 use rod::contact::{Contact, ContactOptions, Cuboid, Cylinder, Obstacle, Plane, Shape, Sphere};
 use rod::contact_mesh::MeshShape;
 use rod::routing::route;
+use rod::sliding::SlidingClips;
 use rod::{
     CableSpec, ClipKind, ClipMotion, ClipSpec, DynamicOptions, Dynamics, NewtonOptions, PointLoad,
     Pose, Rod, Section, State, Statics,
@@ -77,6 +78,9 @@ struct Record {
     contact_state: Vec<u8>,
     body_contact_force: Vec<f64>,
     contact_gap: Vec<f64>,
+    /// Per step and clip: the length of cable slid through the clip since the reference
+    /// (σ − s; 0 for clips that hold the cable).
+    slid_length: Vec<f64>,
 }
 
 impl Record {
@@ -148,6 +152,18 @@ impl Record {
         self.contact_energy.push(ws.contact_energy);
     }
 
+    /// The slid length of every clip at the step just pushed.
+    fn push_sliding(&mut self, rod: &Rod, sliding: Option<&SlidingClips>) {
+        let start = self.slid_length.len();
+        self.slid_length
+            .extend(std::iter::repeat_n(0.0, rod.spec.clips.len()));
+        if let Some(sl) = sliding {
+            for (k, &c) in sl.clips.iter().enumerate() {
+                self.slid_length[start + c] = sl.sigma[k] - rod.spec.clips[c].s;
+            }
+        }
+    }
+
     /// Room for the contact outputs of `n` saved steps.
     fn reserve_contact(&mut self, n: usize, nodes: usize, bodies: usize) {
         self.contact_normal.reserve(n * 3 * nodes);
@@ -212,6 +228,7 @@ impl Record {
             "reaction_moment",
             shaped(self.reaction_moment, &[t, n_clips, 3])?,
         )?;
+        d.set_item("slid_length", shaped(self.slid_length, &[t, n_clips])?)?;
         d.set_item("iterations", PyArray1::from_vec(py, self.iterations))?;
         d.set_item("substeps", PyArray1::from_vec(py, self.substeps))?;
         d.set_item("residual", PyArray1::from_vec(py, self.residual))?;
@@ -422,6 +439,7 @@ impl Cable {
                 "fixed" => ClipKind::Fixed,
                 "swivel" => ClipKind::Swivel,
                 "ball" => ClipKind::Ball,
+                "sliding" => ClipKind::Sliding { friction: 0.0 },
                 "hinge" => match clip_axes.get(&name) {
                     Some(a) => ClipKind::Hinge {
                         axis: vec3(a, &format!("clip '{name}' axis"))?,
@@ -434,8 +452,8 @@ impl Cable {
                 },
                 other => {
                     return Err(PyValueError::new_err(format!(
-                        "clip '{name}': type = {other:?}; allowed: fixed, swivel, ball, hinge"
-                    )))
+                    "clip '{name}': type = {other:?}; allowed: fixed, swivel, ball, hinge, sliding"
+                )))
                 }
             };
             let pose = Pose {
@@ -622,6 +640,7 @@ impl Cable {
                             return (rec, Some(format!("kink at node {}", kink.node)));
                         }
                         rec.push(rod, &st, &solver.ws, &stats);
+                        rec.push_sliding(rod, solver.sliding.as_ref());
                         if let Some(c) = &solver.contact {
                             rec.push_contact(c);
                         }
@@ -763,6 +782,7 @@ impl Cable {
                 return (rec, Some(format!("start: {e}")));
             }
             rec.push(rod, &st, &dy.ws, &stats);
+            rec.push_sliding(rod, dy.sliding.as_ref());
             rec.push_energies(&dy.energies);
             if let Some(c) = &dy.contact {
                 rec.push_contact(c);
@@ -785,6 +805,7 @@ impl Cable {
                                 ..Default::default()
                             };
                             rec.push(rod, &st, &dy.ws, &stats);
+                            rec.push_sliding(rod, dy.sliding.as_ref());
                             rec.push_viscous(&dy.ws);
                             rec.push_energies(&dy.energies);
                             if let Some(c) = &dy.contact {
@@ -871,8 +892,9 @@ impl Cable {
             .as_ref()
             .ok_or_else(|| PyValueError::new_err("run a static solve (run_sequence) first"))?;
         let rod = &self.rod;
-        let ws = &mut self.solver.ws;
-        ws.assemble_static(rod, st, 1.0, true)
+        let solver = &mut self.solver;
+        let ws = &mut solver.ws;
+        ws.assemble_terms(rod, st, 1.0, true, &mut [&mut solver.sliding])
             .map_err(|k| PyValueError::new_err(format!("kink at node {}", k.node)))?;
         let mut dofs = Vec::new();
         for (b, m) in rod.mask.iter().enumerate() {

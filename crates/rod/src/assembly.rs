@@ -40,6 +40,8 @@ pub struct Workspace {
     pub load_potential: f64,
     /// Energy of the contact barrier.
     pub contact_energy: f64,
+    /// Reactions of clips that hold no node (sliding clips), set by their term.
+    pub held_reaction: Vec<Option<(Vector3<f64>, Vector3<f64>)>>,
 }
 
 /// What an assembly evaluates: the part of the cable, whether the Jacobian is wanted, the
@@ -200,6 +202,7 @@ impl Workspace {
             dissipation: 0.0,
             load_potential: 0.0,
             contact_energy: 0.0,
+            held_reaction: vec![None; rod.spec.clips.len()],
         }
     }
 
@@ -618,6 +621,9 @@ impl Workspace {
     /// Reaction force and moment (about the clip point) of clip `c` on the cable, global frame.
     /// Valid after an assembly at the state `st`.
     pub fn clip_reaction(&self, rod: &Rod, st: &State, c: usize) -> (Vector3<f64>, Vector3<f64>) {
+        if let Some(r) = self.held_reaction[c] {
+            return r;
+        }
         let centre = st.clip_pose[c].position;
         let mut f = Vector3::zeros();
         let mut m = Vector3::zeros();

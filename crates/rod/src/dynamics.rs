@@ -20,6 +20,7 @@ use crate::block_tridiag::BlockTridiag;
 use crate::contact::Contact;
 use crate::model::{EdgeKind, NodeKind, Pose, Rod, Segment};
 use crate::rotation::{log_vec, right_jacobian, rotate_body, rotation_matrix, skew, slerp, Quat};
+use crate::sliding::SlidingClips;
 use crate::state::State;
 use crate::statics::SolveError;
 use nalgebra::{Matrix3, Vector3, Vector6};
@@ -191,6 +192,8 @@ pub struct Dynamics {
     /// Contact with the surroundings (a term of the assembly when set); the obstacles are
     /// placed at their poses at t_{n+1} before each step.
     pub contact: Option<Contact>,
+    /// The sliding clips' term (None without sliding clips).
+    pub sliding: Option<SlidingClips>,
     ga: GenAlpha,
     rates: Rates,
     vdot: Vec<Vector6<f64>>,
@@ -269,6 +272,7 @@ impl Dynamics {
         let mut dynamics = Dynamics {
             ws: Workspace::new(rod),
             contact: None,
+            sliding: SlidingClips::of(rod),
             ga: GenAlpha::new(opts.rho_inf),
             opts,
             rates,
@@ -415,6 +419,8 @@ impl Dynamics {
         External.add_residual_jacobian(rod, st, &ev, &mut self.ws)?;
         self.contact
             .add_residual_jacobian(rod, st, &ev, &mut self.ws)?;
+        self.sliding
+            .add_residual_jacobian(rod, st, &ev, &mut self.ws)?;
         self.ws.finalize_part(rod, want_jac, part);
         Ok(())
     }
@@ -529,6 +535,11 @@ impl Dynamics {
         self.power_n = power;
         if self.opts.outputs_every_step {
             self.update_outputs(rod, st)?;
+        }
+        if let Some(Err(c)) = self.sliding.as_mut().map(|s| s.check(rod, st)) {
+            return Err(SolveError::SlidOff {
+                clip: rod.spec.clips[c].name.clone(),
+            });
         }
         Ok(stats)
     }

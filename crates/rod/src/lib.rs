@@ -14,6 +14,7 @@ pub mod model;
 pub mod rotation;
 pub mod routing;
 pub mod shear;
+pub mod sliding;
 pub mod stability;
 pub mod state;
 pub mod statics;

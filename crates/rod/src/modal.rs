@@ -25,6 +25,7 @@ use crate::assembly::Workspace;
 use crate::block_tridiag::{Block, BlockTridiag, Singular};
 use crate::model::{EdgeKind, NodeKind, Rod};
 use crate::rotation::rotation_matrix;
+use crate::sliding::SlidingClips;
 use crate::state::State;
 use nalgebra::{DMatrix, Vector3, Vector6};
 use std::fmt;
@@ -150,7 +151,7 @@ pub fn lumped_mass(rod: &Rod) -> Vec<Vector6<f64>> {
 /// The symmetric tangent stiffness at `st` (inactive slots: identity rows and columns).
 pub fn tangent_stiffness(rod: &Rod, st: &State) -> Result<BlockTridiag, ModalError> {
     let mut ws = Workspace::new(rod);
-    ws.assemble_static(rod, st, 1.0, true)
+    ws.assemble_terms(rod, st, 1.0, true, &mut [&mut SlidingClips::of(rod)])
         .map_err(|k| ModalError::Kink { node: k.node })?;
     let mut k = ws.jac;
     let n = k.n_blocks();

@@ -20,6 +20,9 @@ pub enum ClipKind {
     /// Position prescribed, rotation free about `axis` only (clip frame: d1, d2, d3 = cable
     /// tangent; point clips only). A swivel is the hinge about d3.
     Hinge { axis: Vector3<f64> },
+    /// A guide of the clip's length holding the cable's axis on its line (position and
+    /// direction d3) while the cable slides through axially (`sliding.rs`); `friction` μ.
+    Sliding { friction: f64 },
 }
 
 impl ClipKind {
@@ -28,7 +31,7 @@ impl ClipKind {
         match self {
             ClipKind::Swivel => Some(Vector3::z()),
             ClipKind::Hinge { axis } => Some(axis.normalize()),
-            ClipKind::Fixed | ClipKind::Ball => None,
+            ClipKind::Fixed | ClipKind::Ball | ClipKind::Sliding { .. } => None,
         }
     }
 }
@@ -215,6 +218,7 @@ impl Rod {
         let eps = 1e-9 * l;
         // Breakpoints: cable ends, clip ends, load points.
         let mut intervals: Vec<(f64, f64, usize)> = Vec::new();
+        let mut sliding: Vec<usize> = Vec::new();
         for (i, c) in spec.clips.iter().enumerate() {
             if !(c.length >= 0.0 && c.length.is_finite()) {
                 return Err(SpecError(format!("{}: length must be ≥ 0", fmt_clip(c))));
@@ -251,6 +255,24 @@ impl Rod {
                     fmt_clip(c)
                 )));
             }
+            if let ClipKind::Sliding { friction } = c.kind {
+                if c.length <= 0.0 {
+                    return Err(SpecError(format!(
+                        "{}: a sliding clip is a guide; its length must be > 0 (it holds the \
+                         cable's direction over that length)",
+                        fmt_clip(c)
+                    )));
+                }
+                if friction != 0.0 {
+                    return Err(SpecError(format!(
+                        "{}: friction = {friction}: friction in sliding clips is not \
+                         implemented yet; allowed: 0",
+                        fmt_clip(c)
+                    )));
+                }
+                sliding.push(i);
+                continue;
+            }
             intervals.push((a.max(0.0), b.min(l), i));
         }
         intervals.sort_by(|x, y| x.0.partial_cmp(&y.0).unwrap());
@@ -267,6 +289,9 @@ impl Rod {
         for &(a, b, _) in &intervals {
             breaks.push(a);
             breaks.push(b);
+        }
+        for &i in &sliding {
+            breaks.push(spec.clips[i].s.clamp(0.0, l));
         }
         for (i, ld) in spec.loads.iter().enumerate() {
             if !(ld.s >= -eps && ld.s <= l + eps) {
@@ -324,6 +349,22 @@ impl Rod {
                     free_axis: c.kind.free_axis(),
                 });
             }
+        }
+        // A sliding clip holds no node: its node at the reference only routes the cable.
+        let max_ds = ds_edge.iter().cloned().fold(0.0, f64::max);
+        for &ci in &sliding {
+            let c = &spec.clips[ci];
+            if c.length < 2.0 * max_ds {
+                return Err(SpecError(format!(
+                    "{}: the guide must hold at least three nodes to hold the direction, but \
+                     edges are up to {max_ds:.4} m long; allowed: length ≥ {:.4} m, or more \
+                     segments (about {})",
+                    fmt_clip(c),
+                    2.0 * max_ds,
+                    (2.0 * l / c.length).ceil()
+                )));
+            }
+            clip_nodes[ci].push(node_at(c.s));
         }
         let ghost_at: Vec<Option<usize>> = (0..=n_edges)
             .map(|n| ghosts.iter().position(|g| g.node == n))

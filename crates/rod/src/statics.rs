@@ -5,6 +5,7 @@ use crate::assembly::{KinkAt, Workspace};
 use crate::contact::Contact;
 use crate::model::{NodeKind, Pose, Rod};
 use crate::rotation::slerp;
+use crate::sliding::SlidingClips;
 use crate::stability::{free_rigid_motions, Inertia, StabilityCheck};
 use crate::state::State;
 use nalgebra::{Vector3, Vector6};
@@ -99,6 +100,10 @@ pub enum SolveError {
         residual: f64,
         load_factor: f64,
     },
+    /// A sliding clip's guide reaches beyond a cable end (the cable ran out of it).
+    SlidOff {
+        clip: String,
+    },
 }
 
 impl fmt::Display for SolveError {
@@ -146,6 +151,10 @@ impl fmt::Display for SolveError {
                 "Newton did not converge: {iterations} iterations, last residual {residual:.3e} N \
                  at load factor {load_factor:.4}"
             ),
+            SolveError::SlidOff { clip } => write!(
+                f,
+                "the cable ran out of sliding clip '{clip}': its guide reaches beyond a cable end"
+            ),
         }
     }
 }
@@ -168,6 +177,8 @@ pub struct Statics {
     pub opts: NewtonOptions,
     /// Contact with the surroundings (a term of the assembly when set).
     pub contact: Option<Contact>,
+    /// The sliding clips' term (None without sliding clips).
+    pub sliding: Option<SlidingClips>,
     delta: Vec<Vector6<f64>>,
     trial: Vec<Vector6<f64>>,
     base: State,
@@ -200,6 +211,7 @@ impl Statics {
             ws: Workspace::new(rod),
             opts,
             contact: None,
+            sliding: SlidingClips::of(rod),
             delta: vec![Vector6::zeros(); rod.n_edges() + 1],
             trial: vec![Vector6::zeros(); rod.n_edges() + 1],
             base: State::empty(),
@@ -223,8 +235,23 @@ impl Statics {
         load_factor: f64,
         want_jac: bool,
     ) -> Result<(), KinkAt> {
-        self.ws
-            .assemble_terms(rod, st, load_factor, want_jac, &mut [&mut self.contact])
+        self.ws.assemble_terms(
+            rod,
+            st,
+            load_factor,
+            want_jac,
+            &mut [&mut self.contact, &mut self.sliding],
+        )
+    }
+
+    /// Fails with `SlidOff` if a sliding clip's guide reaches beyond a cable end.
+    pub fn check_sliding(&mut self, rod: &Rod, st: &State) -> Result<(), SolveError> {
+        match self.sliding.as_mut().map(|s| s.check(rod, st)) {
+            Some(Err(c)) => Err(SolveError::SlidOff {
+                clip: rod.spec.clips[c].name.clone(),
+            }),
+            _ => Ok(()),
+        }
     }
 
     /// Limits the step fraction `alpha` of the Newton correction so that the cable does not
@@ -462,6 +489,7 @@ impl Statics {
         stats.iterations += pre.iterations;
         self.ensure_stable(rod, st, &mut stats, 0.0)?;
         stats.snap = None; // leaving an unstable first solution is no jump of the cable
+        self.check_sliding(rod, st)?;
         Ok(stats)
     }
 
@@ -1096,7 +1124,9 @@ impl Statics {
         };
         std::mem::swap(&mut self.prev, &mut self.last);
         self.has_prev = true;
-        result
+        let stats = result?;
+        self.check_sliding(rod, st)?;
+        Ok(stats)
     }
 }
 
