@@ -201,9 +201,36 @@ def test_bad_sliding_clips(scene_dict):
     d["cables"][0]["clips"][1]["length"] = 0.0
     assert "give length > 0" in error_of(d)
     d = hanging(scene_dict)
-    d["cables"][0]["clips"][1]["friction"] = 0.3
+    d["cables"][0]["clips"][0]["friction"] = 0.3
     msg = error_of(d)
-    assert "clips[1]" in msg and "friction = 0.3" in msg and "not implemented" in msg
+    assert "clips[0]" in msg and "friction = 0.3" in msg and "only a sliding clip" in msg
+    d = hanging(scene_dict)
+    d["cables"][0]["clips"][1]["friction"] = -0.1
+    assert "clips[1].friction" in error_of(d)
     d = hanging(scene_dict, segments=10)
     msg = error_of(d)
     assert "'guide'" in msg and "at least three nodes" in msg
+
+
+def test_friction_in_a_sliding_clip_adds_mu_n_to_the_pull(scene_dict):
+    # Lifting the clamp drags the cable up through the guide against a side pull at its end:
+    # the clamp pulls the weight plus the Coulomb force μ Σ N of the guide (the guide's
+    # friction on the cable, along its line, is the axial part of its reaction).
+    d = hanging(scene_dict)
+    d["cables"][0]["loads"] = [{"s": 1.0, "force": [0.3, 0.0, 0.0]}]
+    d["simulation"].update(mode="quasistatic", duration=1.0, time_step=0.25)
+    d["bodies"][0]["motion"] = [
+        {"channel": "z", "signal": {"type": "table", "t": [0.0, 1.0], "value": [0.0, 0.1]}}
+    ]
+    pulls = {}
+    for mu in (0.0, 0.3):
+        d["cables"][0]["clips"][1]["friction"] = mu
+        res = simulate(scene_from_dict(d)).cable
+        pulls[mu] = res.clips["top"].force[1:, 2]
+        friction = -res.clips["guide"].force[1:, 2]  # down (+t), against the lift
+        assert np.all(friction >= 0)
+        if mu == 0.0:
+            np.testing.assert_allclose(friction, 0.0, atol=1e-8)
+    weight = 0.1 * 9.81 * 1.0
+    np.testing.assert_allclose(pulls[0.0], weight, rtol=1e-8)
+    assert np.all(pulls[0.3] > weight + 0.05)

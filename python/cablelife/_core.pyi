@@ -21,6 +21,7 @@ class Cable:
         max_iterations=40,
         step_tolerance=1e-9,
         clip_axes=None,
+        clip_friction=None,
     ) -> None: ...
     @property
     def arc_length(self) -> Any: ...

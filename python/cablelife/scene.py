@@ -161,7 +161,7 @@ class Clip(_Model):
     type: Literal["fixed", "swivel", "ball", "hinge", "sliding"] = "fixed"
     length: NonNegativeFloat = 0.0  # held length; 0 = point clip
     axis: Direction | None = None  # hinge: the turning axis in the clip frame (d1, d2, d3)
-    friction: NonNegativeFloat = 0.0  # sliding: Coulomb μ (only 0 is implemented)
+    friction: NonNegativeFloat = 0.0  # sliding: Coulomb friction coefficient μ
     frame: Literal["global", "body"] = "global"  # frame of position/direction/normal
 
     @field_validator("direction", "normal", "axis")
@@ -200,11 +200,6 @@ class Clip(_Model):
             raise ValueError(
                 f"friction = {self.friction} is given for a {self.type} clip; only a sliding "
                 "clip has friction"
-            )
-        if self.friction != 0:
-            raise ValueError(
-                f"friction = {self.friction}: friction in sliding clips is not implemented yet; "
-                "allowed: 0 (frictionless)"
             )
         if self.type != "hinge" and self.axis is not None:
             raise ValueError(

@@ -229,6 +229,7 @@ def build_cable(scene: Scene, cable: Cable) -> _core.Cable:
             loads,
             max_iterations=scene.simulation.max_iterations,
             clip_axes={c.name: list(c.axis) for c in cable.clips if c.axis is not None},
+            clip_friction={c.name: c.friction for c in cable.clips if c.type == "sliding"},
         )
     except ValueError as err:
         raise SceneError(f"cable '{cable.name}': {err}") from None

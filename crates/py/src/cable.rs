@@ -405,11 +405,11 @@ impl Cable {
 impl Cable {
     /// clips: list of (name, s, length, kind, position[3], quaternion[4] scalar first);
     /// loads: list of (s, force[3], moment[3]); clip_axes: {clip name: axis[3] in the clip
-    /// frame} of the hinge clips.
+    /// frame} of the hinge clips; clip_friction: {clip name: μ} of the sliding clips.
     #[new]
     #[pyo3(signature = (length, segments, shear_stiffness, bend_stiffness, mass_per_length,
         rotary_inertia, natural_curvature, gravity, clips, loads, max_iterations=40,
-        step_tolerance=1e-9, clip_axes=None))]
+        step_tolerance=1e-9, clip_axes=None, clip_friction=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         length: f64,
@@ -425,8 +425,10 @@ impl Cable {
         max_iterations: usize,
         step_tolerance: f64,
         clip_axes: Option<std::collections::HashMap<String, Vec<f64>>>,
+        clip_friction: Option<std::collections::HashMap<String, f64>>,
     ) -> PyResult<Self> {
         let clip_axes = clip_axes.unwrap_or_default();
+        let clip_friction = clip_friction.unwrap_or_default();
         let section = Section {
             shear_stiffness: vec3(&shear_stiffness, "shear_stiffness")?,
             bend_stiffness: vec3(&bend_stiffness, "bend_stiffness")?,
@@ -439,7 +441,9 @@ impl Cable {
                 "fixed" => ClipKind::Fixed,
                 "swivel" => ClipKind::Swivel,
                 "ball" => ClipKind::Ball,
-                "sliding" => ClipKind::Sliding { friction: 0.0 },
+                "sliding" => ClipKind::Sliding {
+                    friction: clip_friction.get(&name).copied().unwrap_or(0.0),
+                },
                 "hinge" => match clip_axes.get(&name) {
                     Some(a) => ClipKind::Hinge {
                         axis: vec3(a, &format!("clip '{name}' axis"))?,

@@ -444,6 +444,9 @@ impl Dynamics {
         self.a_n.clone_from(&self.a);
         self.outputs_current = false;
         self.obstacles_moved = false;
+        if let Some(s) = &mut self.sliding {
+            s.begin_step(rod, st, Some(h));
+        }
         if let Some(c) = &mut self.contact {
             c.begin_step(&st.x, Some(h));
             if c.take_moved() {

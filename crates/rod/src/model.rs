@@ -263,10 +263,9 @@ impl Rod {
                         fmt_clip(c)
                     )));
                 }
-                if friction != 0.0 {
+                if !(friction.is_finite() && friction >= 0.0) {
                     return Err(SpecError(format!(
-                        "{}: friction = {friction}: friction in sliding clips is not \
-                         implemented yet; allowed: 0",
+                        "{}: friction = {friction}: must be a number ≥ 0",
                         fmt_clip(c)
                     )));
                 }
@@ -361,7 +360,7 @@ impl Rod {
                      segments (about {})",
                     fmt_clip(c),
                     2.0 * max_ds,
-                    (2.0 * l / c.length).ceil()
+                    (spec.segments as f64 * max_ds / (0.5 * c.length)).ceil()
                 )));
             }
             clip_nodes[ci].push(node_at(c.s));

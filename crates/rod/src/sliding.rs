@@ -2,11 +2,14 @@
 //! its line (the clip position P and direction t) while the cable material slides through it.
 //!
 //! The cable's nodes stay material (Lagrangian); the clip is a term of the assembly that pulls
-//! every node x inside the guide onto the line: energy ½ k_n w(z) |Q(x − P)|² per node, with
+//! every node x inside the guide onto the line with the force −k_n w(z) Q(x − P), with
 //! z = t·(x − P) the position along the line, Q = I − t tᵀ the projector across it and w a C¹
 //! window (1 over |z| ≤ ℓ/2, a cubic taper to 0 over half an edge beyond, so that nodes enter and
-//! leave the guide smoothly). The force is across the line only (up to the taper's ½ w′|Q d|² t,
-//! second order in the hold's deviation): the cable slides without axial resistance. Each node
+//! leave the guide smoothly). The force is across the line only, like a rigid frictionless
+//! guide's reaction: the cable slides without axial resistance. (It is the gradient of
+//! ½ k_n w |Q d|² without the window's ∂w/∂z term: that term would be an axial force
+//! ½ k_n w′ |Q d|² at the guide's ends that does not vanish under mesh refinement; the force is
+//! therefore not conservative and its Jacobian k_n (w Q + w′ Q d tᵀ) not symmetric.) Each node
 //! couples to nothing else: the block-tridiagonal structure stays.
 //!
 //! Hold stiffness k_n = `HOLD_FACTOR` · EA δs_n / Δs² (δs_n the node's length, Δs the mean edge):
@@ -40,8 +43,19 @@ pub struct SlidingClips {
     pub reaction: Vec<(Vector3<f64>, Vector3<f64>)>,
     /// A sliding clip whose guide reaches beyond a cable end (last full assembly).
     pub off_end: Option<usize>,
+    /// Per sliding clip: the sum of the hold's normal forces |F_n| (last full assembly), N.
+    pub normal_force: Vec<f64>,
+    /// Per sliding clip: the friction force along the line on the cable (last full assembly).
+    pub friction_force: Vec<f64>,
+    /// Stick widths of the regularised friction: static (m) and dynamic (m/s).
+    pub stick_distance: f64,
+    pub stick_velocity: f64,
     hold: Vec<f64>,
     reach: f64,
+    /// Per node: its coordinate along each guide's line at the start of the step (friction
+    /// reference), row-major (clip, node); the stick width of the step.
+    z_ref: Vec<f64>,
+    eps: f64,
 }
 
 impl SlidingClips {
@@ -61,14 +75,45 @@ impl SlidingClips {
             .map(|d| HOLD_FACTOR * ea * d / (h * h))
             .collect();
         let reach = rod.ds_edge.iter().cloned().fold(0.0, f64::max);
+        let stick_distance = 1e-4 * h;
         Some(SlidingClips {
             sigma: vec![f64::NAN; clips.len()],
             reaction: vec![(Vector3::zeros(), Vector3::zeros()); clips.len()],
+            normal_force: vec![0.0; clips.len()],
+            friction_force: vec![0.0; clips.len()],
+            z_ref: vec![f64::NAN; clips.len() * rod.arc.len()],
             clips,
             off_end: None,
+            stick_distance,
+            stick_velocity: 1e-3,
+            eps: stick_distance,
             hold,
             reach,
         })
+    }
+
+    /// Whether a sliding clip has friction.
+    pub fn has_friction(&self, rod: &Rod) -> bool {
+        self.clips.iter().any(
+            |&c| matches!(rod.spec.clips[c].kind, ClipKind::Sliding { friction } if friction > 0.0),
+        )
+    }
+
+    /// Starts a step from the state `st`: the friction reference (each node's coordinate along
+    /// each guide's line); `h` the time step of a dynamic step (None: static, quasistatic).
+    pub fn begin_step(&mut self, rod: &Rod, st: &State, h: Option<f64>) {
+        let n = rod.arc.len();
+        for (k, &c) in self.clips.iter().enumerate() {
+            let pose = &st.clip_pose[c];
+            let t = rotation_matrix(&pose.orientation) * Vector3::z();
+            for (j, x) in st.x.iter().enumerate() {
+                self.z_ref[k * n + j] = t.dot(&(x - pose.position));
+            }
+        }
+        self.eps = match h {
+            Some(h) => self.stick_velocity * h,
+            None => self.stick_distance,
+        };
     }
 
     /// Updates σ of every sliding clip at the state `st`; the first clip whose guide reaches
@@ -105,21 +150,20 @@ impl SlidingClips {
     }
 }
 
-/// The guide's window along the line and its first two derivatives in z.
+/// The guide's window along the line and its derivative in z.
 #[inline]
-fn window(z: f64, half: f64, taper: f64) -> (f64, f64, f64) {
+fn window(z: f64, half: f64, taper: f64) -> (f64, f64) {
     let r = z.abs();
     if r <= half {
-        return (1.0, 0.0, 0.0);
+        return (1.0, 0.0);
     }
     if r >= half + taper {
-        return (0.0, 0.0, 0.0);
+        return (0.0, 0.0);
     }
     let s = (r - half) / taper;
     let w = 1.0 - 3.0 * s * s + 2.0 * s * s * s;
     let dw = (-6.0 * s + 6.0 * s * s) / taper * z.signum();
-    let ddw = (-6.0 + 12.0 * s) / (taper * taper);
-    (w, dw, ddw)
+    (w, dw)
 }
 
 impl Term for SlidingClips {
@@ -155,38 +199,77 @@ impl Term for SlidingClips {
             let Some(sigma) = sigma else { continue };
             let span = half + taper + 2.0 * self.reach;
             let q_proj = Matrix3::identity() - t * t.transpose();
+            let mu = match rod.spec.clips[c].kind {
+                ClipKind::Sliding { friction } => friction,
+                _ => 0.0,
+            };
+            let n_nodes = rod.arc.len();
             let mut force = Vector3::zeros();
             let mut moment = Vector3::zeros();
+            let (mut normal, mut axial) = (0.0, 0.0);
             for n in blocks.clone() {
                 if (rod.arc[n] - sigma).abs() > span || rod.node_kind[n] != NodeKind::Free {
                     continue;
                 }
                 let d = st.x[n] - p;
                 let z = t.dot(&d);
-                let (w, dw, ddw) = window(z, half, taper);
+                let (w, dw) = window(z, half, taper);
                 if w == 0.0 {
                     continue;
                 }
                 let q = q_proj * d;
                 let qq = q.norm_squared();
                 let kn = self.hold[n];
-                let grad = kn * (w * q + 0.5 * dw * qq * t);
+                // The hold force k w(z) Q d: across the line only (no ∂w/∂z part, which would
+                // be a spurious axial force ½ k w′ |Q d|² at the guide's ends).
+                let mut grad = kn * w * q;
+                let mut h = if ev.want_jac {
+                    kn * (w * q_proj + dw * q * t.transpose())
+                } else {
+                    Matrix3::zeros()
+                };
+                // Regularised Coulomb friction along the line (IPC's f₁, stick width ε):
+                // μ N f₁(|u|) against the slip u = z − z_ref since the start of the step,
+                // N = k w |q| the node's normal force at the current iterate.
+                let qn = qq.sqrt();
+                let nf = kn * w * qn;
+                let z_ref = self.z_ref[k * n_nodes + n];
+                if mu > 0.0 && z_ref.is_finite() {
+                    let u = z - z_ref;
+                    let (eps, a) = (self.eps, u.abs());
+                    let (phi, dphi) = if a < eps {
+                        (2.0 / eps - a / (eps * eps), -1.0 / (eps * eps))
+                    } else {
+                        (1.0 / a, -1.0 / (a * a))
+                    };
+                    let f = mu * nf * phi * u;
+                    grad += f * t;
+                    if all {
+                        axial -= f;
+                    }
+                    if ev.want_jac {
+                        let mut dn = kn * qn * dw * t;
+                        if qn > 0.0 {
+                            dn += kn * w * q / qn;
+                        }
+                        h += mu * t * (phi * u * dn + nf * (phi + dphi * a) * t).transpose();
+                    }
+                }
                 ws.node_grad[n] += grad;
                 if all {
                     ws.elastic_energy += 0.5 * kn * w * qq;
                     force -= grad;
                     moment -= d.cross(&grad);
+                    normal += nf;
                 }
                 if ev.want_jac {
-                    let h = kn
-                        * (w * q_proj
-                            + dw * (q * t.transpose() + t * q.transpose())
-                            + 0.5 * ddw * qq * t * t.transpose());
                     ws.jac.add3(n, 0, n, 0, &h);
                 }
             }
             if all {
                 self.reaction[k] = (force, moment);
+                self.normal_force[k] = normal;
+                self.friction_force[k] = axial;
                 ws.held_reaction[c] = Some((force, moment));
             }
         }

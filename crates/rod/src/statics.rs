@@ -529,6 +529,9 @@ impl Statics {
         if let Some(c) = &mut self.contact {
             c.begin_step(&st.x, None); // friction acts against the motion from the start
         }
+        if let Some(s) = &mut self.sliding {
+            s.begin_step(rod, st, None);
+        }
         let start = st.clone();
         // Plain Newton converges in a handful of iterations from a good guess; a slow start
         // means a poor guess, for which the pseudo-transient path is the better use of time.
@@ -594,10 +597,11 @@ impl Statics {
         let frictional = self
             .contact
             .as_ref()
-            .is_some_and(|c| c.active > 0 && c.obstacles.iter().any(|o| o.friction > 0.0));
+            .is_some_and(|c| c.active > 0 && c.obstacles.iter().any(|o| o.friction > 0.0))
+            || self.sliding.is_some();
         if frictional || rod.edge_moment.iter().any(|m| *m != Vector3::zeros()) {
             // A dead moment is not conservative on the rotation group, and friction in contact
-            // is not conservative at all: the symmetric part of the tangent is then no
+            // and the guides of sliding clips (sliding.rs) are not conservative at all: the symmetric part of the tangent is then no
             // stability criterion (that needs the dynamics).
             stats.unstable = None;
             return Ok(());
@@ -1004,7 +1008,8 @@ impl Statics {
     }
 
     /// One step of a sequence of equilibria: from the current (converged) state to the clip
-    /// poses `target`, bisecting the clip motion when Newton fails.
+    /// poses `target`, bisecting the clip motion when Newton fails. (The sliding clips'
+    /// friction reference is set by `sequence_step`, before its predictor.)
     pub fn step_to(
         &mut self,
         rod: &Rod,
@@ -1112,6 +1117,9 @@ impl Statics {
         target: &[Pose],
     ) -> Result<SolveStats, SolveError> {
         self.last.clone_from(st);
+        if let Some(s) = &mut self.sliding {
+            s.begin_step(rod, st, None); // the guides' friction acts from the last equilibrium
+        }
         if self.has_prev {
             st.extrapolate_free(rod, &self.prev, &self.last);
         }

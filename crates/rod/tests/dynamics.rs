@@ -336,7 +336,7 @@ fn iteration_matrix_is_the_derivative_of_the_dynamic_residual() {
     // a clip moving and rotating: the assembled iteration matrix (stiffness, damping and its
     // configuration derivative, inertia, tangent of the rotation steps) against central
     // differences of the residual along the Newton update.
-    let mut spec = cantilever(1.0, 16, circle(0.005, 5e7, 0.45, 1500.0));
+    let mut spec = cantilever(1.0, 24, circle(0.005, 5e7, 0.45, 1500.0));
     spec.gravity = Vector3::new(0.0, 0.0, -9.81);
     spec.natural_curvature = Vector3::new(0.5, -0.2, 0.3);
     spec.loads.push(PointLoad {
@@ -388,6 +388,13 @@ fn iteration_matrix_is_the_derivative_of_the_dynamic_residual() {
                 axis: Vector3::new(0.5, -0.3, 0.8),
             },
             pose([0.71, 0.24, 0.01], [0.2, 1.0, 0.0], [0.0, 0.0, 1.0]),
+        ),
+        clip(
+            "g",
+            0.4,
+            0.13,
+            ClipKind::Sliding { friction: 0.0 },
+            pose([0.37, 0.03, 0.01], [1.0, 0.3, -0.1], [0.0, 0.0, 1.0]),
         ),
     ];
     let rod = Rod::new(spec).unwrap();

@@ -239,11 +239,20 @@ fn pulled_through_dynamically_at_constant_speed_the_slid_length_follows() {
 }
 
 #[test]
-#[allow(clippy::needless_range_loop)] // rows of three block vectors
 fn jacobian_with_a_sliding_clip_matches_finite_differences() {
     // A bent cable through an oblique guide, nodes moved off the line (and into the guide's
-    // tapered ends): the assembled Jacobian against central differences of the residual.
+    // tapered ends): the assembled Jacobian against central differences of the residual;
+    // frictionless, and with friction sticking (slip < ε) and slipping (slip ≫ ε).
+    jacobian_check(0.0, 0.0);
+    jacobian_check(0.4, 0.3);
+    jacobian_check(0.4, 20.0);
+}
+
+/// FD check with friction μ and each node's slip since the reference `slip` stick widths.
+#[allow(clippy::needless_range_loop)] // rows of three block vectors
+fn jacobian_check(mu: f64, slip: f64) {
     let mut spec = hanging(30);
+    spec.clips[1].kind = ClipKind::Sliding { friction: mu };
     spec.clips[1].pose = pose([0.02, 0.01, 0.0], [0.2, 0.1, -1.0], [1.0, 0.0, 0.2]);
     spec.loads.push(rod::PointLoad {
         s: L,
@@ -260,7 +269,18 @@ fn jacobian_with_a_sliding_clip_matches_finite_differences() {
         ) * 2e-3;
     }
     let mut s = Statics::new(&rod, NewtonOptions::default());
+    let sl = s.sliding.as_mut().unwrap();
+    let mut reference = st.clone();
+    let t = rod::rotation::rotation_matrix(&st.clip_pose[1].orientation) * Vector3::z();
+    for (i, x) in reference.x.iter_mut().enumerate() {
+        *x -= t * slip * sl.stick_distance * (1.0 + 0.1 * (i as f64).sin());
+    }
+    sl.begin_step(&rod, &reference, None);
     s.assemble(&rod, &st, 1.0, true).unwrap();
+    if mu > 0.0 {
+        let sl = s.sliding.as_ref().unwrap();
+        assert!(sl.friction_force[0].abs() > 1e-3 * mu * sl.normal_force[0]);
+    }
     let jac = s.ws.jac.clone();
     let nb = rod.arc.len();
     let h = 1e-7;
@@ -329,4 +349,106 @@ fn modal_stiffness_includes_the_guide() {
         "no guide in the scale {scale:e}"
     );
     assert!(worst < 1e-9 * scale, "{worst:e} of {scale:e}");
+}
+
+#[test]
+fn pulling_through_a_guide_with_friction_costs_mu_times_the_normal_force() {
+    // A side pull at the lower end presses the cable against the guide; lifting the clamp
+    // drags it up through the guide. Fully slipping (each step's slip ≫ the stick width), the
+    // guide's friction on the cable is μ Σ N along the line (down, against the motion), and the
+    // clamp pulls the weight plus that: the friction law's Coulomb force.
+    let mu = 0.3;
+    let side = Vector3::new(0.3, 0.0, 0.0);
+    let mut spec = hanging(50);
+    spec.clips[1].kind = ClipKind::Sliding { friction: mu };
+    spec.loads.push(rod::PointLoad {
+        s: L,
+        force: side,
+        moment: Vector3::zeros(),
+    });
+    let rod = Rod::new(spec).unwrap();
+    let (mut st, mut s) = solve(&rod);
+    for k in 1..=4 {
+        let stats = s
+            .sequence_step(&rod, &mut st, &moved_top(&rod, 0.02 * k as f64))
+            .unwrap();
+        assert!(stats.iterations < 15, "{stats:?}");
+        s.assemble(&rod, &st, 1.0, false).unwrap();
+        let sl = s.sliding.as_ref().unwrap();
+        let normal = sl.normal_force[0];
+        assert!(normal > 0.1, "the guide must be pressed: N = {normal}");
+        // Along the line t = −z: the friction on the cable points down (+t), μ N.
+        let (f1, _) = s.ws.clip_reaction(&rod, &st, 1);
+        assert!(
+            (-f1.z - mu * normal).abs() < 1e-6 * mu * normal,
+            "friction {} vs μN = {}",
+            -f1.z,
+            mu * normal
+        );
+        assert!((sl.friction_force[0] + f1.z).abs() < 1e-9);
+        // The clamp carries the weight and the friction: ΣF_z = 0 to the solver tolerance.
+        let (f0, _) = s.ws.clip_reaction(&rod, &st, 0);
+        let weight: f64 = rod.node_mass.iter().sum::<f64>() * 9.81;
+        assert!(
+            (f0.z - weight - mu * normal).abs() < 1e-8,
+            "pull {} vs weight {weight} + μN {}",
+            f0.z,
+            mu * normal
+        );
+    }
+}
+
+#[test]
+fn dynamic_pull_through_a_guide_with_friction_runs() {
+    // The dynamic pull with friction and a side load: it runs (regularised stick within the
+    // step) and the guide's friction stays within its Coulomb bound μ Σ N.
+    let mut spec = hanging(40);
+    spec.clips[1].kind = ClipKind::Sliding { friction: 0.3 };
+    spec.loads.push(rod::PointLoad {
+        s: L,
+        force: Vector3::new(0.3, 0.0, 0.0),
+        moment: Vector3::zeros(),
+    });
+    let rod = Rod::new(spec).unwrap();
+    let (mut st, _) = solve(&rod);
+    let speed = 0.1;
+    let motion = |t: f64| -> Vec<ClipMotion> {
+        let ramp = (t / 0.2).min(1.0);
+        moved_top(
+            &rod,
+            speed * t * ramp * 0.5 + speed * (t - 0.2).max(0.0) * 0.5,
+        )
+        .into_iter()
+        .enumerate()
+        .map(|(c, pose)| ClipMotion {
+            pose,
+            velocity: Vector3::new(0.0, 0.0, if c == 0 { speed * ramp } else { 0.0 }),
+            angular_velocity: Vector3::zeros(),
+            acceleration: Vector3::zeros(),
+            angular_acceleration: Vector3::zeros(),
+        })
+        .collect()
+    };
+    let opts = DynamicOptions {
+        tau_shear: Vector3::new(0.01, 0.01, 0.01),
+        tau_bend: Vector3::new(0.01, 0.01, 0.01),
+        ..Default::default()
+    };
+    let mut dy = Dynamics::new(&rod, &st, &motion(0.0), opts);
+    dy.start(&rod, &st).unwrap();
+    let h = 1e-3;
+    let mut prev = motion(0.0);
+    for k in 1..=500 {
+        let next = motion(k as f64 * h);
+        dy.advance(&rod, &mut st, h, &prev, &next, 6).unwrap();
+        prev = next;
+    }
+    dy.update_outputs(&rod, &st).unwrap();
+    let sl = dy.sliding.as_ref().unwrap();
+    assert!(sl.normal_force[0] > 0.1);
+    assert!(sl.friction_force[0].abs() <= 0.3 * sl.normal_force[0] * (1.0 + 1e-9));
+    assert!(
+        sl.friction_force[0].abs() > 0.1 * 0.3 * sl.normal_force[0],
+        "{sl:?}"
+    );
 }
