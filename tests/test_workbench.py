@@ -307,3 +307,111 @@ def test_workbench_command_errors(tmp_path):
     assert r.exit_code == 2 and "--port 70000" in r.output
     r = runner.invoke(app, ["workbench", str(EXAMPLE), "--result", str(EXAMPLE)])
     assert r.exit_code == 2 and "--result" in r.output
+
+
+@pytest.fixture(scope="module")
+def near_engine_run(tmp_path_factory):
+    """A quasistatic run of the surroundings example (1 s), saved."""
+    from cablelife.simulate import simulate
+
+    scene = ROOT / "examples" / "surroundings" / "hose-near-engine.toml"
+    if not (scene.parent / "engine.stl").exists():
+        pytest.skip("example meshes not generated")
+    sc = load_scene(scene)
+    sc.simulation.duration = 1.0
+    sc.simulation.time_step = 0.05
+    path = tmp_path_factory.mktemp("run") / "run.h5"
+    simulate(sc, mode="quasistatic").save(path)
+    return scene, path
+
+
+def test_player_gives_the_saved_steps(near_engine_run):
+    from cablelife.results import load_result
+    from cablelife.workbench.player import Player
+
+    _, path = near_engine_run
+    player = Player.open(path)
+    res = load_result(path)
+    c = res.cables["hose"]
+    assert player.info()["steps"] == c.n_steps == 21
+    k = 7
+    d = player.step(k)
+    assert d["time"] == pytest.approx(c.time[k])
+    np.testing.assert_allclose(d["cables"]["hose"]["positions"], c.positions[k])
+    np.testing.assert_allclose(d["cables"]["hose"]["values"]["clearance"], c.clearance[k] * 1e3)
+    m = c.moments[k]
+    np.testing.assert_allclose(d["cables"]["hose"]["values"]["bending"], np.hypot(m[:, 0], m[:, 1]))
+    geo = res.surroundings
+    assert set(d["bodies"]) == {"engine", "car-body"}
+    np.testing.assert_allclose(d["bodies"]["engine"], geo.poses[0, k])
+    with pytest.raises(IndexError, match="step 21: the result has steps 0 … 20"):
+        player.step(21)
+    with pytest.raises(WorkbenchError, match="--result"):
+        Player.open(ROOT / "examples" / "hose-three-clips.toml")
+
+
+def test_page_plays_a_result_file_with_the_surroundings(near_engine_run, tmp_path):
+    """The surroundings example with its bodies' geometry, coloured by clearance; a result
+    file scrubbed step by step (the page draws the saved nodes)."""
+    _browser()
+    from cablelife.results import load_result
+    from cablelife.workbench.drive import run_page, workbench_process
+
+    scene, path = near_engine_run
+    shots = Path(os.environ.get("CABLELIFE_SCREENSHOTS", tmp_path))
+    positions = load_result(path).cables["hose"].positions
+
+    async def script(page):
+        await page.call("setQuantity('clearance')")
+        live = await page.screenshot(shots / "workbench-clearance.png")
+        bodies = await page.cdp.evaluate("document.querySelector('#quantity').options.length")
+        steps = [await page.call(f"showResultStep({k})") for k in (0, 5, 20)]
+        label = await page.text("player-time")
+        await page.call("setQuantity('bending')")
+        played = await page.screenshot(shots / "workbench-result.png")
+        return live, bodies, steps, label, played
+
+    with workbench_process(scene, "--result", str(path)) as (_, url):
+        live, options, steps, label, played = run_page(url, script)
+    assert options == 5  # clearance offered: the scene has geometry
+    for k, d in zip((0, 5, 20), steps, strict=True):
+        np.testing.assert_allclose(d["cables"]["hose"]["positions"], positions[k])
+    assert label == "t = 1.000 s (step 20)"
+    assert live.stat().st_size > 20_000 and played.stat().st_size > 20_000
+
+
+def test_mouse_drag_of_a_clip_is_one_undo_step(scene_copy):
+    """A drag with the mouse on the clip's handle (TransformControls): the cable follows
+    while dragging, its end node stays on the clip, and one undo restores the start."""
+    _browser()
+    import asyncio
+
+    from cablelife.workbench.drive import run_page, workbench_process
+
+    async def script(page):
+        x0 = np.array((await page.call("state()"))["cables"]["hose"]["positions"])
+        x, y = await page.call(f"clipOnScreen('hose', '{CLIP}')")
+        mouse = page.cdp.call
+        await mouse("Input.dispatchMouseEvent", type="mouseMoved", x=x, y=y)
+        await mouse("Input.dispatchMouseEvent", type="mousePressed", x=x, y=y, button="left",
+                    clickCount=1)  # fmt: skip
+        during = []
+        for k in range(1, 21):
+            await mouse("Input.dispatchMouseEvent", type="mouseMoved", x=x - 3 * k, y=y + 2 * k,
+                        button="left", buttons=1)  # fmt: skip
+            await asyncio.sleep(0.03)
+            during.append(np.array((await page.call("state()"))["cables"]["hose"]["positions"]))
+        await mouse("Input.dispatchMouseEvent", type="mouseReleased", x=x - 60, y=y + 40,
+                    button="left", clickCount=1)  # fmt: skip
+        await asyncio.sleep(0.3)
+        x1 = np.array((await page.call("state()"))["cables"]["hose"]["positions"])
+        await page.call("undo()")
+        x2 = np.array((await page.call("state()"))["cables"]["hose"]["positions"])
+        return x0, during, x1, x2
+
+    with workbench_process(scene_copy) as (_, url):
+        x0, during, x1, x2 = run_page(url, script)
+    shapes = {round(float(d[-1][1]), 9) for d in during}
+    assert len(shapes) > 3  # updates arrived while dragging
+    assert np.linalg.norm(x1[-1] - x0[-1]) > 0.02
+    assert np.array_equal(x2, x0)  # one drag, one undo step

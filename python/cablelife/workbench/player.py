@@ -68,4 +68,9 @@ class Player:
                 "radius": radius,
                 "values": {q: np.round(v, 12).tolist() for q, v in values.items()},
             }
-        return {"step": k, "time": time, "cables": cables}
+        bodies = {}
+        geo = self.result.surroundings
+        if geo is not None:  # body poses [R | t] at this step (x = R X + t)
+            j = int(np.argmin(np.abs(np.asarray(geo.time) - time)))
+            bodies = {n: np.asarray(geo.poses[b, j]).tolist() for b, n in enumerate(geo.bodies)}
+        return {"step": k, "time": time, "cables": cables, "bodies": bodies}

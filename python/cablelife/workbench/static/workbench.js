@@ -8,13 +8,16 @@
   var info = null, live = null, shown = null, playing = null;
   var quantity = "bending";
   var renderer, scene, camera, orbit, gizmo, dirty = true;
-  var tubes = {}, clipObjects = {}, selected = null;
+  var tubes = {}, clipObjects = {}, bodyMeshes = {}, selected = null;
   var ws, nextId = 1, waiting = {}, inflight = false, pending = null, dragMark = false;
   var updateTimes = [], frameTimes = [], lastSolveMs = 0;
   var statusText = "";
 
   function $(id) { return document.getElementById(id); }
-  function fmt(v, d) { return v === null || v === undefined ? "–" : Number(v).toPrecision(d || 4); }
+  function fmt(v, d) {
+    if (v === null || v === undefined) return "–";
+    return Math.abs(v) < 1e-9 ? "0" : Number(v).toPrecision(d || 4); // round-off shown as 0
+  }
   function esc(s) { return String(s).replace(/[&<>"]/g, function (c) { return {"&": "&amp;", "<": "&lt;", ">": "&gt;", '"': "&quot;"}[c]; }); }
 
   function showMessage(text, isError) {
@@ -41,7 +44,7 @@
       if (!v) return;
       v.forEach(function (x) { if (isFinite(x)) { lo = Math.min(lo, x); hi = Math.max(hi, x); } });
     });
-    if (quantity === "bend_ratio") return {lo: 0, hi: 3, reverse: true};
+    if (quantity === "bend_ratio") return {lo: 0, hi: 2, reverse: true}; // 1 (the rule) mid-scale
     if (quantity === "clearance") return {lo: Math.min(0, lo), hi: Math.max(50, Math.min(hi, 200)), reverse: true};
     if (!isFinite(lo)) { lo = 0; hi = 1; }
     if (quantity === "torsion") { var a = Math.max(Math.abs(lo), Math.abs(hi), 1e-12); return {lo: -a, hi: a}; }
@@ -136,6 +139,8 @@
       g.computeVertexNormals();
       var m = new THREE.Mesh(g, new THREE.MeshLambertMaterial({color: 0x9aa3ad, transparent: true, opacity: 0.55, side: THREE.DoubleSide, depthWrite: false}));
       m.name = "body:" + b.name;
+      m.matrixAutoUpdate = false;
+      bodyMeshes[b.name] = m;
       scene.add(m);
     });
   }
@@ -272,9 +277,9 @@
         var opts = info.clipTypes.map(function (t) { return "<option" + (t === k.type ? " selected" : "") + ">" + t + "</option>"; }).join("");
         var d = ' data-cable="' + esc(n) + '" data-item="' + esc(k.name) + '"';
         html += '<tr class="clip' + (sel ? " sel" : "") + '"' + d + "><td>" + esc(k.name) + "</td>" +
-          '<td><input type="number" step="0.01"' + d + ' data-key="s" value="' + k.s + '" style="width:58px"></td>' +
+          '<td><input type="number" step="0.01"' + d + ' data-key="s" value="' + k.s + '" style="width:46px"></td>' +
           "<td><select" + d + ' data-key="type">' + opts + "</select></td>" +
-          '<td><input type="number" step="0.005"' + d + ' data-key="length" value="' + k.length + '" style="width:52px"></td>' +
+          '<td><input type="number" step="0.005"' + d + ' data-key="length" value="' + k.length + '" style="width:46px"></td>' +
           '<td class="num">' + fmt(fn, 3) + '</td><td class="num">' + fmt(mn, 3) + "</td></tr>";
       });
       html += "</table>";
@@ -344,6 +349,19 @@
   function undo() { return request({op: "undo"}); }
 
   // ---------------------------------------------------------------- result file
+  function showClips(on) {
+    Object.keys(clipObjects).forEach(function (c) { Object.keys(clipObjects[c]).forEach(function (k) { clipObjects[c][k].visible = on; }); });
+    gizmo.visible = on && selected !== null;
+    if (!on) gizmo.detach(); else if (selected) gizmo.attach(clipObjects[selected.cable][selected.clip]);
+  }
+  // Bodies at a saved step: x = R X + t, rows of [R | t] (at rest without).
+  function poseBodies(poses) {
+    Object.keys(bodyMeshes).forEach(function (n) {
+      var p = poses[n], m = bodyMeshes[n].matrix;
+      if (p) m.set(p[0][0], p[0][1], p[0][2], p[0][3], p[1][0], p[1][1], p[1][2], p[1][3], p[2][0], p[2][1], p[2][2], p[2][3], 0, 0, 0, 1);
+      else m.identity();
+    });
+  }
   function setupPlayer(r) {
     if (!r) return;
     $("player").className = "";
@@ -353,8 +371,12 @@
     function show(k) {
       return fetch("/api/result/" + k).then(function (x) { return x.json(); }).then(function (d) {
         playing = k;
-        $("player-time").textContent = "t = " + fmt(d.time, 4) + " s";
+        showClips(false);
+        poseBodies(d.bodies || {});
+        $("player-time").textContent = "t = " + fmt(d.time, 4) + " s (step " + k + ")";
         draw(d, false);
+        renderer.render(scene, camera);
+        return d;
       });
     }
     slider.addEventListener("input", function () { show(+slider.value); });
@@ -372,9 +394,17 @@
     });
     $("player-live").addEventListener("click", function () {
       if (timer) { clearInterval(timer); timer = null; $("player-play").textContent = "play"; }
-      playing = null; $("player-time").textContent = ""; draw(live, true);
+      playing = null; $("player-time").textContent = ""; showClips(true); poseBodies({}); draw(live, true);
     });
-    window.cablelifeWorkbench.showResultStep = show;
+    // test hook: show saved step k of the result; resolves when drawn, with its nodes
+    window.cablelifeWorkbench.showResultStep = function (k) {
+      slider.value = k;
+      return show(k).then(function (d) {
+        var out = {time: d.time, cables: {}};
+        Object.keys(d.cables).forEach(function (n) { out.cables[n] = {positions: d.cables[n].positions}; });
+        return out;
+      });
+    };
   }
 
   // ---------------------------------------------------------------- start
@@ -438,6 +468,14 @@
         return {solveMs: msg.solveMs};
       });
     },
+    // several clips at once, one update (as dragging a bracket that holds them): [[cable, clip, xyz], ...]
+    moveClips: function (list) {
+      var moves = list.map(function (m) { return {cable: m[0], clip: m[1], position: m[2]}; });
+      return request({op: "move", moves: moves, mark: true}).then(function (msg) {
+        if (msg.ok === false) throw new Error(msg.error);
+        return {solveMs: msg.solveMs};
+      });
+    },
     state: function () {
       var out = {cables: {}};
       if (!live) return out;
@@ -452,6 +490,11 @@
     edit: function (cable, item, key, value) { return request({op: "edit", cable: cable, item: item, key: key, value: value}); },
     setQuantity: function (q) { quantity = q; $("quantity").value = q; draw(shown, playing === null); renderer.render(scene, camera); },
     select: select,
+    // where a clip is on the page (CSS px), to drag it with the mouse in tests
+    clipOnScreen: function (cable, clip) {
+      var v = clipObjects[cable][clip].position.clone().project(camera), r = renderer.domElement.getBoundingClientRect();
+      return [r.left + (v.x + 1) / 2 * r.width, r.top + (1 - v.y) / 2 * r.height];
+    },
   };
 
   ws = new WebSocket("ws://" + location.host + "/ws");
