@@ -260,12 +260,12 @@ def test_page_follows_a_dragged_clip(scene_copy, tmp_path):
             seen.append(np.array((await page.call("state()"))["cables"]["hose"]["positions"]))
         wall = time.perf_counter() - t0
         stats = await page.call("stats()")
+        await page.call("setQuantity('bend_ratio')")
+        shot = await page.screenshot(shots / "workbench.png")
         bad = await page.call("moveClip('hose', 'nowhere', [0, 0, 0])")
         bad_cable = await page.call(f"moveClip('pipe', '{CLIP}', [0, 0, 0])")
         message = await page.text("message")
         after = np.array((await page.call("state()"))["cables"]["hose"]["positions"])
-        await page.call("setQuantity('bend_ratio')")
-        shot = await page.screenshot(shots / "workbench.png")
         saved = await page.call(f"save({str(tmp_path / 'saved.toml')!r})")
         return seen, wall, stats, bad, bad_cable, message, after, shot, saved
 

@@ -16,7 +16,7 @@ from pathlib import Path
 import tornado.web
 import tornado.websocket
 
-from cablelife.workbench.session import QUANTITIES, Session, WorkbenchError
+from cablelife.workbench.session import CLIP_TYPES, QUANTITIES, Session, WorkbenchError
 
 STATIC = Path(__file__).parent / "static"
 
@@ -49,7 +49,7 @@ class SceneHandler(_Base):
             "quantities": {k: {"label": a, "unit": b} for k, (a, b) in QUANTITIES.items()},
             "bendFactor": s.bend_factor,
             "geometry": s.geometry(),
-            "clipTypes": ["fixed", "swivel", "ball"],
+            "clipTypes": list(CLIP_TYPES),
             "state": s.state(),
             "result": self.app.get("result_info"),
         }

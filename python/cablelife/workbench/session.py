@@ -14,6 +14,7 @@ from __future__ import annotations
 import math
 import threading
 import time
+import typing
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -22,7 +23,7 @@ import numpy as np
 
 from cablelife.limits import LIMITS
 from cablelife.rotations import matrix_quaternions
-from cablelife.scene import Cable, Scene, SceneError, load_scene, scene_from_dict
+from cablelife.scene import Cable, Clip, Scene, SceneError, load_scene, scene_from_dict
 from cablelife.simulate import build_cable, euler_matrix
 
 #: Colour quantities: key → (label, unit). Values per node.
@@ -30,14 +31,15 @@ QUANTITIES = {
     "bending": ("bending moment |M1, M2|", "N m"),
     "torsion": ("torsion M3", "N m"),
     "tension": ("tension F3", "N"),
-    "bend_ratio": ("bend radius ÷ rule", "1"),
+    "bend_ratio": ("bend radius ÷ rule", ""),
     "clearance": ("clearance", "mm"),
 }
 
 #: Undo steps kept.
 UNDO_DEPTH = 200
 
-CLIP_TYPES = ("fixed", "swivel", "ball")
+#: Clip types offered for editing: those of the scene format (docs/scene.md).
+CLIP_TYPES = typing.get_args(Clip.model_fields["type"].annotation)
 
 
 class WorkbenchError(ValueError):

@@ -54,7 +54,7 @@
   }
   function drawColourBar(r) {
     var q = info.quantities[quantity];
-    $("cb-title").textContent = q.label + " [" + q.unit + "]" + (quantity === "bend_ratio" ? " (< 1 breaks the rule " + info.bendFactor + " × d)" : "");
+    $("cb-title").textContent = q.label + (q.unit ? " [" + q.unit + "]" : "") + (quantity === "bend_ratio" ? " (< 1 breaks the rule " + info.bendFactor + " × d)" : "");
     var stops = r.reverse ? STOPS.slice().reverse() : STOPS;
     $("cb-bar").style.background = "linear-gradient(to right," + stops.join(",") + ")";
     $("cb-min").textContent = fmt(r.lo, 3);
