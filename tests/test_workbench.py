@@ -307,6 +307,14 @@ def test_workbench_command_errors(tmp_path):
     assert r.exit_code == 2 and "--port 70000" in r.output
     r = runner.invoke(app, ["workbench", str(EXAMPLE), "--result", str(EXAMPLE)])
     assert r.exit_code == 2 and "--result" in r.output
+    import socket
+
+    with socket.socket() as taken:
+        taken.bind(("127.0.0.1", 0))
+        taken.listen()
+        port = taken.getsockname()[1]
+        r = runner.invoke(app, ["workbench", str(EXAMPLE), "--no-browser", "--port", str(port)])
+    assert r.exit_code == 2 and f"cannot listen on 127.0.0.1:{port}" in r.output
 
 
 @pytest.fixture(scope="module")
@@ -384,7 +392,6 @@ def test_mouse_drag_of_a_clip_is_one_undo_step(scene_copy):
     """A drag with the mouse on the clip's handle (TransformControls): the cable follows
     while dragging, its end node stays on the clip, and one undo restores the start."""
     _browser()
-    import asyncio
 
     from cablelife.workbench.drive import run_page, workbench_process
 
@@ -399,11 +406,11 @@ def test_mouse_drag_of_a_clip_is_one_undo_step(scene_copy):
         for k in range(1, 21):
             await mouse("Input.dispatchMouseEvent", type="mouseMoved", x=x - 3 * k, y=y + 2 * k,
                         button="left", buttons=1)  # fmt: skip
-            await asyncio.sleep(0.03)
+            await page.call("settled()")  # still pressed: the cable answered this pose
             during.append(np.array((await page.call("state()"))["cables"]["hose"]["positions"]))
         await mouse("Input.dispatchMouseEvent", type="mouseReleased", x=x - 60, y=y + 40,
                     button="left", clickCount=1)  # fmt: skip
-        await asyncio.sleep(0.3)
+        await page.call("settled()")  # the drag's last pose solved and drawn
         x1 = np.array((await page.call("state()"))["cables"]["hose"]["positions"])
         await page.call("undo()")
         x2 = np.array((await page.call("state()"))["cables"]["hose"]["positions"])
@@ -415,3 +422,96 @@ def test_mouse_drag_of_a_clip_is_one_undo_step(scene_copy):
     assert len(shapes) > 3  # updates arrived while dragging
     assert np.linalg.norm(x1[-1] - x0[-1]) > 0.02
     assert np.array_equal(x2, x0)  # one drag, one undo step
+
+
+def test_server_listens_on_loopback_and_refuses_foreign_pages(scene_copy):
+    """Without a browser: the scene JSON over HTTP, a move over the websocket, and a
+    websocket from another site's page refused."""
+    import asyncio
+    import json
+    import urllib.request
+
+    from cablelife.workbench.server import listen, make_app
+    from tornado.httpclient import HTTPClientError, HTTPRequest
+    from tornado.websocket import websocket_connect
+
+    session = Session.open(scene_copy)
+
+    async def main():
+        server, port = listen(make_app(session))
+        try:
+            assert server._sockets and all(
+                s.getsockname()[0] == "127.0.0.1" for s in server._sockets.values()
+            )
+            loop = asyncio.get_running_loop()
+            url = f"http://127.0.0.1:{port}"
+            info = await loop.run_in_executor(
+                None, lambda: json.load(urllib.request.urlopen(f"{url}/api/scene"))
+            )
+            ws = await websocket_connect(HTTPRequest(f"ws://127.0.0.1:{port}/ws",
+                                                     headers={"Origin": url}))  # fmt: skip
+            await ws.write_message(json.dumps({"id": 7, "op": "move", "moves": [
+                {"cable": "hose", "clip": CLIP, "position": [0.75, 0.27, 0.01]}]}))  # fmt: skip
+            reply = json.loads(await ws.read_message())
+            await ws.write_message(json.dumps({"id": 8, "op": "fly"}))
+            bad = json.loads(await ws.read_message())
+            ws.close()
+            refused = None
+            try:
+                foreign = {"Origin": "http://evil.example"}
+                await websocket_connect(HTTPRequest(f"ws://127.0.0.1:{port}/ws", headers=foreign))
+            except HTTPClientError as err:
+                refused = err.code
+            return info, reply, bad, refused
+        finally:
+            server.stop()
+
+    info, reply, bad, refused = asyncio.run(main())
+    session.close()
+    assert info["state"]["cables"]["hose"]["figures"]["clips"][2]["name"] == CLIP
+    assert reply["id"] == 7 and reply["ok"] and reply["solveMs"] > 0
+    assert reply["state"]["cables"]["hose"]["positions"][-1] == [0.75, 0.27, 0.01]
+    assert bad == {"id": 8, "ok": False,
+                   "error": "op = 'fly'; allowed: move, edit, undo, save, state"}  # fmt: skip
+    assert refused == 403
+
+
+def test_panel_edit_and_undo_buttons(scene_copy):
+    """Typing a clip's s in the side panel re-solves the cable (a new mesh); the undo
+    button restores it; a refused value shows the validator's message."""
+    _browser()
+
+    from cablelife.workbench.drive import run_page, workbench_process
+
+    set_input = (
+        '(() => {{ const e = document.querySelector(\'input[data-item="middle"]'
+        "[data-key=\"s\"]'); e.value = '{0}'; e.dispatchEvent(new Event('change', "
+        "{{bubbles: true}})); }})()"
+    )
+
+    async def script(page):
+        async def settle():
+            await page.call("settled()")  # every request answered and drawn
+            return await page.cdp.evaluate(
+                'document.querySelector(\'input[data-item="middle"][data-key="s"]\').value'
+            )
+
+        n0 = (await page.call("state()"))["cables"]["hose"]["positions"]
+        await page.cdp.evaluate(set_input.format(0.42))
+        edited = await settle()
+        n1 = (await page.call("state()"))["cables"]["hose"]["positions"]
+        await page.cdp.evaluate(set_input.format(1.7))
+        kept = await settle()
+        refused = await page.text("message")
+        await page.cdp.evaluate("document.getElementById('undo').click()")
+        undone = await settle()
+        n2 = (await page.call("state()"))["cables"]["hose"]["positions"]
+        return n0, edited, n1, refused, kept, undone, n2
+
+    with workbench_process(scene_copy) as (_, url):
+        n0, edited, n1, refused, kept, undone, n2 = run_page(url, script)
+    assert edited == "0.42" and kept == "0.42" and undone == "0.5"
+    # the middle clip now holds s = 0.42: another shape; undone: the first one again
+    assert np.abs(np.array(n1) - np.array(n0)).max() > 1e-3
+    assert n2 == n0
+    assert "covers s = [1.7, 1.7] m, outside the cable [0, 1.0] m" in refused

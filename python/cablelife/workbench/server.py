@@ -79,9 +79,13 @@ class SocketHandler(tornado.websocket.WebSocketHandler):
     def initialize(self, app_state):
         self.app = app_state
 
-    def check_origin(self, origin):  # the page is served from this very server only
+    def check_origin(self, origin):
+        """Only the workbench's own page may connect: its origin is this server, addressed as
+        127.0.0.1 or localhost (a page of another site, also one whose name was re-pointed to
+        127.0.0.1, is refused)."""
         host = self.request.headers.get("Host", "")
-        return origin.split("//", 1)[-1] == host
+        name = host.rsplit(":", 1)[0]
+        return name in ("127.0.0.1", "localhost") and origin.split("//", 1)[-1] == host
 
     async def on_message(self, message):
         try:
@@ -97,7 +101,11 @@ class SocketHandler(tornado.websocket.WebSocketHandler):
             reply = {"ok": False, "error": str(err)}
         reply["id"] = rid
         try:
-            self.write_message(_json(reply))
+            text = _json(reply)
+        except ValueError as err:  # a non-finite number: say so instead of sending NaN
+            text = _json({"id": rid, "ok": False, "error": f"the reply cannot be sent: {err}"})
+        try:
+            self.write_message(text)
         except tornado.websocket.WebSocketClosedError:
             pass
 

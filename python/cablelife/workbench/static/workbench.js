@@ -9,7 +9,7 @@
   var quantity = "bending";
   var renderer, scene, camera, orbit, gizmo, dirty = true;
   var tubes = {}, clipObjects = {}, bodyMeshes = {}, selected = null;
-  var ws, nextId = 1, waiting = {}, inflight = false, pending = null, dragMark = false;
+  var ws, nextId = 1, waiting = {}, inflight = false, pending = null, dragMark = false, idleWaiters = [];
   var updateTimes = [], frameTimes = [], lastSolveMs = 0;
   var statusText = "";
 
@@ -292,10 +292,14 @@
   // ---------------------------------------------------------------- server
   function request(req) {
     req.id = nextId++;
-    return new Promise(function (resolve, reject) {
-      waiting[req.id] = {resolve: resolve, reject: reject};
+    var entry = {};
+    entry.promise = new Promise(function (resolve, reject) {
+      entry.resolve = resolve; entry.reject = reject;
+      waiting[req.id] = entry;
       ws.send(JSON.stringify(req));
     });
+    entry.promise.catch(function () {}); // settled() waits for it; the caller sees the error
+    return entry.promise;
   }
 
   function onReply(msg) {
@@ -329,7 +333,9 @@
     var mark = dragMark; dragMark = false;
     request({op: "move", moves: [move], mark: mark}).catch(function (e) { showMessage(e.message, true); }).then(function () {
       inflight = false;
-      if (pending) { var p = pending; pending = null; sendMove(p); }
+      if (pending) { var p = pending; pending = null; sendMove(p); return; }
+      var done = idleWaiters; idleWaiters = [];
+      done.forEach(function (f) { f(); });
     });
   }
 
@@ -475,6 +481,12 @@
         if (msg.ok === false) throw new Error(msg.error);
         return {solveMs: msg.solveMs};
       });
+    },
+    // resolves when the moves of a mouse drag are all solved and drawn, and every other request answered
+    settled: function () {
+      var open = Object.keys(waiting).map(function (k) { return waiting[k].promise.catch(function () { return null; }); });
+      var moves = inflight || pending ? new Promise(function (r) { idleWaiters.push(r); }) : Promise.resolve();
+      return Promise.all([moves].concat(open)).then(function () { return true; });
     },
     state: function () {
       var out = {cables: {}};
