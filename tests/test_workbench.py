@@ -265,12 +265,15 @@ def test_page_follows_a_dragged_clip(scene_copy, tmp_path):
         bad = await page.call("moveClip('hose', 'nowhere', [0, 0, 0])")
         bad_cable = await page.call(f"moveClip('pipe', '{CLIP}', [0, 0, 0])")
         message = await page.text("message")
+        failed = await page.call(f"moveClip('hose', '{CLIP}', [5000, 0, 0])")
         after = np.array((await page.call("state()"))["cables"]["hose"]["positions"])
         saved = await page.call(f"save({str(tmp_path / 'saved.toml')!r})")
-        return seen, wall, stats, bad, bad_cable, message, after, shot, saved
+        return seen, wall, stats, bad, bad_cable, message, failed, after, shot, saved
 
     with workbench_process(scene_copy) as (proc, url):
-        seen, wall, stats, bad, bad_cable, message, after, shot, saved = run_page(url, script)
+        seen, wall, stats, bad, bad_cable, message, failed, after, shot, saved = run_page(
+            url, script
+        )
         stopped_s, code = stop_time(proc)
     print(f"\nworkbench: 50 moveClip calls in {wall:.2f} s = {50 / wall:.1f} updates/s "
           f"(page stats {stats}); Ctrl-C stopped it in {stopped_s:.2f} s")  # fmt: skip
@@ -291,6 +294,8 @@ def test_page_follows_a_dragged_clip(scene_copy, tmp_path):
     }
     assert bad_cable == {"error": "cable 'pipe' is not in the scene; allowed: 'hose'"}
     assert "cable 'pipe' is not in the scene" in message
+    # a failed solve: its reason, the last good state kept
+    assert "cable 'hose': no equilibrium at the new clip pose" in failed["error"]
     assert np.array_equal(after, seen[-1])
     assert shot.stat().st_size > 20_000
     assert code == 130  # Ctrl-C
