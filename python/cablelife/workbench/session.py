@@ -118,6 +118,11 @@ class Session:
 
         path = Path(path)
         scene = load_scene(path)
+        if getattr(scene, "junctions", None):  # harnesses (issue 16): not solved here yet
+            raise SceneError(
+                f"{str(path)!r} has [[junctions]] (a harness); the workbench solves single "
+                "cables only so far: run the harness with `cablelife run`"
+            )
         doc = tomlkit.parse(path.read_text(encoding="utf-8"))
         session = cls(path=path, scene=scene, doc=doc, bend_factor=bend_factor)
         session.env = load_surroundings(scene)
