@@ -232,7 +232,8 @@ def chromium(width: int = 1200, height: int = 900) -> Iterator[int]:
     if browser is None:
         raise FileNotFoundError("chromium not found (Debian package 'chromium')")
     port = _free_port()
-    with tempfile.TemporaryDirectory() as profile:
+    # Chromium's helper processes may still write to the profile after the browser ended
+    with tempfile.TemporaryDirectory(ignore_cleanup_errors=True) as profile:
         proc = subprocess.Popen(
             [browser, *FLAGS, f"--remote-debugging-port={port}", f"--user-data-dir={profile}",
              f"--window-size={width},{height}", "about:blank"],
