@@ -460,6 +460,10 @@ def test_server_listens_on_loopback_and_refuses_foreign_pages(scene_copy):
             reply = json.loads(await ws.read_message())
             await ws.write_message(json.dumps({"id": 8, "op": "fly"}))
             bad = json.loads(await ws.read_message())
+            await ws.write_message(json.dumps({"id": 9, "op": "move", "moves": [1]}))
+            bad_moves = json.loads(await ws.read_message())
+            await ws.write_message("[1, 2")
+            not_json = json.loads(await ws.read_message())
             ws.close()
             refused = None
             try:
@@ -467,17 +471,20 @@ def test_server_listens_on_loopback_and_refuses_foreign_pages(scene_copy):
                 await websocket_connect(HTTPRequest(f"ws://127.0.0.1:{port}/ws", headers=foreign))
             except HTTPClientError as err:
                 refused = err.code
-            return info, reply, bad, refused
+            return info, reply, bad, bad_moves, not_json, refused
         finally:
             server.stop()
 
-    info, reply, bad, refused = asyncio.run(main())
+    info, reply, bad, bad_moves, not_json, refused = asyncio.run(main())
     session.close()
     assert info["state"]["cables"]["hose"]["figures"]["clips"][2]["name"] == CLIP
     assert reply["id"] == 7 and reply["ok"] and reply["solveMs"] > 0
     assert reply["state"]["cables"]["hose"]["positions"][-1] == [0.75, 0.27, 0.01]
     assert bad == {"id": 8, "ok": False,
                    "error": "op = 'fly'; allowed: move, edit, undo, save, state"}  # fmt: skip
+    assert bad_moves["ok"] is False
+    assert bad_moves["error"] == "move: moves = [1]; give [{cable, clip, position}, ...]"
+    assert not_json == {"ok": False, "error": "a request must be a JSON object"}
     assert refused == 403
 
 

@@ -91,7 +91,7 @@ class SocketHandler(tornado.websocket.WebSocketHandler):
         try:
             req = json.loads(message)
             rid = req.get("id")
-        except (ValueError, AttributeError):
+        except (ValueError, AttributeError, TypeError):
             self.write_message(_json({"ok": False, "error": "a request must be a JSON object"}))
             return
         loop = asyncio.get_running_loop()
@@ -99,6 +99,8 @@ class SocketHandler(tornado.websocket.WebSocketHandler):
             reply = await loop.run_in_executor(self.app["worker"], self._handle, req)
         except (WorkbenchError, ValueError) as err:
             reply = {"ok": False, "error": str(err)}
+        except Exception as err:  # never leave the page waiting for an answer
+            reply = {"ok": False, "error": f"the workbench failed: {type(err).__name__}: {err}"}
         reply["id"] = rid
         try:
             text = _json(reply)
@@ -114,8 +116,14 @@ class SocketHandler(tornado.websocket.WebSocketHandler):
         op = req.get("op")
         if op == "move":
             moves = req.get("moves")
-            if not isinstance(moves, list) or not moves:
-                raise WorkbenchError("move: give moves = [{cable, clip, position}, ...]")
+            if (
+                not isinstance(moves, list)
+                or not moves
+                or not all(isinstance(m, dict) for m in moves)
+            ):
+                raise WorkbenchError(
+                    f"move: moves = {str(moves)[:80]}; give [{{cable, clip, position}}, ...]"
+                )
             start = time.perf_counter()
             errors = s.move_clips(moves, mark=bool(req.get("mark", True)))
             ms = (time.perf_counter() - start) * 1e3
