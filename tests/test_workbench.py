@@ -253,6 +253,8 @@ def test_page_follows_a_dragged_clip(scene_copy, tmp_path):
     shots = Path(os.environ.get("CABLELIFE_SCREENSHOTS", tmp_path))
 
     async def script(page):
+        poses = [await page.call(f"clipPose('hose', '{c}')") for c in
+                 ("body-clip", "middle", CLIP)]  # fmt: skip
         seen = []
         t0 = time.perf_counter()
         for p in points:
@@ -268,15 +270,23 @@ def test_page_follows_a_dragged_clip(scene_copy, tmp_path):
         failed = await page.call(f"moveClip('hose', '{CLIP}', [5000, 0, 0])")
         after = np.array((await page.call("state()"))["cables"]["hose"]["positions"])
         saved = await page.call(f"save({str(tmp_path / 'saved.toml')!r})")
-        return seen, wall, stats, bad, bad_cable, message, failed, after, shot, saved
+        return poses, seen, wall, stats, bad, bad_cable, message, failed, after, shot, saved
 
     with workbench_process(scene_copy) as (proc, url):
-        seen, wall, stats, bad, bad_cable, message, failed, after, shot, saved = run_page(
+        poses, seen, wall, stats, bad, bad_cable, message, failed, after, shot, saved = run_page(
             url, script
         )
         stopped_s, code = stop_time(proc)
     print(f"\nworkbench: 50 moveClip calls in {wall:.2f} s = {50 / wall:.1f} updates/s "
           f"(page stats {stats}); Ctrl-C stopped it in {stopped_s:.2f} s")  # fmt: skip
+    # the clip frames are drawn (and a turn is sent) with the scene's orientation
+    from cablelife.simulate import clip_poses
+
+    pos, quat = clip_poses(scene0, scene0.cables[0], np.array([0.0]), with_motion=False)
+    for j, pose in enumerate(poses):
+        np.testing.assert_allclose(pose["position"], pos[0, j], atol=1e-12)
+        q = np.array(pose["quaternion"])
+        assert min(np.abs(q - quat[0, j]).max(), np.abs(q + quat[0, j]).max()) < 1e-7
     for p, x in zip(points, seen, strict=True):
         np.testing.assert_allclose(x[node], p, atol=1e-12)
     assert set(stats) == {"solvesPerSecond", "lastSolveMs", "framesPerSecond"}

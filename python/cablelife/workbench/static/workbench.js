@@ -502,6 +502,11 @@
     edit: function (cable, item, key, value) { return request({op: "edit", cable: cable, item: item, key: key, value: value}); },
     setQuantity: function (q) { quantity = q; $("quantity").value = q; draw(shown, playing === null); renderer.render(scene, camera); },
     select: select,
+    // the clip's pose as drawn (and as a turn sends it): position, quaternion [w, x, y, z]
+    clipPose: function (cable, clip) {
+      var o = clipObjects[cable][clip];
+      return {position: o.position.toArray(), quaternion: [o.quaternion.w, o.quaternion.x, o.quaternion.y, o.quaternion.z]};
+    },
     // where a clip is on the page (CSS px), to drag it with the mouse in tests
     clipOnScreen: function (cable, clip) {
       var v = clipObjects[cable][clip].position.clone().project(camera), r = renderer.domElement.getBoundingClientRect();
