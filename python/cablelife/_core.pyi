@@ -79,6 +79,14 @@ class Cable:
         run ends with error "interrupted" when it is set).
         """
         ...
+    def step_static(self, positions, quaternions) -> Any:
+        """One static equilibrium at the clip poses `positions` (C, 3), `quaternions` (C, 4),
+        warm-started from the last equilibrium (sub-stepped toward the poses on failure), or
+        solved from the routed shape when there is none (interactive use: the workbench).
+        Returns the dict of `run_sequence` with one step; a failed solve is a ValueError and
+        keeps the last equilibrium as it was.
+        """
+        ...
     def set_contact(
         self,
         obstacles,

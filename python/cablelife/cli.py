@@ -1,5 +1,5 @@
 """Command line: ``cablelife run``, ``modes``, ``signal``, ``volume``, ``report``, ``paraview``,
-``lda``, ``compare``, ``study``, ``demo``, ``schema``."""
+``lda``, ``compare``, ``study``, ``demo``, ``workbench``, ``schema``."""
 
 from __future__ import annotations
 
@@ -307,6 +307,9 @@ def _register_optional() -> None:
 
     app.command(name="study")(study_command)
     app.command(name="demo")(demo_command)
+    from cablelife.workbench.cli import workbench_command
+
+    app.command(name="workbench")(workbench_command)
 
 
 _register_optional()

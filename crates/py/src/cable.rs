@@ -668,6 +668,66 @@ impl Cable {
         Ok(d)
     }
 
+    /// One static equilibrium at the clip poses `positions` (C, 3), `quaternions` (C, 4),
+    /// warm-started from the last equilibrium (sub-stepped toward the poses on failure), or
+    /// solved from the routed shape when there is none (interactive use: the workbench).
+    /// Returns the dict of `run_sequence` with one step; a failed solve is a ValueError and
+    /// keeps the last equilibrium as it was.
+    fn step_static<'py>(
+        &mut self,
+        py: Python<'py>,
+        positions: PyReadonlyArray2<'py, f64>,
+        quaternions: PyReadonlyArray2<'py, f64>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let n_clips = self.rod.spec.clips.len();
+        let (pos, qs) = (positions.as_array(), quaternions.as_array());
+        if pos.dim() != (n_clips, 3) || qs.dim() != (n_clips, 4) {
+            return Err(PyValueError::new_err(format!(
+                "clip poses must be ({n_clips}, 3) and ({n_clips}, 4); got {:?} and {:?}",
+                pos.dim(),
+                qs.dim()
+            )));
+        }
+        let pos3 = pos.insert_axis(numpy::ndarray::Axis(0));
+        let qs3 = qs.insert_axis(numpy::ndarray::Axis(0));
+        let target = read_poses(&pos3, &qs3)?.remove(0);
+        let rod = &self.rod;
+        let solver = &mut self.solver;
+        if let (Some(c), Some(p)) = (&mut solver.contact, obstacle_at(&self.obstacle_poses, 0)) {
+            c.set_obstacle_poses(p);
+        }
+        let previous = self.state.clone();
+        let (outcome, st) = py.detach(|| {
+            let (result, st) = match previous {
+                Some(mut st) => (solver.sequence_step(rod, &mut st, &target), st),
+                None => match route(rod, Some(&target)) {
+                    Ok(mut st) => (solver.solve(rod, &mut st), st),
+                    Err(e) => return (Err(e.0), None),
+                },
+            };
+            let outcome = match result {
+                Ok(stats) => match solver.assemble(rod, &st, 1.0, false) {
+                    Ok(()) => {
+                        let mut rec = Record::with_capacity(1, rod);
+                        rec.push(rod, &st, &solver.ws, &stats);
+                        if let Some(c) = &solver.contact {
+                            rec.push_contact(c);
+                        }
+                        Ok(rec)
+                    }
+                    Err(kink) => Err(format!("kink at node {}", kink.node)),
+                },
+                Err(e) => Err(e.to_string()),
+            };
+            (outcome, Some(st))
+        });
+        let rec = outcome.map_err(PyValueError::new_err)?;
+        self.state = st;
+        let d = rec.into_dict(py, self.rod.arc.len(), n_clips)?;
+        d.set_item("error", None::<String>)?;
+        Ok(d)
+    }
+
     /// Dynamic run: static equilibrium at the clip poses of step 0, then generalized-α steps
     /// of `time_step` through the clip kinematics (T, C, ·): positions, quaternions, velocities,
     /// angular velocities, accelerations, angular accelerations (global). Every

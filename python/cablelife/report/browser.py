@@ -15,6 +15,8 @@ import subprocess
 import tempfile
 import time
 import urllib.request
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -99,8 +101,15 @@ class _Cdp:
                     raise RuntimeError(f"{method}: {msg['error']}")
                 return msg.get("result", {})
 
-    async def evaluate(self, expr: str):
-        r = await self.call("Runtime.evaluate", expression=expr, returnByValue=True)
+    async def evaluate(self, expr: str, await_promise: bool = False, strict: bool = False):
+        """The value of a JavaScript expression (with ``await_promise``: of the promise it
+        gives); a script error gives None, or with ``strict`` raises RuntimeError (its text)."""
+        r = await self.call(
+            "Runtime.evaluate", expression=expr, returnByValue=True, awaitPromise=await_promise
+        )
+        if strict and "exceptionDetails" in r:
+            d = r["exceptionDetails"]
+            raise RuntimeError(d.get("exception", {}).get("description") or d.get("text"))
         return r.get("result", {}).get("value")
 
 
@@ -140,22 +149,8 @@ async def _scroll_through(cdp: _Cdp, height: int, t0: float, timeout: float) -> 
 
 
 async def _check(url, port, width, height, timeout, shots, scroll_shots, evaluate) -> PageCheck:
-    from tornado.websocket import websocket_connect
-
-    deadline = time.monotonic() + 20
-    while True:
-        try:
-            with urllib.request.urlopen(f"http://127.0.0.1:{port}/json/list") as r:
-                pages = [t for t in json.load(r) if t["type"] == "page"]
-            if pages:
-                break
-        except OSError:
-            pass
-        if time.monotonic() > deadline:
-            raise RuntimeError("chromium did not open its DevTools port")
-        await asyncio.sleep(0.1)
-    ws = await websocket_connect(pages[0]["webSocketDebuggerUrl"], max_message_size=2**30)
-    cdp = _Cdp(ws)
+    cdp = await connect(port)
+    ws = cdp.ws
     await cdp.call("Emulation.setDeviceMetricsOverride", width=width, height=height,
                    deviceScaleFactor=1, mobile=False)  # fmt: skip
     t0 = time.perf_counter()
@@ -214,11 +209,31 @@ def check_page(
     """Opens ``path`` in a fresh headless Chromium and reports what it saw; with
     ``screenshots`` (a folder) one PNG per screen height down the page; ``evaluate``: name →
     JavaScript expression, their values in ``values``."""
+    with chromium(width, height) as port:
+        return asyncio.run(
+            _check(
+                Path(path).resolve().as_uri(),
+                port,
+                width,
+                height,
+                timeout,
+                screenshots,
+                scroll_shots,
+                evaluate,
+            )  # fmt: skip
+        )
+
+
+@contextmanager
+def chromium(width: int = 1200, height: int = 900) -> Iterator[int]:
+    """A fresh headless Chromium with its own profile; yields its DevTools port (connect to
+    its page with :func:`connect`). Ended when the block ends."""
     browser = find_browser()
     if browser is None:
         raise FileNotFoundError("chromium not found (Debian package 'chromium')")
     port = _free_port()
-    with tempfile.TemporaryDirectory() as profile:
+    # Chromium's helper processes may still write to the profile after the browser ended
+    with tempfile.TemporaryDirectory(ignore_cleanup_errors=True) as profile:
         proc = subprocess.Popen(
             [browser, *FLAGS, f"--remote-debugging-port={port}", f"--user-data-dir={profile}",
              f"--window-size={width},{height}", "about:blank"],
@@ -226,21 +241,30 @@ def check_page(
             stderr=subprocess.DEVNULL,
         )  # fmt: skip
         try:
-            return asyncio.run(
-                _check(
-                    Path(path).resolve().as_uri(),
-                    port,
-                    width,
-                    height,
-                    timeout,
-                    screenshots,
-                    scroll_shots,
-                    evaluate,
-                )  # fmt: skip
-            )
+            yield port
         finally:
             proc.terminate()
             try:
                 proc.wait(10)
             except subprocess.TimeoutExpired:
                 proc.kill()
+
+
+async def connect(port: int, timeout: float = 20.0) -> _Cdp:
+    """A DevTools session on the first page of the Chromium listening on ``port``."""
+    from tornado.websocket import websocket_connect
+
+    deadline = time.monotonic() + timeout
+    while True:
+        try:
+            with urllib.request.urlopen(f"http://127.0.0.1:{port}/json/list") as r:
+                pages = [t for t in json.load(r) if t["type"] == "page"]
+            if pages:
+                break
+        except OSError:
+            pass
+        if time.monotonic() > deadline:
+            raise RuntimeError("chromium did not open its DevTools port")
+        await asyncio.sleep(0.1)
+    ws = await websocket_connect(pages[0]["webSocketDebuggerUrl"], max_message_size=2**30)
+    return _Cdp(ws)

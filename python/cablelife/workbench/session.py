@@ -1,0 +1,575 @@
+"""The workbench's model: the scene being edited, one warm static solver per cable, the
+quantities the page colours the cables by, undo, and saving back to TOML.
+
+Moving a clip re-solves its cable from the last equilibrium (``_core.Cable.step_static``,
+sub-stepped toward the new pose when a direct Newton solve fails); a failed solve keeps the
+last good state and the clip where it was, and says why. Editing a clip's ``s``, type or
+length, or a cable's length, rebuilds that cable's solver (a new mesh) and solves it from its
+routed shape. The scene's TOML text is kept as a tomlkit document, so that saving changes only
+the edited values and keeps the user's comments and layout.
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+import time
+import typing
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from cablelife.limits import LIMITS
+from cablelife.rotations import matrix_quaternions
+from cablelife.scene import Cable, Clip, Scene, SceneError, load_scene, scene_from_dict
+from cablelife.simulate import build_cable, euler_matrix
+
+#: Colour quantities: key → (label, unit). Values per node.
+QUANTITIES = {
+    "bending": ("bending moment |M1, M2|", "N m"),
+    "torsion": ("torsion M3", "N m"),
+    "tension": ("tension F3", "N"),
+    "bend_ratio": ("bend radius ÷ rule", ""),
+    "clearance": ("clearance", "mm"),
+}
+
+#: Undo steps kept.
+UNDO_DEPTH = 200
+
+#: Clip types offered for editing: those of the scene format (docs/scene.md).
+CLIP_TYPES = typing.get_args(Clip.model_fields["type"].annotation)
+
+
+class WorkbenchError(ValueError):
+    """A request the workbench cannot carry out; the message names the item and value."""
+
+
+def quat_matrix(q) -> np.ndarray:
+    """Rotation matrix of a quaternion (w, x, y, z), normalised."""
+    w, x, y, z = np.asarray(q, float) / np.linalg.norm(q)
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
+        ]
+    )
+
+
+def node_average(edge_values: np.ndarray) -> np.ndarray:
+    """Edge values (N,) onto the nodes (N+1,): the ends keep their edge, inner nodes average."""
+    pad = np.concatenate([edge_values[:1], edge_values, edge_values[-1:]])
+    return 0.5 * (pad[:-1] + pad[1:])
+
+
+@dataclass
+class Equilibrium:
+    """The last good static state of one cable (global frame, SI units)."""
+
+    positions: np.ndarray  # (N+1, 3)
+    quaternions: np.ndarray  # (N, 4)
+    forces: np.ndarray  # (N, 3) body frame
+    moments: np.ndarray  # (N+1, 3) body frame
+    reaction_force: np.ndarray  # (C, 3)
+    reaction_moment: np.ndarray  # (C, 3)
+    iterations: int
+    solve_ms: float
+
+
+@dataclass
+class LiveCable:
+    """One cable of the session: its scene entry, its solver and its last equilibrium."""
+
+    name: str
+    core: object  # _core.Cable
+    arc_length: np.ndarray
+    clip_positions: np.ndarray  # (C, 3) global
+    clip_quaternions: np.ndarray  # (C, 4) scalar first
+    stiffness: np.ndarray  # EI1, EI2, GJ
+    radius: float
+    state: Equilibrium | None = None
+    message: str = ""  # why the last solve failed ("" after a good one)
+
+
+@dataclass
+class Session:
+    """A scene opened in the workbench."""
+
+    path: Path
+    scene: Scene
+    doc: object  # tomlkit document of the scene file
+    bend_factor: float = 10.0
+    cables: dict[str, LiveCable] = field(default_factory=dict)
+    env: object = None  # surroundings (clearance), or None
+    undo_stack: list[str] = field(default_factory=list)
+    lock: threading.RLock = field(default_factory=threading.RLock)
+    pool: ThreadPoolExecutor | None = None
+    solves: int = 0
+
+    # ------------------------------------------------------------------ opening
+    @classmethod
+    def open(cls, path: str | Path, bend_factor: float = 10.0) -> Session:
+        """Reads the scene, builds a solver per cable and solves every cable once."""
+        import tomlkit
+
+        from cablelife.surroundings.build import load_surroundings
+
+        path = Path(path)
+        scene = load_scene(path)
+        if getattr(scene, "junctions", None):  # harnesses (issue 16): not solved here yet
+            raise SceneError(
+                f"{str(path)!r} has [[junctions]] (a harness); the workbench solves single "
+                "cables only so far: run the harness with `cablelife run`"
+            )
+        doc = tomlkit.parse(path.read_text(encoding="utf-8"))
+        session = cls(path=path, scene=scene, doc=doc, bend_factor=bend_factor)
+        session.env = load_surroundings(scene)
+        session.pool = ThreadPoolExecutor(max_workers=max(1, min(len(scene.cables), 4)))
+        for cable in scene.cables:
+            session._rebuild(cable)
+        failed = [c for c in session.cables.values() if c.state is None]
+        if failed:
+            raise SceneError(
+                "; ".join(f"cable '{c.name}': no static equilibrium: {c.message}" for c in failed)
+            )
+        return session
+
+    def close(self) -> None:
+        if self.pool is not None:
+            self.pool.shutdown(wait=False, cancel_futures=True)
+
+    def _rebuild(self, cable: Cable) -> LiveCable:
+        """A fresh solver for ``cable`` (its mesh follows the clips), solved from its route."""
+        from cablelife.contact_settings import set_contact
+        from cablelife.simulate import clip_poses
+
+        core = build_cable(self.scene, cable)
+        if self.scene.contact is not None and self.scene.contact.enabled:
+            try:
+                set_contact(core, self.scene, cable, np.array([0.0]))
+            except ValueError as err:
+                raise SceneError(f"cable '{cable.name}': {err}") from None
+        pos, quat = clip_poses(self.scene, cable, np.array([0.0]), with_motion=False)
+        props = cable.properties()
+        live = LiveCable(
+            name=cable.name,
+            core=core,
+            arc_length=np.asarray(core.arc_length),
+            clip_positions=pos[0].copy(),
+            clip_quaternions=quat[0].copy(),
+            stiffness=np.array(
+                [props.bend_stiffness[0], props.bend_stiffness[1], props.bend_stiffness[2]]
+            ),  # fmt: skip
+            radius=float(props.outer_radius),
+        )
+        self.cables[cable.name] = live
+        self._solve(live, live.clip_positions, live.clip_quaternions)
+        return live
+
+    # ------------------------------------------------------------------ lookups
+    def cable_spec(self, name: str) -> Cable:
+        for c in self.scene.cables:
+            if c.name == name:
+                return c
+        raise WorkbenchError(
+            f"cable {name!r} is not in the scene; allowed: "
+            + ", ".join(repr(c.name) for c in self.scene.cables)
+        )
+
+    def clip_index(self, cable: Cable, clip: str) -> int:
+        for j, c in enumerate(cable.clips):
+            if c.name == clip:
+                return j
+        raise WorkbenchError(
+            f"cable '{cable.name}' has no clip {clip!r}; allowed: "
+            + ", ".join(repr(c.name) for c in cable.clips)
+        )
+
+    # ------------------------------------------------------------------ solving
+    def _solve(self, live: LiveCable, positions: np.ndarray, quaternions: np.ndarray) -> bool:
+        """One warm-started equilibrium; keeps the last good one on failure."""
+        start = time.perf_counter()
+        try:
+            out = live.core.step_static(
+                np.ascontiguousarray(positions, float), np.ascontiguousarray(quaternions, float)
+            )
+        except ValueError as err:
+            live.message = f"cable '{live.name}': no equilibrium at the new clip pose ({err})"
+            return False
+        ms = (time.perf_counter() - start) * 1e3
+        x = out["positions"][0]
+        if not np.isfinite(x).all():
+            live.message = f"cable '{live.name}': the solve gave non-finite positions"
+            return False
+        live.state = Equilibrium(
+            positions=x,
+            quaternions=out["quaternions"][0],
+            forces=out["forces"][0],
+            moments=out["moments"][0],
+            reaction_force=out["reaction_force"][0],
+            reaction_moment=out["reaction_moment"][0],
+            iterations=int(out["iterations"][0]),
+            solve_ms=ms,
+        )
+        live.clip_positions = np.array(positions, float)
+        live.clip_quaternions = np.array(quaternions, float)
+        live.message = ""
+        self.solves += 1
+        return True
+
+    def _check_point(self, what: str, position) -> np.ndarray:
+        try:
+            p = np.asarray(position, float).reshape(3)
+        except (TypeError, ValueError):
+            raise WorkbenchError(
+                f"{what} = {position!r}: give three numbers [x, y, z] in m"
+            ) from None
+        lo, hi = LIMITS["coordinate"]
+        if not np.isfinite(p).all() or (p < lo).any() or (p > hi).any():
+            raise WorkbenchError(
+                f"{what} = {p.tolist()}: allowed: finite coordinates within {lo:g} … {hi:g} m"
+            )
+        return p
+
+    def move_clips(self, moves: list[dict], mark: bool = True) -> dict:
+        """Moves clips (global position [x, y, z] m, optional orientation ``quaternion``
+        [w, x, y, z] of the clip frame d1, d2, d3) and re-solves the cables concerned (in
+        parallel). Each move: {"cable", "clip", "position", "quaternion"?}. Returns
+        {cable: error message or ""}: a cable whose solve fails keeps its last state and its
+        clips where they were. ``mark``: an undo step starts here (the first move of a drag;
+        later moves of the same drag pass False)."""
+        with self.lock:
+            targets: dict[str, tuple[np.ndarray, np.ndarray, list]] = {}
+            for m in moves:
+                cable = self.cable_spec(str(m.get("cable")))
+                j = self.clip_index(cable, str(m.get("clip")))
+                what = f"cable '{cable.name}', clip '{cable.clips[j].name}' position"
+                p = self._check_point(what, m.get("position"))
+                live = self.cables[cable.name]
+                pos, quat, edits = targets.setdefault(
+                    cable.name,
+                    (live.clip_positions.copy(), live.clip_quaternions.copy(), []),
+                )
+                pos[j] = p
+                frame = None
+                if m.get("quaternion") is not None:
+                    q = np.asarray(m["quaternion"], float).reshape(4)
+                    if not np.isfinite(q).all() or np.linalg.norm(q) < 1e-9:
+                        raise WorkbenchError(
+                            f"cable '{cable.name}', clip '{cable.clips[j].name}' quaternion = "
+                            f"{q.tolist()}: give a non-zero [w, x, y, z]"
+                        )
+                    frame = quat_matrix(q)
+                    quat[j] = matrix_quaternions(frame[None])[0]
+                edits.append((j, p, frame))
+            if mark:
+                self._push_undo()
+            names = list(targets)
+            results = list(
+                self.pool.map(lambda n: self._solve(self.cables[n], *targets[n][:2]), names)
+            )
+            errors = {}
+            for name, ok in zip(names, results, strict=True):
+                if ok:
+                    for j, p, frame in targets[name][2]:
+                        self._set_clip_pose(self.cable_spec(name), j, p, frame)
+                errors[name] = self.cables[name].message
+            if mark and not any(results):
+                self.undo_stack.pop()
+            return errors
+
+    def _set_clip_pose(self, cable: Cable, j: int, p: np.ndarray, frame) -> None:
+        """Writes a clip's new global pose into the scene (and its TOML), in the clip's frame."""
+        clip = cable.clips[j]
+        rot, origin = np.eye(3), np.zeros(3)
+        if clip.frame == "body":
+            body = self.scene.body(clip.body)
+            rot, origin = euler_matrix(body.orientation), np.asarray(body.origin, float)
+        local = rot.T @ (p - origin)
+        clip.position = tuple(_tidy(v) for v in local)
+        entry = self._toml_clip(cable.name, clip.name)
+        entry["position"] = [_tidy(v) for v in local]
+        if frame is not None:
+            d3, d1 = rot.T @ frame[:, 2], rot.T @ frame[:, 0]
+            clip.direction = tuple(_tidy(v) for v in d3)
+            clip.normal = tuple(_tidy(v) for v in d1)
+            entry["direction"] = [_tidy(v) for v in d3]
+            entry["normal"] = [_tidy(v) for v in d1]
+
+    # ------------------------------------------------------------------ edits
+    def edit(self, cable: str, item: str, key: str, value) -> None:
+        """Sets a clip's ``s``, ``type`` or ``length`` (item = the clip's name) or the cable's
+        ``length`` (item = ""), validated as a scene; rebuilds and re-solves the cable. On an
+        invalid value or a failed solve nothing changes."""
+        with self.lock:
+            spec = self.cable_spec(cable)
+            if item:
+                self.clip_index(spec, item)
+                allowed = ("s", "type", "length")
+            else:
+                allowed = ("length",)
+            if key not in allowed:
+                raise WorkbenchError(
+                    f"cable '{cable}'{f', clip {item!r}' if item else ''}: {key!r} cannot be "
+                    f"edited here; allowed: {', '.join(allowed)}"
+                )
+            if key == "type" and value not in CLIP_TYPES:
+                raise WorkbenchError(
+                    f"cable '{cable}', clip '{item}': type = {value!r}; allowed: "
+                    + ", ".join(CLIP_TYPES)
+                )
+            if key != "type":
+                if isinstance(value, bool) or not isinstance(value, int | float):
+                    raise WorkbenchError(
+                        f"cable '{cable}'{f', clip {item!r}' if item else ''}: {key} = "
+                        f"{value!r}; give a number in m"
+                    )
+                value = float(value)
+            self._push_undo()
+            old_doc = self.doc
+            import tomlkit
+
+            self.doc = tomlkit.parse(old_doc.as_string())
+            entry = self._toml_clip(cable, item) if item else self._toml_cable(cable)
+            entry[key] = value
+            try:
+                self._reload(cable)
+            except (SceneError, WorkbenchError):
+                self.doc = old_doc
+                self.undo_stack.pop()
+                self._reload(cable)
+                raise
+
+    def _reload(self, changed: str | None = None) -> None:
+        """Validates the TOML document as a scene; rebuilds the changed cable's solver (all
+        when None). Raises SceneError (nothing rebuilt) for an invalid scene or a failed solve."""
+        scene = scene_from_dict(
+            self.doc.unwrap(), base_dir=self.path.parent.resolve(), source=str(self.path)
+        )
+        keep_scene, keep_cables = self.scene, dict(self.cables)
+        # clip poses edited by dragging live in the document too: the new scene has them
+        self.scene = scene
+        try:
+            for c in scene.cables:
+                if changed is None or c.name == changed:
+                    live = self._rebuild(c)
+                    if live.state is None:
+                        raise SceneError(live.message)
+        except SceneError:
+            self.scene, self.cables = keep_scene, keep_cables
+            raise
+
+    def undo(self) -> bool:
+        """Back to the scene before the last move or edit; False when there is nothing to undo."""
+        import tomlkit
+
+        with self.lock:
+            if not self.undo_stack:
+                return False
+            self.doc = tomlkit.parse(self.undo_stack.pop())
+            self._reload()
+            return True
+
+    def _push_undo(self) -> None:
+        self.undo_stack.append(self.doc.as_string())
+        del self.undo_stack[:-UNDO_DEPTH]
+
+    # ------------------------------------------------------------------ TOML
+    def _toml_cable(self, name: str):
+        for entry in self.doc.get("cables", []):
+            if entry.get("name") == name:
+                return entry
+        raise WorkbenchError(f"cable {name!r} is not in the scene file")
+
+    def _toml_clip(self, cable: str, clip: str):
+        for entry in self._toml_cable(cable).get("clips", []):
+            if entry.get("name") == clip:
+                return entry
+        raise WorkbenchError(f"cable '{cable}' has no clip {clip!r} in the scene file")
+
+    def scene_text(self) -> str:
+        return self.doc.as_string()
+
+    def save(self, path: str | Path | None = None) -> Path:
+        """Writes the edited scene (atomically) to ``path`` (default: the scene file) and checks
+        that it loads back as a scene."""
+        from cablelife.atomic import write_text_atomic
+
+        target = Path(path) if path else self.path
+        if target.suffix.lower() != ".toml":
+            raise WorkbenchError(f"save to {str(target)!r}: give a .toml file")
+        if not target.parent.is_dir():
+            raise WorkbenchError(f"save to {str(target)!r}: the folder does not exist")
+        with self.lock:
+            text = self.doc.as_string()
+            scene_from_dict(self.doc.unwrap(), base_dir=target.parent.resolve())
+            write_text_atomic(target, text)
+        load_scene(target)  # round trip
+        return target
+
+    # ------------------------------------------------------------------ views
+    def node_values(self, live: LiveCable) -> dict[str, list[float]]:
+        """The colour quantities per node of a cable's last equilibrium."""
+        st = live.state
+        m, f = st.moments, st.forces
+        bending = np.hypot(m[:, 0], m[:, 1])
+        kappa = np.hypot(m[:, 0] / live.stiffness[0], m[:, 1] / live.stiffness[1])
+        rule = self.bend_factor * 2 * live.radius
+        with np.errstate(divide="ignore"):
+            radius = np.where(kappa > 0, 1.0 / kappa, np.inf)
+        values = {
+            "bending": bending,
+            "torsion": m[:, 2],
+            "tension": node_average(f[:, 2]),
+            "bend_ratio": np.minimum(radius / rule, 1e6),
+        }
+        clearance = self.clearance(live)
+        if clearance is not None:
+            values["clearance"] = clearance * 1e3
+        return {k: np.round(v, 12).tolist() for k, v in values.items()}
+
+    def clearance(self, live: LiveCable) -> np.ndarray | None:
+        """Clearance (N+1,) m of the cable surface to the geometry at rest; None without."""
+        if self.env is None:
+            return None
+        maps = np.zeros((len(self.env.bodies), 1, 3, 4))
+        maps[:, :, :, :3] = np.eye(3)
+        value, _ = self.env.core.clearance(
+            np.ascontiguousarray(live.state.positions[None], float), live.radius, maps
+        )
+        return np.asarray(value)[0]
+
+    def figures(self, live: LiveCable) -> dict:
+        """The side panel's figures of one cable."""
+        st = live.state
+        m, f = st.moments, st.forces
+        kappa = np.hypot(m[:, 0] / live.stiffness[0], m[:, 1] / live.stiffness[1])
+        i = int(np.argmax(kappa))
+        k_edge = int(np.argmax(f[:, 2]))
+        k_comp = int(np.argmin(f[:, 2]))
+        k_tors = int(np.argmax(np.abs(m[:, 2])))
+        s = live.arc_length
+        mid = 0.5 * (s[1:] + s[:-1])
+        spec = self.cable_spec(live.name)
+        out = {
+            "minBendRadius": _finite(1.0 / kappa[i]) if kappa[i] > 0 else None,
+            "minBendRadiusS": float(s[i]),
+            "bendRule": self.bend_factor * 2 * live.radius,
+            "maxTension": float(f[k_edge, 2]),
+            "maxTensionS": float(mid[k_edge]),
+            "maxCompression": float(max(-f[k_comp, 2], 0.0)),
+            "maxCompressionS": float(mid[k_comp]),
+            "maxTorsion": float(abs(m[k_tors, 2])),
+            "maxTorsionS": float(s[k_tors]),
+            "iterations": st.iterations,
+            "solveMs": st.solve_ms,
+            "clips": [
+                {
+                    "name": c.name,
+                    "s": c.s,
+                    "type": c.type,
+                    "length": c.length,
+                    "body": c.body,
+                    "force": st.reaction_force[j].tolist(),
+                    "moment": st.reaction_moment[j].tolist(),
+                }
+                for j, c in enumerate(spec.clips)
+            ],
+            "length": spec.length,
+        }
+        out["warning"] = strain_warning(live)
+        clearance = self.clearance(live)
+        if clearance is not None:
+            k = int(np.argmin(clearance))
+            out["minClearance"] = float(clearance[k])
+            out["minClearanceS"] = float(s[k])
+        return out
+
+    def state(self) -> dict:
+        """What the page draws: per cable the nodes, the clip poses, the colour values, the
+        figures and the last solve's message."""
+        with self.lock:
+            cables = {}
+            for name, live in self.cables.items():
+                frames = [quat_matrix(q) for q in live.clip_quaternions]
+                cables[name] = {
+                    "positions": live.state.positions.tolist(),
+                    "arcLength": live.arc_length.tolist(),
+                    "radius": live.radius,
+                    "clipPositions": live.clip_positions.tolist(),
+                    "clipFrames": [r.T.tolist() for r in frames],  # rows d1, d2, d3
+                    "values": self.node_values(live),
+                    "figures": self.figures(live),
+                    "message": live.message,
+                }
+            return {"cables": cables, "solves": self.solves, "undo": len(self.undo_stack)}
+
+    def geometry(self) -> dict:
+        """The bodies' meshes (global, at rest) and names, for the page (once)."""
+        if self.env is None:
+            return {"bodies": []}
+        out = []
+        for name, (v, f) in zip(self.env.bodies, self.env.display_meshes(), strict=True):
+            out.append(
+                {
+                    "name": name,
+                    "vertices": np.round(np.asarray(v, float), 6).ravel().tolist(),
+                    "faces": np.asarray(f, np.int64).ravel().tolist(),
+                }
+            )
+        return {"bodies": out}
+
+
+def strain_warning(live: LiveCable) -> str:
+    """A warning when the equilibrium's strains leave the model's validity range
+    (docs/solver.md), else ""."""
+    from types import SimpleNamespace
+
+    from cablelife import validity
+
+    st = live.state
+    c = SimpleNamespace(positions=st.positions[None], quaternions=st.quaternions[None],
+                        arc_length=live.arc_length)  # fmt: skip
+    axial, shear = validity.strains(c)
+    s = 0.5 * (live.arc_length[1:] + live.arc_length[:-1])
+    for name, v, limit in (("axial", axial[0], validity.AXIAL_STRAIN_LIMIT),
+                           ("shear", shear[0], validity.SHEAR_STRAIN_LIMIT)):  # fmt: skip
+        k = int(np.argmax(np.abs(v)))
+        if abs(v[k]) > limit:
+            return (
+                f"cable '{live.name}': {name} strain {100 * v[k]:.3g} % at s = {s[k]:.3f} m, "
+                f"outside the model's validity range (±{100 * limit:g} %): the clips stretch "
+                "the cable"
+            )
+    return ""
+
+
+def _tidy(v: float) -> float:
+    """A coordinate as written to TOML: rounded to 1e-12 (no 0.30000000000000004)."""
+    r = round(float(v), 12)
+    return 0.0 if r == 0 else r
+
+
+def _finite(v: float) -> float | None:
+    return float(v) if math.isfinite(v) else None
+
+
+def at_rest(scene: Scene) -> Scene:
+    """The scene with every body at rest (no motion): the pose the workbench shows."""
+    data = scene.model_dump(mode="json", exclude_none=True)
+    for body in data.get("bodies", []):
+        body["motion"] = []
+        body.pop("motion_file", None)
+    data["simulation"]["mode"] = "static"
+    return scene_from_dict(data, base_dir=scene.base_dir)
+
+
+def batch_equilibrium(scene: Scene, cable: str) -> np.ndarray:
+    """Node positions (N+1, 3) of a cold static solve by ``simulate`` of one cable of
+    ``scene`` with its bodies at rest: the reference the workbench's warm solves are checked
+    against."""
+    from cablelife.simulate import simulate
+
+    return simulate(at_rest(scene), mode="static").cables[cable].positions[0]

@@ -1,0 +1,525 @@
+/* cablelife workbench page: the scene in 3D (three.js r111, served by the workbench), clips
+   dragged with TransformControls, every move solved by the server (websocket), the cables
+   drawn as tubes coloured by a section quantity. Test hook: window.cablelifeWorkbench. */
+(function () {
+  "use strict";
+  var G = 12; // vertices around the tube
+  var STOPS = ["#30123b", "#4669db", "#26bce1", "#3ff393", "#c3f133", "#fca50a", "#e4460a", "#7a0403"];
+  var info = null, live = null, shown = null, playing = null;
+  var quantity = "bending";
+  var renderer, scene, camera, orbit, gizmo, dirty = true;
+  var tubes = {}, clipObjects = {}, bodyMeshes = {}, selected = null;
+  var ws, nextId = 1, waiting = {}, inflight = false, pending = null, dragMark = false, idleWaiters = [];
+  var updateTimes = [], frameTimes = [], lastSolveMs = 0;
+  var statusText = "";
+
+  function $(id) { return document.getElementById(id); }
+  function fmt(v, d) {
+    if (v === null || v === undefined) return "–";
+    return Math.abs(v) < 1e-9 ? "0" : Number(v).toPrecision(d || 4); // round-off shown as 0
+  }
+  function esc(s) { return String(s).replace(/[&<>"]/g, function (c) { return {"&": "&amp;", "<": "&lt;", ">": "&gt;", '"': "&quot;"}[c]; }); }
+
+  function showMessage(text, isError) {
+    var m = $("message");
+    m.textContent = text || "";
+    m.className = text ? (isError ? "" : "info") : "hidden";
+    m.style.background = isError ? "#fff0f0" : "#f0f7ff";
+    m.style.color = isError ? "#900" : "#124";
+  }
+
+  // ---------------------------------------------------------------- colours
+  function hexRgb(h) { return [parseInt(h.substr(1, 2), 16) / 255, parseInt(h.substr(3, 2), 16) / 255, parseInt(h.substr(5, 2), 16) / 255]; }
+  var RGB = STOPS.map(hexRgb);
+  function colour(t, out, k) {
+    t = Math.max(0, Math.min(1, isFinite(t) ? t : 1)) * (RGB.length - 1);
+    var i = Math.min(RGB.length - 2, Math.floor(t)), f = t - i;
+    for (var c = 0; c < 3; c++) out[k + c] = RGB[i][c] * (1 - f) + RGB[i + 1][c] * f;
+  }
+  // Value range of the quantity over every cable shown; reversed: small values red (limits).
+  function range(state) {
+    var lo = Infinity, hi = -Infinity;
+    Object.keys(state.cables).forEach(function (n) {
+      var v = state.cables[n].values[quantity];
+      if (!v) return;
+      v.forEach(function (x) { if (isFinite(x)) { lo = Math.min(lo, x); hi = Math.max(hi, x); } });
+    });
+    if (quantity === "bend_ratio") return {lo: 0, hi: 2, reverse: true}; // 1 (the rule) mid-scale
+    if (quantity === "clearance") return {lo: Math.min(0, lo), hi: Math.max(50, Math.min(hi, 200)), reverse: true};
+    if (!isFinite(lo)) { lo = 0; hi = 1; }
+    if (quantity === "torsion") { var a = Math.max(Math.abs(lo), Math.abs(hi), 1e-12); return {lo: -a, hi: a}; }
+    if (quantity === "bending") lo = 0;
+    if (hi - lo < 1e-12) hi = lo + 1e-12;
+    return {lo: lo, hi: hi};
+  }
+  function drawColourBar(r) {
+    var q = info.quantities[quantity];
+    $("cb-title").textContent = q.label + (q.unit ? " [" + q.unit + "]" : "") + (quantity === "bend_ratio" ? " (< 1 breaks the rule " + info.bendFactor + " × d)" : "");
+    var stops = r.reverse ? STOPS.slice().reverse() : STOPS;
+    $("cb-bar").style.background = "linear-gradient(to right," + stops.join(",") + ")";
+    $("cb-min").textContent = fmt(r.lo, 3);
+    $("cb-mid").textContent = fmt((r.lo + r.hi) / 2, 3);
+    $("cb-max").textContent = fmt(r.hi, 3) + (quantity === "bend_ratio" || quantity === "clearance" ? "+" : "");
+  }
+
+  // ---------------------------------------------------------------- 3D scene
+  function setup3d() {
+    var view = $("view");
+    renderer = new THREE.WebGLRenderer({antialias: true, preserveDrawingBuffer: true});
+    renderer.setPixelRatio(window.devicePixelRatio || 1);
+    renderer.setSize(view.clientWidth, view.clientHeight);
+    view.appendChild(renderer.domElement);
+    scene = new THREE.Scene();
+    scene.background = new THREE.Color(0xf4f5f7);
+    camera = new THREE.PerspectiveCamera(40, view.clientWidth / view.clientHeight, 0.001, 1000);
+    camera.up.set(0, 0, 1);
+    scene.add(new THREE.AmbientLight(0xffffff, 0.55));
+    var sun = new THREE.DirectionalLight(0xffffff, 0.6);
+    sun.position.set(1, -2, 3);
+    scene.add(sun);
+    var back = new THREE.DirectionalLight(0xffffff, 0.25);
+    back.position.set(-2, 1, -1);
+    scene.add(back);
+    orbit = new THREE.OrbitControls(camera, renderer.domElement);
+    orbit.addEventListener("change", function () { dirty = true; });
+    gizmo = new THREE.TransformControls(camera, renderer.domElement);
+    gizmo.setSize(0.8);
+    gizmo.addEventListener("change", function () { dirty = true; });
+    gizmo.addEventListener("dragging-changed", function (e) {
+      orbit.enabled = !e.value;
+      if (e.value) dragMark = true; else if (live) applyLive(live); // snap to the last good pose
+    });
+    gizmo.addEventListener("objectChange", function () {
+      if (!selected || !gizmo.dragging) return;
+      var o = clipObjects[selected.cable][selected.clip];
+      var move = {cable: selected.cable, clip: selected.clip, position: [o.position.x, o.position.y, o.position.z]};
+      if (gizmo.getMode() === "rotate") move.quaternion = [o.quaternion.w, o.quaternion.x, o.quaternion.y, o.quaternion.z];
+      queueMove(move);
+    });
+    scene.add(gizmo);
+    window.addEventListener("resize", function () {
+      renderer.setSize(view.clientWidth, view.clientHeight);
+      camera.aspect = view.clientWidth / view.clientHeight;
+      camera.updateProjectionMatrix();
+      dirty = true;
+    });
+    var ray = new THREE.Raycaster(), down = null;
+    renderer.domElement.addEventListener("pointerdown", function (e) { down = [e.clientX, e.clientY]; });
+    renderer.domElement.addEventListener("pointerup", function (e) {
+      if (!down || Math.abs(e.clientX - down[0]) + Math.abs(e.clientY - down[1]) > 4 || gizmo.dragging) return;
+      var r = renderer.domElement.getBoundingClientRect();
+      ray.setFromCamera({x: (e.clientX - r.left) / r.width * 2 - 1, y: -(e.clientY - r.top) / r.height * 2 + 1}, camera);
+      var handles = [];
+      Object.keys(clipObjects).forEach(function (c) { Object.keys(clipObjects[c]).forEach(function (k) { handles.push(clipObjects[c][k].userData.handle); }); });
+      var hit = ray.intersectObjects(handles)[0];
+      if (hit) select(hit.object.userData.cable, hit.object.userData.clip);
+    });
+    window.addEventListener("keydown", function (e) {
+      if (e.target.tagName === "INPUT" || e.target.tagName === "SELECT") return;
+      if (e.key === "w") setMode("translate");
+      if (e.key === "e") setMode("rotate");
+      if (e.key === "z" && (e.ctrlKey || e.metaKey)) undo();
+    });
+    (function loop(t) {
+      if (dirty) {
+        renderer.render(scene, camera);
+        dirty = false;
+        frameTimes.push(t);
+        if (frameTimes.length > 120) frameTimes.shift();
+      }
+      requestAnimationFrame(loop);
+    })(performance.now());
+  }
+
+  function addBodies(geometry) {
+    geometry.bodies.forEach(function (b) {
+      var g = new THREE.BufferGeometry();
+      g.setAttribute("position", new THREE.Float32BufferAttribute(b.vertices, 3));
+      g.setIndex(b.faces);
+      g.computeVertexNormals();
+      var m = new THREE.Mesh(g, new THREE.MeshLambertMaterial({color: 0x9aa3ad, transparent: true, opacity: 0.55, side: THREE.DoubleSide, depthWrite: false}));
+      m.name = "body:" + b.name;
+      m.matrixAutoUpdate = false;
+      bodyMeshes[b.name] = m;
+      scene.add(m);
+    });
+  }
+
+  function makeTube(name, n) {
+    var g = new THREE.BufferGeometry();
+    g.setAttribute("position", new THREE.BufferAttribute(new Float32Array(n * G * 3), 3));
+    g.setAttribute("color", new THREE.BufferAttribute(new Float32Array(n * G * 3), 3));
+    var idx = [];
+    for (var i = 0; i < n - 1; i++) for (var k = 0; k < G; k++) {
+      var a = i * G + k, b = i * G + (k + 1) % G, c = a + G, d = b + G;
+      idx.push(a, b, d, a, d, c);
+    }
+    g.setIndex(idx);
+    var m = new THREE.Mesh(g, new THREE.MeshLambertMaterial({vertexColors: THREE.VertexColors}));
+    m.name = "cable:" + name;
+    scene.add(m);
+    return m;
+  }
+
+  // Rings around the nodes in frames carried along the cable (parallel transport).
+  function updateTube(mesh, x, radius, values, r) {
+    var n = x.length, pos = mesh.geometry.attributes.position.array, col = mesh.geometry.attributes.color.array;
+    var t = new THREE.Vector3(), nrm = null, b = new THREE.Vector3(), tmp = new THREE.Vector3();
+    for (var i = 0; i < n; i++) {
+      var p = x[Math.min(i + 1, n - 1)], q = x[Math.max(i - 1, 0)];
+      t.set(p[0] - q[0], p[1] - q[1], p[2] - q[2]).normalize();
+      if (nrm === null) {
+        nrm = Math.abs(t.z) < 0.9 ? new THREE.Vector3(0, 0, 1) : new THREE.Vector3(1, 0, 0);
+      }
+      tmp.copy(t).multiplyScalar(nrm.dot(t));
+      nrm.sub(tmp);
+      if (nrm.lengthSq() < 1e-20) nrm.set(t.y, -t.x, 0);
+      nrm.normalize();
+      b.crossVectors(t, nrm);
+      var v = values ? values[i] : 0;
+      var s = (v - r.lo) / (r.hi - r.lo);
+      if (r.reverse) s = 1 - s;
+      for (var k = 0; k < G; k++) {
+        var a = 2 * Math.PI * k / G, ca = Math.cos(a) * radius, sa = Math.sin(a) * radius, o = (i * G + k) * 3;
+        pos[o] = x[i][0] + ca * nrm.x + sa * b.x;
+        pos[o + 1] = x[i][1] + ca * nrm.y + sa * b.y;
+        pos[o + 2] = x[i][2] + ca * nrm.z + sa * b.z;
+        colour(s, col, o);
+      }
+    }
+    mesh.geometry.attributes.position.needsUpdate = true;
+    mesh.geometry.attributes.color.needsUpdate = true;
+    mesh.geometry.computeVertexNormals();
+    mesh.geometry.computeBoundingSphere();
+  }
+
+  function makeClip(cable, clip, size) {
+    var grp = new THREE.Group();
+    var handle = new THREE.Mesh(new THREE.SphereBufferGeometry(size * 0.45, 16, 12), new THREE.MeshLambertMaterial({color: 0x333333}));
+    handle.userData = {cable: cable, clip: clip};
+    grp.add(handle);
+    grp.userData.handle = handle;
+    [[1, 0, 0, 0xd62728], [0, 1, 0, 0x2ca02c], [0, 0, 1, 0x1f77b4]].forEach(function (a) {
+      grp.add(new THREE.ArrowHelper(new THREE.Vector3(a[0], a[1], a[2]), new THREE.Vector3(), size * 2.2, a[3], size * 0.6, size * 0.35));
+    });
+    grp.name = "clip:" + cable + "/" + clip;
+    scene.add(grp);
+    return grp;
+  }
+
+  function setClipPose(o, p, rows) {
+    o.position.set(p[0], p[1], p[2]);
+    var m = new THREE.Matrix4().makeBasis(
+      new THREE.Vector3().fromArray(rows[0]), new THREE.Vector3().fromArray(rows[1]), new THREE.Vector3().fromArray(rows[2]));
+    o.quaternion.setFromRotationMatrix(m);
+  }
+
+  function fitCamera(state) {
+    var box = new THREE.Box3();
+    Object.keys(state.cables).forEach(function (n) {
+      state.cables[n].positions.forEach(function (p) { box.expandByPoint(new THREE.Vector3(p[0], p[1], p[2])); });
+    });
+    var c = box.getCenter(new THREE.Vector3()), size = box.getSize(new THREE.Vector3()).length() || 1;
+    orbit.target.copy(c);
+    camera.position.set(c.x + 0.45 * size, c.y - 1.5 * size, c.z + 0.8 * size);
+    camera.near = size / 1000; camera.far = size * 100;
+    camera.updateProjectionMatrix();
+    orbit.update();
+  }
+
+  // ---------------------------------------------------------------- state
+  function draw(state, withClips) {
+    var r = range(state);
+    Object.keys(state.cables).forEach(function (n) {
+      var c = state.cables[n];
+      if (!tubes[n]) tubes[n] = makeTube(n, c.positions.length);
+      updateTube(tubes[n], c.positions, c.radius, c.values[quantity], r);
+      if (withClips && c.clipPositions) {
+        c.figures.clips.forEach(function (k, j) {
+          var o = clipObjects[n][k.name];
+          if (!(gizmo.dragging && selected && selected.cable === n && selected.clip === k.name)) setClipPose(o, c.clipPositions[j], c.clipFrames[j]);
+        });
+      }
+    });
+    drawColourBar(r);
+    shown = state;
+    dirty = true;
+  }
+
+  function applyLive(state) {
+    live = state;
+    if (playing === null) draw(state, true);
+    panel(state);
+  }
+
+  function panel(state) {
+    var html = "";
+    Object.keys(state.cables).forEach(function (n) {
+      var c = state.cables[n], f = c.figures;
+      html += "<h2>cable " + esc(n) + "</h2>";
+      if (c.message) html += '<div class="bad">' + esc(c.message) + "</div>";
+      if (f.warning) html += '<div class="bad">' + esc(f.warning) + "</div>";
+      html += "<table>";
+      html += '<tr><td>length [m]</td><td class="num"><input type="number" step="0.01" data-cable="' + esc(n) + '" data-item="" data-key="length" value="' + f.length + '"></td></tr>';
+      var rb = f.minBendRadius === null ? "straight" : fmt(f.minBendRadius * 1e3, 3) + " mm at s = " + fmt(f.minBendRadiusS, 3) + " m";
+      var bad = f.minBendRadius !== null && f.minBendRadius < f.bendRule;
+      html += "<tr><td>min bend radius</td><td class=\"num" + (bad ? " bad" : "") + "\">" + rb + "</td></tr>";
+      html += '<tr><td>rule (' + info.bendFactor + ' × d)</td><td class="num">' + fmt(f.bendRule * 1e3, 3) + " mm</td></tr>";
+      html += '<tr><td>max tension</td><td class="num">' + fmt(f.maxTension, 3) + " N at s = " + fmt(f.maxTensionS, 3) + " m</td></tr>";
+      html += '<tr><td>max compression</td><td class="num">' + fmt(f.maxCompression, 3) + " N at s = " + fmt(f.maxCompressionS, 3) + " m</td></tr>";
+      html += '<tr><td>max |torsion|</td><td class="num">' + fmt(f.maxTorsion, 3) + " N m at s = " + fmt(f.maxTorsionS, 3) + " m</td></tr>";
+      if (f.minClearance !== undefined) html += '<tr><td>min clearance</td><td class="num' + (f.minClearance < 0 ? " bad" : "") + '">' + fmt(f.minClearance * 1e3, 3) + " mm at s = " + fmt(f.minClearanceS, 3) + " m</td></tr>";
+      html += '<tr><td>last solve</td><td class="num">' + fmt(f.solveMs, 2) + " ms, " + f.iterations + " iterations</td></tr>";
+      html += "</table><table><tr><th>clip</th><th>s [m]</th><th>type</th><th>length [m]</th><th>|F| [N]</th><th>|M| [N m]</th></tr>";
+      f.clips.forEach(function (k) {
+        var sel = selected && selected.cable === n && selected.clip === k.name;
+        var fn = Math.hypot.apply(null, k.force), mn = Math.hypot.apply(null, k.moment);
+        var opts = info.clipTypes.map(function (t) { return "<option" + (t === k.type ? " selected" : "") + ">" + t + "</option>"; }).join("");
+        var d = ' data-cable="' + esc(n) + '" data-item="' + esc(k.name) + '"';
+        html += '<tr class="clip' + (sel ? " sel" : "") + '"' + d + "><td>" + esc(k.name) + "</td>" +
+          '<td><input type="number" step="0.01"' + d + ' data-key="s" value="' + k.s + '" style="width:46px"></td>' +
+          "<td><select" + d + ' data-key="type">' + opts + "</select></td>" +
+          '<td><input type="number" step="0.005"' + d + ' data-key="length" value="' + k.length + '" style="width:46px"></td>' +
+          '<td class="num">' + fmt(fn, 3) + '</td><td class="num">' + fmt(mn, 3) + "</td></tr>";
+      });
+      html += "</table>";
+    });
+    var box = $("cables");
+    if (box.contains(document.activeElement) && document.activeElement.tagName === "INPUT") return; // typing
+    box.innerHTML = html;
+  }
+
+  // ---------------------------------------------------------------- server
+  function request(req) {
+    req.id = nextId++;
+    var entry = {};
+    entry.promise = new Promise(function (resolve, reject) {
+      entry.resolve = resolve; entry.reject = reject;
+      waiting[req.id] = entry;
+      ws.send(JSON.stringify(req));
+    });
+    entry.promise.catch(function () {}); // settled() waits for it; the caller sees the error
+    return entry.promise;
+  }
+
+  function onReply(msg) {
+    var w = waiting[msg.id];
+    delete waiting[msg.id];
+    if (msg.state) {
+      applyLive(msg.state);
+      if (msg.solveMs !== undefined) lastSolveMs = msg.solveMs;
+      var now = performance.now();
+      updateTimes.push(now);
+      if (updateTimes.length > 60) updateTimes.shift();
+      renderer.render(scene, camera); // on screen before the promise resolves
+      frameTimes.push(now);
+      dirty = false;
+    }
+    if (msg.ok === false || msg.error) showMessage(msg.error, msg.ok === false);
+    else if (msg.saved) showMessage("saved to " + msg.saved, false);
+    else showMessage("");
+    if (!w) return;
+    if (msg.ok === false && !msg.state) w.reject(new Error(msg.error));
+    else w.resolve(msg);
+  }
+
+  // One move in flight; while it is solved, later moves replace each other (the latest wins).
+  function queueMove(move) {
+    if (inflight) { pending = move; return; }
+    sendMove(move);
+  }
+  function sendMove(move) {
+    inflight = true;
+    var mark = dragMark; dragMark = false;
+    request({op: "move", moves: [move], mark: mark}).catch(function (e) { showMessage(e.message, true); }).then(function () {
+      inflight = false;
+      if (pending) { var p = pending; pending = null; sendMove(p); return; }
+      var done = idleWaiters; idleWaiters = [];
+      done.forEach(function (f) { f(); });
+    });
+  }
+
+  function select(cable, clip) {
+    selected = {cable: cable, clip: clip};
+    gizmo.attach(clipObjects[cable][clip]);
+    panel(live);
+    $("selected").innerHTML = "selected: cable <b>" + esc(cable) + "</b>, clip <b>" + esc(clip) + "</b> — drag the arrows (W: move, E: turn)";
+    dirty = true;
+  }
+  function setMode(m) {
+    gizmo.setMode(m);
+    $("mode-translate").className = m === "translate" ? "on" : "";
+    $("mode-rotate").className = m === "rotate" ? "on" : "";
+    dirty = true;
+  }
+  function undo() { return request({op: "undo"}); }
+
+  // ---------------------------------------------------------------- result file
+  function showClips(on) {
+    Object.keys(clipObjects).forEach(function (c) { Object.keys(clipObjects[c]).forEach(function (k) { clipObjects[c][k].visible = on; }); });
+    gizmo.visible = on && selected !== null;
+    if (!on) gizmo.detach(); else if (selected) gizmo.attach(clipObjects[selected.cable][selected.clip]);
+  }
+  // Bodies at a saved step: x = R X + t, rows of [R | t] (at rest without).
+  function poseBodies(poses) {
+    Object.keys(bodyMeshes).forEach(function (n) {
+      var p = poses[n], m = bodyMeshes[n].matrix;
+      if (p) m.set(p[0][0], p[0][1], p[0][2], p[0][3], p[1][0], p[1][1], p[1][2], p[1][3], p[2][0], p[2][1], p[2][2], p[2][3], 0, 0, 0, 1);
+      else m.identity();
+    });
+  }
+  function setupPlayer(r) {
+    if (!r) return;
+    $("player").className = "";
+    $("player-name").textContent = r.path + " (" + r.mode + ", " + r.steps + " steps)";
+    var slider = $("player-step"), timer = null;
+    slider.max = r.steps - 1;
+    function show(k) {
+      return fetch("/api/result/" + k).then(function (x) { return x.json(); }).then(function (d) {
+        playing = k;
+        showClips(false);
+        poseBodies(d.bodies || {});
+        $("player-time").textContent = "t = " + fmt(d.time, 4) + " s (step " + k + ")";
+        draw(d, false);
+        renderer.render(scene, camera);
+        return d;
+      });
+    }
+    slider.addEventListener("input", function () { show(+slider.value); });
+    $("player-play").addEventListener("click", function () {
+      if (timer) { clearInterval(timer); timer = null; $("player-play").textContent = "play"; return; }
+      $("player-play").textContent = "pause";
+      var busy = false;
+      timer = setInterval(function () {
+        if (busy) return;
+        busy = true;
+        var k = (+slider.value + 1) % r.steps;
+        slider.value = k;
+        show(k).then(function () { busy = false; });
+      }, 1000 / 25);
+    });
+    $("player-live").addEventListener("click", function () {
+      if (timer) { clearInterval(timer); timer = null; $("player-play").textContent = "play"; }
+      playing = null; $("player-time").textContent = ""; showClips(true); poseBodies({}); draw(live, true);
+    });
+    // test hook: show saved step k of the result; resolves when drawn, with its nodes
+    window.cablelifeWorkbench.showResultStep = function (k) {
+      slider.value = k;
+      return show(k).then(function (d) {
+        var out = {time: d.time, cables: {}};
+        Object.keys(d.cables).forEach(function (n) { out.cables[n] = {positions: d.cables[n].positions}; });
+        return out;
+      });
+    };
+  }
+
+  // ---------------------------------------------------------------- start
+  function start() {
+    fetch("/api/scene").then(function (r) { return r.json(); }).then(function (d) {
+      info = d;
+      $("scene-name").textContent = d.scene;
+      var sel = $("quantity");
+      Object.keys(d.quantities).forEach(function (k) {
+        if (k === "clearance" && d.geometry.bodies.length === 0) return;
+        var o = document.createElement("option");
+        o.value = k; o.textContent = d.quantities[k].label;
+        sel.appendChild(o);
+      });
+      sel.value = quantity;
+      sel.addEventListener("change", function () { quantity = sel.value; draw(shown, playing === null); });
+      setup3d();
+      addBodies(d.geometry);
+      var st = d.state;
+      Object.keys(st.cables).forEach(function (n) {
+        clipObjects[n] = {};
+        var c = st.cables[n], size = Math.max(c.radius * 2.5, 0.004);
+        c.figures.clips.forEach(function (k) { clipObjects[n][k.name] = makeClip(n, k.name, size); });
+      });
+      fitCamera(st);
+      applyLive(st);
+      $("mode-translate").onclick = function () { setMode("translate"); };
+      $("mode-rotate").onclick = function () { setMode("rotate"); };
+      $("undo").onclick = undo;
+      $("save").onclick = function () { request({op: "save"}); };
+      $("cables").addEventListener("change", function (e) {
+        var t = e.target, key = t.dataset.key;
+        if (!key) return;
+        var value = key === "type" ? t.value : parseFloat(t.value);
+        request({op: "edit", cable: t.dataset.cable, item: t.dataset.item, key: key, value: value}).catch(function (err) {
+          showMessage(err.message, true); panel(live);
+        });
+      });
+      $("cables").addEventListener("click", function (e) {
+        var tr = e.target.closest("tr.clip");
+        if (tr && e.target.tagName !== "INPUT" && e.target.tagName !== "SELECT") select(tr.dataset.cable, tr.dataset.item);
+      });
+      setupPlayer(d.result);
+      var first = Object.keys(st.cables)[0];
+      var clips = st.cables[first].figures.clips;
+      select(first, clips[clips.length - 1].name);
+      document.body.dataset.ready = "yes";
+    }).catch(function (e) { showMessage("cannot load the scene: " + e.message, true); document.body.dataset.ready = "failed"; });
+  }
+
+  function rate(times) {
+    var now = performance.now(), recent = times.filter(function (t) { return now - t < 2000; });
+    if (recent.length < 2) return 0;
+    return (recent.length - 1) / ((recent[recent.length - 1] - recent[0]) / 1000);
+  }
+
+  window.cablelifeWorkbench = {
+    moveClip: function (cable, clip, xyz) {
+      return request({op: "move", moves: [{cable: cable, clip: clip, position: xyz}], mark: true}).then(function (msg) {
+        if (msg.ok === false) throw new Error(msg.error);
+        return {solveMs: msg.solveMs};
+      });
+    },
+    // several clips at once, one update (as dragging a bracket that holds them): [[cable, clip, xyz], ...]
+    moveClips: function (list) {
+      var moves = list.map(function (m) { return {cable: m[0], clip: m[1], position: m[2]}; });
+      return request({op: "move", moves: moves, mark: true}).then(function (msg) {
+        if (msg.ok === false) throw new Error(msg.error);
+        return {solveMs: msg.solveMs};
+      });
+    },
+    // resolves when the moves of a mouse drag are all solved and drawn, and every other request answered
+    settled: function () {
+      var open = Object.keys(waiting).map(function (k) { return waiting[k].promise.catch(function () { return null; }); });
+      var moves = inflight || pending ? new Promise(function (r) { idleWaiters.push(r); }) : Promise.resolve();
+      return Promise.all([moves].concat(open)).then(function () { return true; });
+    },
+    state: function () {
+      var out = {cables: {}};
+      if (!live) return out;
+      Object.keys(live.cables).forEach(function (n) { out.cables[n] = {positions: live.cables[n].positions}; });
+      return out;
+    },
+    stats: function () {
+      return {solvesPerSecond: rate(updateTimes), lastSolveMs: lastSolveMs, framesPerSecond: rate(frameTimes)};
+    },
+    save: function (path) { return request({op: "save", path: path || null}); },
+    undo: undo,
+    edit: function (cable, item, key, value) { return request({op: "edit", cable: cable, item: item, key: key, value: value}); },
+    setQuantity: function (q) { quantity = q; $("quantity").value = q; draw(shown, playing === null); renderer.render(scene, camera); },
+    select: select,
+    // the clip's pose as drawn (and as a turn sends it): position, quaternion [w, x, y, z]
+    clipPose: function (cable, clip) {
+      var o = clipObjects[cable][clip];
+      return {position: o.position.toArray(), quaternion: [o.quaternion.w, o.quaternion.x, o.quaternion.y, o.quaternion.z]};
+    },
+    // where a clip is on the page (CSS px), to drag it with the mouse in tests
+    clipOnScreen: function (cable, clip) {
+      var v = clipObjects[cable][clip].position.clone().project(camera), r = renderer.domElement.getBoundingClientRect();
+      return [r.left + (v.x + 1) / 2 * r.width, r.top + (1 - v.y) / 2 * r.height];
+    },
+  };
+
+  ws = new WebSocket("ws://" + location.host + "/ws");
+  ws.onmessage = function (e) { onReply(JSON.parse(e.data)); };
+  ws.onclose = function () {
+    showMessage("the workbench server has stopped (restart `cablelife workbench`)", true);
+    Object.keys(waiting).forEach(function (k) { waiting[k].reject(new Error("the workbench server has stopped")); });
+    waiting = {};
+  };
+  ws.onopen = start;
+})();

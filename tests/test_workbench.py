@@ -1,0 +1,539 @@
+"""The workbench (docs/workbench.md): warm static solves of dragged clips equal cold batch
+solves of the same pose; edits, undo and saving back to TOML; bad requests; the page in
+headless Chromium driven through its test hook; Ctrl-C."""
+
+from __future__ import annotations
+
+import os
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+from cablelife.scene import SceneError, load_scene, scene_from_dict
+from cablelife.workbench.session import Session, WorkbenchError, batch_equilibrium
+
+ROOT = Path(__file__).resolve().parents[1]
+EXAMPLE = ROOT / "examples" / "hose-three-clips.toml"
+CLIP = "engine-bracket"  # on the engine body, global frame, at s = 1 (the cable's end)
+START = np.array([0.75, 0.25, 0.0])
+
+
+def path_points(n: int = 50) -> np.ndarray:
+    """A drag path of the bracket clip: a quarter circle of 4 cm up and sideways, then back
+    half way (the warm start follows a path, not a jump)."""
+    a = np.linspace(0.0, np.pi / 2, n)
+    return START + 0.04 * np.column_stack([np.zeros(n), 1 - np.cos(a), np.sin(a)])
+
+
+@pytest.fixture
+def scene_copy(tmp_path):
+    target = tmp_path / "scene.toml"
+    shutil.copy(EXAMPLE, target)
+    return target
+
+
+def clip_node(session: Session, cable: str, clip: str) -> int:
+    live = session.cables[cable]
+    s = next(c.s for c in session.cable_spec(cable).clips if c.name == clip)
+    return int(np.argmin(np.abs(live.arc_length - s)))
+
+
+def edited_scene(session: Session):
+    return scene_from_dict(session.doc.unwrap(), base_dir=session.path.parent.resolve())
+
+
+def test_dragged_clip_equilibrium_equals_batch_solve(scene_copy):
+    session = Session.open(scene_copy)
+    node = clip_node(session, "hose", CLIP)
+    for p in path_points(20):
+        errors = session.move_clips([{"cable": "hose", "clip": CLIP, "position": p.tolist()}])
+        assert errors == {"hose": ""}
+        x = session.cables["hose"].state.positions
+        np.testing.assert_allclose(x[node], p, atol=1e-12)
+    ref = batch_equilibrium(edited_scene(session), "hose")
+    assert np.abs(session.cables["hose"].state.positions - ref).max() < 1e-9
+    # the path changed the shape: the check above compares two different equilibria otherwise
+    first = batch_equilibrium(load_scene(EXAMPLE), "hose")
+    assert np.abs(ref - first).max() > 0.02
+
+
+def test_turning_a_clip_is_a_batch_pose_too(scene_copy):
+    session = Session.open(scene_copy)
+    from cablelife.rotations import matrix_quaternions
+    from cablelife.simulate import frame_matrix
+
+    turn = 0.3  # rad about the global z axis
+    rz = np.array([[np.cos(turn), -np.sin(turn), 0], [np.sin(turn), np.cos(turn), 0], [0, 0, 1]])
+    frame = rz @ frame_matrix([1.0, 0.0, 0.0], [0.0, 0.0, 1.0])  # columns d1, d2, d3
+    q = matrix_quaternions(frame[None])[0].tolist()
+    session.move_clips([{"cable": "hose", "clip": CLIP, "position": START.tolist(),
+                         "quaternion": q}])  # fmt: skip
+    clip = session.cable_spec("hose").clips[2]
+    np.testing.assert_allclose(clip.direction, [np.cos(turn), np.sin(turn), 0.0], atol=1e-12)
+    np.testing.assert_allclose(clip.normal, [0.0, 0.0, 1.0], atol=1e-12)
+    ref = batch_equilibrium(edited_scene(session), "hose")
+    assert np.abs(session.cables["hose"].state.positions - ref).max() < 1e-9
+
+
+def test_failed_solve_keeps_the_last_good_state(scene_copy):
+    session = Session.open(scene_copy)
+    before = session.cables["hose"].state.positions.copy()
+    text = session.scene_text()
+    # the 1 m hose's end pulled 5 km away: Newton does not converge, even sub-stepped
+    errors = session.move_clips([{"cable": "hose", "clip": CLIP, "position": [5000.0, 0, 0]}])
+    assert "cable 'hose': no equilibrium at the new clip pose" in errors["hose"]
+    assert np.array_equal(session.cables["hose"].state.positions, before)
+    assert session.scene_text() == text  # the clip stays where it was
+    np.testing.assert_allclose(session.cables["hose"].clip_positions[2], START)
+    # and the session goes on
+    assert session.move_clips([{"cable": "hose", "clip": CLIP, "position": [0.75, 0.26, 0]}]) \
+        == {"hose": ""}  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    ("move", "expected"),
+    [
+        ({"cable": "pipe", "clip": CLIP, "position": [0, 0, 0]},
+         "cable 'pipe' is not in the scene; allowed: 'hose'"),
+        ({"cable": "hose", "clip": "top", "position": [0, 0, 0]},
+         "cable 'hose' has no clip 'top'; allowed: 'body-clip', 'middle', 'engine-bracket'"),
+        ({"cable": "hose", "clip": CLIP, "position": [0, "a", 0]},
+         "position = [0, 'a', 0]: give three numbers"),
+        ({"cable": "hose", "clip": CLIP, "position": [0, float("nan"), 0]},
+         "allowed: finite coordinates"),
+        ({"cable": "hose", "clip": CLIP, "position": [0, 0, 0], "quaternion": [0, 0, 0, 0]},
+         "quaternion = [0.0, 0.0, 0.0, 0.0]: give a non-zero [w, x, y, z]"),
+    ],
+)  # fmt: skip
+def test_bad_moves_are_refused_by_name(scene_copy, move, expected):
+    session = Session.open(scene_copy)
+    with pytest.raises(WorkbenchError, match=None) as err:
+        session.move_clips([move])
+    assert expected in str(err.value)
+    assert session.undo_stack == []
+
+
+def test_edits_rebuild_the_cable_and_undo_restores(scene_copy):
+    session = Session.open(scene_copy)
+    session.edit("hose", "middle", "s", 0.45)
+    session.edit("hose", "middle", "type", "ball")
+    session.edit("hose", "", "length", 1.05)
+    spec = session.cable_spec("hose")
+    assert (spec.length, spec.clips[1].s, spec.clips[1].type) == (1.05, 0.45, "ball")
+    assert np.isclose(session.cables["hose"].arc_length[-1], 1.05)
+    ref = batch_equilibrium(edited_scene(session), "hose")
+    assert np.abs(session.cables["hose"].state.positions - ref).max() < 1e-9
+    for _ in range(3):
+        assert session.undo()
+    assert not session.undo()
+    assert session.scene_text() == EXAMPLE.read_text()
+    assert session.cable_spec("hose").clips[1].type == "swivel"
+
+
+@pytest.mark.parametrize(
+    ("args", "expected"),
+    [
+        (("hose", "middle", "type", "glued"),
+         "clip 'middle': type = 'glued'; allowed: fixed, swivel, ball"),
+        (("hose", "middle", "s", "far"), "s = 'far'; give a number in m"),
+        (("hose", "middle", "colour", 1), "'colour' cannot be edited here; allowed: s, type"),
+        (("hose", "", "length", 0.5), "covers s = [1.0, 1.0] m, outside the cable [0, 0.5] m"),
+        (("hose", "middle", "s", 1.5), "covers s = [1.5, 1.5] m, outside the cable"),
+    ],
+)  # fmt: skip
+def test_bad_edits_change_nothing(scene_copy, args, expected):
+    session = Session.open(scene_copy)
+    text = session.scene_text()
+    x = session.cables["hose"].state.positions.copy()
+    with pytest.raises((WorkbenchError, SceneError)) as err:
+        session.edit(*args)
+    assert expected in str(err.value)
+    assert session.scene_text() == text and session.undo_stack == []
+    assert np.array_equal(session.cables["hose"].state.positions, x)
+
+
+def test_save_round_trips_and_keeps_comments(scene_copy, tmp_path):
+    session = Session.open(scene_copy)
+    target = path_points(5)[-1]
+    session.move_clips([{"cable": "hose", "clip": CLIP, "position": target.tolist()}])
+    session.edit("hose", "middle", "length", 0.03)
+    out = session.save(tmp_path / "edited.toml")
+    text = out.read_text()
+    for comment in ("# The engine rocks: 5 mm vertical sine", "# the clip centre: it holds"):
+        assert comment in text
+    again = load_scene(out)
+    clip = again.cables[0].clips[2]
+    np.testing.assert_allclose(clip.position, target, atol=1e-12)
+    assert again.cables[0].clips[1].length == 0.03
+    # the saved scene solves to what the workbench showed
+    ref = batch_equilibrium(again, "hose")
+    assert np.abs(session.cables["hose"].state.positions - ref).max() < 1e-9
+    with pytest.raises(WorkbenchError, match="give a .toml file"):
+        session.save(tmp_path / "edited.txt")
+
+
+def test_body_frame_clip_moves_in_global_coordinates(tmp_path):
+    text = EXAMPLE.read_text().replace(
+        'body = "engine"\nposition = [0.75, 0.25, 0.0]',
+        'body = "engine"\nframe = "body"\nposition = [0.15, 0.05, 0.0]',
+    )
+    text = text.replace(
+        "origin = [0.6, 0.2, 0.0]", "origin = [0.6, 0.2, 0.0]\norientation = [0.0, 0.0, 0.3]"
+    )
+    path = tmp_path / "body.toml"
+    path.write_text(text)
+    session = Session.open(path)
+    goal = np.array([0.74, 0.3, 0.02])
+    assert session.move_clips([{"cable": "hose", "clip": CLIP, "position": goal.tolist()}]) \
+        == {"hose": ""}  # fmt: skip
+    node = clip_node(session, "hose", CLIP)
+    np.testing.assert_allclose(session.cables["hose"].state.positions[node], goal, atol=1e-12)
+    ref = batch_equilibrium(edited_scene(session), "hose")
+    assert np.abs(session.cables["hose"].state.positions - ref).max() < 1e-9
+
+
+def test_state_has_the_panel_figures(scene_copy):
+    session = Session.open(scene_copy)
+    st = session.state()["cables"]["hose"]
+    f = st["figures"]
+    n = len(st["positions"])
+    assert set(st["values"]) == {"bending", "torsion", "tension", "bend_ratio"}
+    assert all(len(v) == n for v in st["values"].values())
+    assert [c["name"] for c in f["clips"]] == ["body-clip", "middle", "engine-bracket"]
+    live = session.cables["hose"]
+    m = live.state.moments
+    kappa = np.hypot(m[:, 0] / live.stiffness[0], m[:, 1] / live.stiffness[1])
+    assert np.isclose(f["minBendRadius"], 1 / kappa.max())
+    assert np.isclose(f["bendRule"], 10 * 2 * 0.008)
+    np.testing.assert_allclose(f["clips"][0]["force"], live.state.reaction_force[0])
+
+
+def test_clearance_with_surroundings():
+    pytest.importorskip("trimesh")
+    scene = ROOT / "examples" / "surroundings" / "hose-near-engine.toml"
+    if not (scene.parent / "engine.stl").exists():
+        pytest.skip("example meshes not generated")
+    session = Session.open(scene)
+    st = session.state()["cables"]["hose"]
+    geo = session.geometry()
+    assert [b["name"] for b in geo["bodies"]] == ["engine", "car-body"]
+    c = np.array(st["values"]["clearance"]) / 1e3
+    from cablelife.simulate import simulate
+    from cablelife.workbench.session import at_rest
+
+    ref = simulate(at_rest(session.scene), mode="static").cables["hose"].clearance[0]
+    np.testing.assert_allclose(c, ref, atol=1e-9)
+    assert np.isclose(st["figures"]["minClearance"], ref.min())
+
+
+# ----------------------------------------------------------------------- in the browser
+
+
+def _browser():
+    from cablelife.report.browser import find_browser
+
+    if find_browser() is None:
+        pytest.skip("chromium not installed")
+
+
+def test_page_follows_a_dragged_clip(scene_copy, tmp_path):
+    """50 moveClip calls along a path: after each the clip's node is where the clip went; the
+    last equilibrium equals a batch solve of that pose; the update rate is printed."""
+    _browser()
+    import time
+
+    from cablelife.simulate import build_cable
+    from cablelife.workbench.drive import run_page, stop_time, workbench_process
+
+    points = path_points(50)
+    scene0 = load_scene(scene_copy)
+    arc = np.asarray(build_cable(scene0, scene0.cables[0]).arc_length)
+    node = int(np.argmin(np.abs(arc - 1.0)))
+    shots = Path(os.environ.get("CABLELIFE_SCREENSHOTS", tmp_path))
+
+    async def script(page):
+        poses = [await page.call(f"clipPose('hose', '{c}')") for c in
+                 ("body-clip", "middle", CLIP)]  # fmt: skip
+        seen = []
+        t0 = time.perf_counter()
+        for p in points:
+            await page.call(f"moveClip('hose', '{CLIP}', {p.tolist()})")
+            seen.append(np.array((await page.call("state()"))["cables"]["hose"]["positions"]))
+        wall = time.perf_counter() - t0
+        stats = await page.call("stats()")
+        await page.call("setQuantity('bend_ratio')")
+        shot = await page.screenshot(shots / "workbench.png")
+        bad = await page.call("moveClip('hose', 'nowhere', [0, 0, 0])")
+        bad_cable = await page.call(f"moveClip('pipe', '{CLIP}', [0, 0, 0])")
+        message = await page.text("message")
+        failed = await page.call(f"moveClip('hose', '{CLIP}', [5000, 0, 0])")
+        after = np.array((await page.call("state()"))["cables"]["hose"]["positions"])
+        saved = await page.call(f"save({str(tmp_path / 'saved.toml')!r})")
+        return poses, seen, wall, stats, bad, bad_cable, message, failed, after, shot, saved
+
+    with workbench_process(scene_copy) as (proc, url):
+        poses, seen, wall, stats, bad, bad_cable, message, failed, after, shot, saved = run_page(
+            url, script
+        )
+        stopped_s, code = stop_time(proc)
+    print(f"\nworkbench: 50 moveClip calls in {wall:.2f} s = {50 / wall:.1f} updates/s "
+          f"(page stats {stats}); Ctrl-C stopped it in {stopped_s:.2f} s")  # fmt: skip
+    # the clip frames are drawn (and a turn is sent) with the scene's orientation
+    from cablelife.simulate import clip_poses
+
+    pos, quat = clip_poses(scene0, scene0.cables[0], np.array([0.0]), with_motion=False)
+    for j, pose in enumerate(poses):
+        np.testing.assert_allclose(pose["position"], pos[0, j], atol=1e-12)
+        q = np.array(pose["quaternion"])
+        assert min(np.abs(q - quat[0, j]).max(), np.abs(q + quat[0, j]).max()) < 1e-7
+    for p, x in zip(points, seen, strict=True):
+        np.testing.assert_allclose(x[node], p, atol=1e-12)
+    assert set(stats) == {"solvesPerSecond", "lastSolveMs", "framesPerSecond"}
+    assert stats["solvesPerSecond"] > 0 and stats["lastSolveMs"] > 0
+    # the page shows what a cold batch solve of the final pose gives
+    edited = load_scene(tmp_path / "saved.toml")
+    np.testing.assert_allclose(edited.cables[0].clips[2].position, points[-1], atol=1e-12)
+    assert np.abs(seen[-1] - batch_equilibrium(edited, "hose")).max() < 1e-9
+    assert saved["ok"] and saved["saved"] == str(tmp_path / "saved.toml")
+    assert "# The engine rocks" in (tmp_path / "saved.toml").read_text()
+    # bad input: a clear error, the state kept
+    assert bad == {
+        "error": "cable 'hose' has no clip 'nowhere'; allowed: 'body-clip', 'middle', "
+        "'engine-bracket'"
+    }
+    assert bad_cable == {"error": "cable 'pipe' is not in the scene; allowed: 'hose'"}
+    assert "cable 'pipe' is not in the scene" in message
+    # a failed solve: its reason, the last good state kept
+    assert "cable 'hose': no equilibrium at the new clip pose" in failed["error"]
+    assert np.array_equal(after, seen[-1])
+    assert shot.stat().st_size > 20_000
+    assert code == 130  # Ctrl-C
+
+
+def test_workbench_command_errors(tmp_path):
+    from cablelife.cli import app
+    from typer.testing import CliRunner
+
+    runner = CliRunner()
+    r = runner.invoke(app, ["workbench", str(tmp_path / "none.toml"), "--no-browser"])
+    assert r.exit_code == 2 and "does not exist" in r.output
+    r = runner.invoke(app, ["workbench", str(EXAMPLE), "--port", "70000"])
+    assert r.exit_code == 2 and "--port 70000" in r.output
+    r = runner.invoke(app, ["workbench", str(EXAMPLE), "--result", str(EXAMPLE)])
+    assert r.exit_code == 2 and "--result" in r.output
+    import socket
+
+    with socket.socket() as taken:
+        taken.bind(("127.0.0.1", 0))
+        taken.listen()
+        port = taken.getsockname()[1]
+        r = runner.invoke(app, ["workbench", str(EXAMPLE), "--no-browser", "--port", str(port)])
+    assert r.exit_code == 2 and f"cannot listen on 127.0.0.1:{port}" in r.output
+
+
+@pytest.fixture(scope="module")
+def near_engine_run(tmp_path_factory):
+    """A quasistatic run of the surroundings example (1 s), saved."""
+    from cablelife.simulate import simulate
+
+    scene = ROOT / "examples" / "surroundings" / "hose-near-engine.toml"
+    if not (scene.parent / "engine.stl").exists():
+        pytest.skip("example meshes not generated")
+    sc = load_scene(scene)
+    sc.simulation.duration = 1.0
+    sc.simulation.time_step = 0.05
+    path = tmp_path_factory.mktemp("run") / "run.h5"
+    simulate(sc, mode="quasistatic").save(path)
+    return scene, path
+
+
+def test_player_gives_the_saved_steps(near_engine_run):
+    from cablelife.results import load_result
+    from cablelife.workbench.player import Player
+
+    _, path = near_engine_run
+    player = Player.open(path)
+    res = load_result(path)
+    c = res.cables["hose"]
+    assert player.info()["steps"] == c.n_steps == 21
+    k = 7
+    d = player.step(k)
+    assert d["time"] == pytest.approx(c.time[k])
+    np.testing.assert_allclose(d["cables"]["hose"]["positions"], c.positions[k])
+    np.testing.assert_allclose(d["cables"]["hose"]["values"]["clearance"], c.clearance[k] * 1e3)
+    m = c.moments[k]
+    np.testing.assert_allclose(d["cables"]["hose"]["values"]["bending"], np.hypot(m[:, 0], m[:, 1]))
+    geo = res.surroundings
+    assert set(d["bodies"]) == {"engine", "car-body"}
+    np.testing.assert_allclose(d["bodies"]["engine"], geo.poses[0, k])
+    with pytest.raises(IndexError, match="step 21: the result has steps 0 … 20"):
+        player.step(21)
+    with pytest.raises(WorkbenchError, match="--result"):
+        Player.open(ROOT / "examples" / "hose-three-clips.toml")
+
+
+def test_page_plays_a_result_file_with_the_surroundings(near_engine_run, tmp_path):
+    """The surroundings example with its bodies' geometry, coloured by clearance; a result
+    file scrubbed step by step (the page draws the saved nodes)."""
+    _browser()
+    from cablelife.results import load_result
+    from cablelife.workbench.drive import run_page, workbench_process
+
+    scene, path = near_engine_run
+    shots = Path(os.environ.get("CABLELIFE_SCREENSHOTS", tmp_path))
+    positions = load_result(path).cables["hose"].positions
+
+    async def script(page):
+        await page.call("setQuantity('clearance')")
+        live = await page.screenshot(shots / "workbench-clearance.png")
+        bodies = await page.cdp.evaluate("document.querySelector('#quantity').options.length")
+        steps = [await page.call(f"showResultStep({k})") for k in (0, 5, 20)]
+        label = await page.text("player-time")
+        await page.call("setQuantity('bending')")
+        played = await page.screenshot(shots / "workbench-result.png")
+        return live, bodies, steps, label, played
+
+    with workbench_process(scene, "--result", str(path)) as (_, url):
+        live, options, steps, label, played = run_page(url, script)
+    assert options == 5  # clearance offered: the scene has geometry
+    for k, d in zip((0, 5, 20), steps, strict=True):
+        np.testing.assert_allclose(d["cables"]["hose"]["positions"], positions[k])
+    assert label == "t = 1.000 s (step 20)"
+    assert live.stat().st_size > 20_000 and played.stat().st_size > 20_000
+
+
+def test_mouse_drag_of_a_clip_is_one_undo_step(scene_copy):
+    """A drag with the mouse on the clip's handle (TransformControls): the cable follows
+    while dragging, its end node stays on the clip, and one undo restores the start."""
+    _browser()
+
+    from cablelife.workbench.drive import run_page, workbench_process
+
+    async def script(page):
+        x0 = np.array((await page.call("state()"))["cables"]["hose"]["positions"])
+        x, y = await page.call(f"clipOnScreen('hose', '{CLIP}')")
+        mouse = page.cdp.call
+        await mouse("Input.dispatchMouseEvent", type="mouseMoved", x=x, y=y)
+        await mouse("Input.dispatchMouseEvent", type="mousePressed", x=x, y=y, button="left",
+                    clickCount=1)  # fmt: skip
+        during = []
+        for k in range(1, 21):
+            await mouse("Input.dispatchMouseEvent", type="mouseMoved", x=x - 3 * k, y=y + 2 * k,
+                        button="left", buttons=1)  # fmt: skip
+            await page.call("settled()")  # still pressed: the cable answered this pose
+            during.append(np.array((await page.call("state()"))["cables"]["hose"]["positions"]))
+        await mouse("Input.dispatchMouseEvent", type="mouseReleased", x=x - 60, y=y + 40,
+                    button="left", clickCount=1)  # fmt: skip
+        await page.call("settled()")  # the drag's last pose solved and drawn
+        x1 = np.array((await page.call("state()"))["cables"]["hose"]["positions"])
+        await page.call("undo()")
+        x2 = np.array((await page.call("state()"))["cables"]["hose"]["positions"])
+        return x0, during, x1, x2
+
+    with workbench_process(scene_copy) as (_, url):
+        x0, during, x1, x2 = run_page(url, script)
+    shapes = {round(float(d[-1][1]), 9) for d in during}
+    assert len(shapes) > 3  # updates arrived while dragging
+    assert np.linalg.norm(x1[-1] - x0[-1]) > 0.02
+    assert np.array_equal(x2, x0)  # one drag, one undo step
+
+
+def test_server_listens_on_loopback_and_refuses_foreign_pages(scene_copy):
+    """Without a browser: the scene JSON over HTTP, a move over the websocket, and a
+    websocket from another site's page refused."""
+    import asyncio
+    import json
+    import urllib.request
+
+    from cablelife.workbench.server import listen, make_app
+    from tornado.httpclient import HTTPClientError, HTTPRequest
+    from tornado.websocket import websocket_connect
+
+    session = Session.open(scene_copy)
+
+    async def main():
+        server, port = listen(make_app(session))
+        try:
+            assert server._sockets and all(
+                s.getsockname()[0] == "127.0.0.1" for s in server._sockets.values()
+            )
+            loop = asyncio.get_running_loop()
+            url = f"http://127.0.0.1:{port}"
+            info = await loop.run_in_executor(
+                None, lambda: json.load(urllib.request.urlopen(f"{url}/api/scene"))
+            )
+            ws = await websocket_connect(HTTPRequest(f"ws://127.0.0.1:{port}/ws",
+                                                     headers={"Origin": url}))  # fmt: skip
+            await ws.write_message(json.dumps({"id": 7, "op": "move", "moves": [
+                {"cable": "hose", "clip": CLIP, "position": [0.75, 0.27, 0.01]}]}))  # fmt: skip
+            reply = json.loads(await ws.read_message())
+            await ws.write_message(json.dumps({"id": 8, "op": "fly"}))
+            bad = json.loads(await ws.read_message())
+            await ws.write_message(json.dumps({"id": 9, "op": "move", "moves": [1]}))
+            bad_moves = json.loads(await ws.read_message())
+            await ws.write_message("[1, 2")
+            not_json = json.loads(await ws.read_message())
+            ws.close()
+            refused = None
+            try:
+                foreign = {"Origin": "http://evil.example"}
+                await websocket_connect(HTTPRequest(f"ws://127.0.0.1:{port}/ws", headers=foreign))
+            except HTTPClientError as err:
+                refused = err.code
+            return info, reply, bad, bad_moves, not_json, refused
+        finally:
+            server.stop()
+
+    info, reply, bad, bad_moves, not_json, refused = asyncio.run(main())
+    session.close()
+    assert info["state"]["cables"]["hose"]["figures"]["clips"][2]["name"] == CLIP
+    assert reply["id"] == 7 and reply["ok"] and reply["solveMs"] > 0
+    assert reply["state"]["cables"]["hose"]["positions"][-1] == [0.75, 0.27, 0.01]
+    assert bad == {"id": 8, "ok": False,
+                   "error": "op = 'fly'; allowed: move, edit, undo, save, state"}  # fmt: skip
+    assert bad_moves["ok"] is False
+    assert bad_moves["error"] == "move: moves = [1]; give [{cable, clip, position}, ...]"
+    assert not_json == {"ok": False, "error": "a request must be a JSON object"}
+    assert refused == 403
+
+
+def test_panel_edit_and_undo_buttons(scene_copy):
+    """Typing a clip's s in the side panel re-solves the cable (a new mesh); the undo
+    button restores it; a refused value shows the validator's message."""
+    _browser()
+
+    from cablelife.workbench.drive import run_page, workbench_process
+
+    set_input = (
+        '(() => {{ const e = document.querySelector(\'input[data-item="middle"]'
+        "[data-key=\"s\"]'); e.value = '{0}'; e.dispatchEvent(new Event('change', "
+        "{{bubbles: true}})); }})()"
+    )
+
+    async def script(page):
+        async def settle():
+            await page.call("settled()")  # every request answered and drawn
+            return await page.cdp.evaluate(
+                'document.querySelector(\'input[data-item="middle"][data-key="s"]\').value'
+            )
+
+        n0 = (await page.call("state()"))["cables"]["hose"]["positions"]
+        await page.cdp.evaluate(set_input.format(0.42))
+        edited = await settle()
+        n1 = (await page.call("state()"))["cables"]["hose"]["positions"]
+        await page.cdp.evaluate(set_input.format(1.7))
+        kept = await settle()
+        refused = await page.text("message")
+        await page.cdp.evaluate("document.getElementById('undo').click()")
+        undone = await settle()
+        n2 = (await page.call("state()"))["cables"]["hose"]["positions"]
+        return n0, edited, n1, refused, kept, undone, n2
+
+    with workbench_process(scene_copy) as (_, url):
+        n0, edited, n1, refused, kept, undone, n2 = run_page(url, script)
+    assert edited == "0.42" and kept == "0.42" and undone == "0.5"
+    # the middle clip now holds s = 0.42: another shape; undone: the first one again
+    assert np.abs(np.array(n1) - np.array(n0)).max() > 1e-3
+    assert n2 == n0
+    assert "covers s = [1.7, 1.7] m, outside the cable [0, 1.0] m" in refused
