@@ -37,6 +37,7 @@ from cablelife.plots import (
 )
 from cablelife.plots.bend_radius import DEFAULT_FACTOR
 from cablelife.plots.fatigue_data import DAMAGE_FLOOR
+from cablelife.plots.runs import variant_of
 from cablelife.report.interactive import maxima_over_time_figure
 from cablelife.report.page import Page
 from cablelife.report.scene3d import FRAMES, cable_figure, volumes_figure, with_damage
@@ -98,12 +99,6 @@ def _g(x: float, unit: str = "", scale: float | None = None) -> str:
 def _scales(c) -> dict[str, float]:
     """The largest force and moment magnitude of a cable (the reference of numerical zeros)."""
     return {"N": float(np.abs(c.forces).max()), "N m": float(np.abs(c.moments).max())}
-
-
-def variant_of(label: str, mode: str) -> str:
-    """The variant a run belongs to: its label without the mode ("A-dynamic" → "A")."""
-    v = re.sub(rf"[\s_\-(]*{mode}\)?$", "", label).strip()
-    return v or label
 
 
 def _colours(runs) -> dict[str, str]:
