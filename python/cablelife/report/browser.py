@@ -9,6 +9,7 @@ from __future__ import annotations
 import asyncio
 import base64
 import json
+import os
 import shutil
 import socket
 import subprocess
@@ -77,6 +78,33 @@ class PageCheck:
     values: dict = field(default_factory=dict)
     first_screen_s: float = -1.0  # navigation start → the figures on the first screen drawn
     on_demand_ms: list[int] = field(default_factory=list)  # drawing time of each other figure
+    # CPU time (s) of all of chromium's processes from the navigation until every figure was
+    # drawn: what the page costs, independent of other load on the machine (-1: no /proc)
+    cpu_s: float = -1.0
+
+
+def tree_cpu(root: int) -> float:
+    """CPU time (user + system, s) of process ``root`` and all its descendants (Linux /proc;
+    -1 elsewhere); children that ended and were waited for are in their parent's figures."""
+    try:
+        names = [d for d in os.listdir("/proc") if d.isdigit()]
+    except OSError:
+        return -1.0
+    parent, cpu = {}, {}
+    for d in names:
+        try:
+            with open(f"/proc/{d}/stat") as f:
+                fields = f.read().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        parent[int(d)] = int(fields[1])
+        cpu[int(d)] = sum(int(x) for x in fields[11:15])  # utime stime cutime cstime
+    tree, todo = set(), [root]
+    while todo:
+        pid = todo.pop()
+        tree.add(pid)
+        todo += [c for c, p in parent.items() if p == pid and c not in tree]
+    return sum(cpu.get(p, 0) for p in tree) / os.sysconf("SC_CLK_TCK")
 
 
 def _free_port() -> int:
@@ -139,7 +167,9 @@ async def _scroll_through(cdp: _Cdp, height: int, t0: float, timeout: float) -> 
     return [ms for fid, ms in drawn if fid not in first]
 
 
-async def _check(url, port, width, height, timeout, shots, scroll_shots, evaluate) -> PageCheck:
+async def _check(
+    url, port, width, height, timeout, shots, scroll_shots, evaluate, pid
+) -> PageCheck:
     from tornado.websocket import websocket_connect
 
     deadline = time.monotonic() + 20
@@ -159,6 +189,7 @@ async def _check(url, port, width, height, timeout, shots, scroll_shots, evaluat
     await cdp.call("Emulation.setDeviceMetricsOverride", width=width, height=height,
                    deviceScaleFactor=1, mobile=False)  # fmt: skip
     t0 = time.perf_counter()
+    cpu0 = tree_cpu(pid)
     await cdp.call("Page.navigate", url=url)
     while True:
         done = await cdp.evaluate("document.body && document.body.dataset.checked")
@@ -169,6 +200,7 @@ async def _check(url, port, width, height, timeout, shots, scroll_shots, evaluat
         await asyncio.sleep(0.02)
     wall = time.perf_counter() - t0
     on_demand = await _scroll_through(cdp, height, t0, timeout)
+    cpu = tree_cpu(pid) - cpu0 if cpu0 >= 0 else -1.0
     data = await cdp.evaluate("JSON.stringify(document.body.dataset)")
     d = json.loads(data)
     overlaps = json.loads(await cdp.evaluate(OVERLAP_JS))
@@ -198,6 +230,7 @@ async def _check(url, port, width, height, timeout, shots, scroll_shots, evaluat
         overlaps=overlaps,
         screenshots=files,
         values=values,
+        cpu_s=cpu,
     )
 
 
@@ -236,6 +269,7 @@ def check_page(
                     screenshots,
                     scroll_shots,
                     evaluate,
+                    proc.pid,
                 )  # fmt: skip
             )
         finally:

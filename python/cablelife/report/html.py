@@ -526,6 +526,10 @@ def _run_section(page, k, run: ReportRun, volumes, color_by, frames, factor, cac
         dmg = run.damage_of(name)
         if dmg is not None and dmg[0].damage.max() > 0:  # the damage map: a button of the view
             view = with_damage(view, c, dmg[0], scene_toml=res.scene_toml, mode=res.mode)
+        if c.surroundings is not None:  # the clearance at its least: a button of the view
+            from cablelife.report.surroundings import with_clearance
+
+            view = with_clearance(view, c, res)
         page.plotly(view, f"3D view of {name}")
         one = [Run(run.label, c, res.mode, _colours([run])[run.label])]
         if alone:
