@@ -291,7 +291,7 @@ def _summary(cache: dict, c) -> dict:
     key = ("summary", id(c))
     got = cache.get(key)
     if got is None:
-        got = cache[key] = cable_summary(c)
+        got = cache[key] = cable_summary(c, strains=False)
     elif hasattr(got, "result"):
         got = cache[key] = got.result()
     return got
@@ -647,7 +647,7 @@ def build_report(
     cache: dict = {}
     for r in runs:
         for name, c in r.result.cables.items():
-            cache[("summary", id(c))] = pool.submit(cable_summary, c)
+            cache[("summary", id(c))] = pool.submit(cable_summary, c, strains=False)
             key = _scene_key(r.result, name)
             if key not in cache:
                 cache[key] = pool.submit(frequency_data, r.result, name)

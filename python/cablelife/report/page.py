@@ -114,10 +114,11 @@ def _pack(data: bytes, level: int = 6) -> str:
 
 @functools.cache
 def plotly_js_packed() -> str:
-    """plotly.js of the installed plotly, gzip-compressed and base64 (4.8 → 2.0 MB)."""
+    """plotly.js of the installed plotly, gzip-compressed (level 6: level 9 is 0.2 % smaller and
+    takes a third longer) and base64 (4.8 → 2.0 MB)."""
     from plotly.offline import get_plotlyjs
 
-    return _pack(get_plotlyjs().encode(), 9)
+    return _pack(get_plotlyjs().encode(), 6)
 
 
 def unpack(page: str, block: str = "figures"):
