@@ -40,7 +40,13 @@ from cablelife.plots.fatigue_data import DAMAGE_FLOOR
 from cablelife.plots.runs import variant_of
 from cablelife.report.interactive import maxima_over_time_figure
 from cablelife.report.page import Page
-from cablelife.report.scene3d import FRAMES, cable_figure, volumes_figure, with_damage
+from cablelife.report.scene3d import (
+    FRAMES,
+    cable_figure,
+    merge_runs,
+    volumes_figure,
+    with_damage,
+)
 from cablelife.results import Result
 from cablelife.summary import cable_summary
 
@@ -520,17 +526,12 @@ def _run_section(page, k, run: ReportRun, volumes, color_by, frames, factor, cac
                 + " × ".join(f"[{a:.1f}, {b:.1f}]" for a, b in zip(box[0], box[1], strict=True))
                 + " mm"
             )
-        view = cable_figure(
-            c, color_by, frames=frames, volume=vol, scene_toml=res.scene_toml, mode=res.mode
-        )
-        dmg = run.damage_of(name)
-        if dmg is not None and dmg[0].damage.max() > 0:  # the damage map: a button of the view
-            view = with_damage(view, c, dmg[0], scene_toml=res.scene_toml, mode=res.mode)
-        if c.surroundings is not None:  # the clearance at its least: a button of the view
-            from cablelife.report.surroundings import with_clearance
-
-            view = with_clearance(view, c, res)
-        page.plotly(view, f"3D view of {name}")
+        view = cache.get("views", {}).get((run.label, name))
+        if isinstance(view, str):  # drawn with another run's view
+            page.note(view)
+        else:
+            view = view or run_view(run, name, vol, color_by, frames)
+            page.plotly(view, f"3D view of {name}")
         one = [Run(run.label, c, res.mode, _colours([run])[run.label])]
         if alone:
             page.plotly(maxima_over_time_figure(one), f"maxima over time of {name}")
@@ -545,6 +546,51 @@ def _run_section(page, k, run: ReportRun, volumes, color_by, frames, factor, cac
             surroundings_section(page, res, name)
         if run.damage_of(name) is not None:
             _damage_section(page, run, name, alone)
+
+
+def run_view(run: ReportRun, name: str, volume, color_by: str, frames: int) -> dict:
+    """The 3D view of a run's cable: the tube coloured by ``color_by`` over time, and behind
+    buttons the damage on the surface and the clearance at its least (when there are)."""
+    res, c = run.result, run.result.cables[name]
+    view = cable_figure(
+        c, color_by, frames=frames, volume=volume, scene_toml=res.scene_toml, mode=res.mode
+    )
+    dmg = run.damage_of(name)
+    if dmg is not None and dmg[0].damage.max() > 0:  # the damage map: a button of the view
+        view = with_damage(view, c, dmg[0], scene_toml=res.scene_toml, mode=res.mode)
+    if c.surroundings is not None:  # the clearance at its least: a button of the view
+        from cablelife.report.surroundings import with_clearance
+
+        view = with_clearance(view, c, res)
+    return view
+
+
+def variant_views(runs: list[ReportRun], volumes: dict, color_by: str, frames: int) -> dict:
+    """One 3D view per variant of its dynamic and quasistatic runs (single-cable runs with the
+    same saved times: :func:`cablelife.report.scene3d.merge_runs`), as each WebGL scene costs
+    about a second to draw without a GPU whatever it shows: (run label, cable) → the view (in
+    the dynamic run's section) or the note that replaces it (in the quasistatic run's)."""
+    by_variant: dict[str, dict[str, ReportRun]] = {}
+    for r in runs:
+        if len(r.result.cables) == 1:
+            by_variant.setdefault(variant_of(r.label, r.result.mode), {})[r.result.mode] = r
+    out: dict = {}
+    for pair in by_variant.values():
+        d, q = pair.get("dynamic"), pair.get("quasistatic")
+        if d is None or q is None:
+            continue
+        (name,) = d.result.cables
+        if list(q.result.cables) != [name]:
+            continue
+        views = [run_view(r, name, volumes.get(r.label), color_by, frames) for r in (d, q)]
+        merged = merge_runs(*views, d.label, q.label)
+        if merged is not None:
+            out[(d.label, name)] = merged
+            out[(q.label, name)] = (
+                f"the 3D view of {name} in this run: in run {d.label}'s section, with that run "
+                f"(its drop-down: '{q.label}: …')"
+            )
+    return out
 
 
 def _damage_section(page: Page, run: ReportRun, name: str, alone: bool = True) -> None:
@@ -666,6 +712,9 @@ def build_report(
     if len(runs) > 1:
         step("comparison")
         _comparison(page, runs, volumes, voxel or 0.004, bend_factor, cache)
+    if len(runs) > 1:
+        step("3D views")
+        cache["views"] = variant_views(runs, volumes, color_by, frames)
     for k, run in enumerate(runs):
         step(f"run {run.label}")
         _run_section(page, k, run, volumes, color_by, frames, bend_factor, cache, len(runs) == 1)

@@ -538,3 +538,63 @@ def with_damage(
     fig["layout"]["title"] = {"text": title["text"] if isinstance(title, dict) else title}
     fig["layout"]["title"]["text"] += " / damage"
     return with_view(fig, extra, "damage on the surface")
+
+
+def _view_buttons(fig: dict) -> list[dict]:
+    """The view buttons of a 3D view (:func:`with_view`), one "all traces" button without."""
+    for m in fig["layout"].get("updatemenus", []):
+        if m.get("name") == "views":
+            return m["buttons"]
+    first = fig["data"][0].get("colorbar", {}).get("title", {}).get("text", "quantity")
+    return [{"label": first, "method": "restyle", "args": [{"visible": [True] * len(fig["data"])}]}]
+
+
+def merge_runs(a: dict, b: dict, label_a: str, label_b: str) -> dict | None:
+    """One 3D view of two runs of a cable (e.g. a variant's dynamic and quasistatic runs):
+    the views of both (:func:`cable_figure` with its :func:`with_view` views) in one WebGL
+    scene, chosen from a drop-down ("<run>: <view>"), the slider moving both; ``a`` starts
+    shown. None when their animation frames differ (other saved times): they stay apart."""
+    fa, fb = a.get("frames", []), b.get("frames", [])
+    if [f["name"] for f in fa] != [f["name"] for f in fb]:
+        return None
+    na, nb = len(a["data"]), len(b["data"])
+    buttons = [
+        {**bt, "label": f"{label_a}: {bt['label']}",
+         "args": [{"visible": [*bt["args"][0]["visible"], *[False] * nb]}]}
+        for bt in _view_buttons(a)
+    ] + [
+        {**bt, "label": f"{label_b}: {bt['label']}",
+         "args": [{"visible": [*[False] * na, *bt["args"][0]["visible"]]}]}
+        for bt in _view_buttons(b)
+    ]  # fmt: skip
+    for t in b["data"]:
+        t["visible"] = False
+    out = {**a, "data": [*a["data"], *b["data"]]}
+    out["frames"] = []
+    for x, y in zip(fa, fb, strict=True):
+        traces = [*x["traces"], *(i + na for i in y["traces"])]
+        out["frames"].append({**x, "data": [*x["data"], *y["data"]], "traces": traces})
+    layout = out["layout"] = {**a["layout"]}
+    menus = [m for m in layout.get("updatemenus", []) if m.get("name") != "views"]
+    menus.append(
+        {
+            "name": "views",
+            "type": "dropdown",
+            "direction": "down",
+            "showactive": True,
+            "active": 0,
+            "x": 0.3,
+            "xanchor": "left",
+            "y": 1.0,
+            "yanchor": "top",
+            "pad": {"t": 4, "l": 4},
+            "buttons": buttons,
+        }
+    )
+    layout["updatemenus"] = menus
+    sb = b["layout"]["scene"]
+    corners = np.array([[sb[f"{x}axis"]["range"][i] for x in "xyz"] for i in (0, 1)])
+    extend_range(out, corners)
+    name = a["data"][0].get("name", "cable")
+    layout["title"] = {"text": f"{name}: runs {label_a} and {label_b} (choose run and view)"}
+    return out
