@@ -527,8 +527,10 @@ def _run_section(page, k, run: ReportRun, volumes, color_by, frames, factor, cac
                 + " mm"
             )
         view = cache.get("views", {}).get((run.label, name))
-        if isinstance(view, str):  # drawn with another run's view
-            page.note(view)
+        view_at = "its 3D view above"
+        if isinstance(view, tuple):  # drawn with another run's view: (note, where)
+            page.note(view[0])
+            view_at = view[1]
         else:
             view = view or run_view(run, name, vol, color_by, frames)
             page.plotly(view, f"3D view of {name}")
@@ -543,9 +545,9 @@ def _run_section(page, k, run: ReportRun, volumes, color_by, frames, factor, cac
         if c.surroundings is not None:
             from cablelife.report.surroundings import surroundings_section
 
-            surroundings_section(page, res, name)
+            surroundings_section(page, res, name, view_at)
         if run.damage_of(name) is not None:
-            _damage_section(page, run, name, alone)
+            _damage_section(page, run, name, alone, view_at)
 
 
 def run_view(run: ReportRun, name: str, volume, color_by: str, frames: int) -> dict:
@@ -569,7 +571,8 @@ def variant_views(runs: list[ReportRun], volumes: dict, color_by: str, frames: i
     """One 3D view per variant of its dynamic and quasistatic runs (single-cable runs with the
     same saved times: :func:`cablelife.report.scene3d.merge_runs`), as each WebGL scene costs
     about a second to draw without a GPU whatever it shows: (run label, cable) → the view (in
-    the dynamic run's section) or the note that replaces it (in the quasistatic run's)."""
+    the dynamic run's section) or, in the quasistatic run's, (the note that replaces it, where
+    its views are)."""
     by_variant: dict[str, dict[str, ReportRun]] = {}
     for r in runs:
         if len(r.result.cables) == 1:
@@ -588,12 +591,15 @@ def variant_views(runs: list[ReportRun], volumes: dict, color_by: str, frames: i
             out[(d.label, name)] = merged
             out[(q.label, name)] = (
                 f"the 3D view of {name} in this run: in run {d.label}'s section, with that run "
-                f"(its drop-down: '{q.label}: …')"
+                f"(its drop-down: '{q.label}: …')",
+                f"run {d.label}'s 3D view (its drop-down, '{q.label}: …')",
             )
     return out
 
 
-def _damage_section(page: Page, run: ReportRun, name: str, alone: bool = True) -> None:
+def _damage_section(
+    page: Page, run: ReportRun, name: str, alone: bool = True, view_at: str = "its 3D view above"
+) -> None:
     """LDA settings, hot spots, the damage along the cable (on the surface: a button of the
     3D view) and the rainflow matrix of the most damaged series."""
     c = run.result.cables[name]
@@ -635,8 +641,8 @@ def _damage_section(page: Page, run: ReportRun, name: str, alone: bool = True) -
         f"damage hot spots (local maxima along the cable above {DAMAGE_FLOOR:g} × the maximum)",
     )
     page.note(
-        f"the {kind} on the surface of {name}: the button 'damage on the surface' of its 3D "
-        "view above (log colours from the floor, hot spots labelled)"
+        f"the {kind} on the surface of {name}: 'damage on the surface' in {view_at} (log "
+        "colours from the floor, hot spots labelled)"
     )
     clips = {n: r.s for n, r in c.clips.items()}
     if alone:  # else the comparison draws the runs of a mode together

@@ -151,7 +151,9 @@ def with_clearance(view: dict, cable: CableResult, result: Result) -> dict:
     return with_view(view, traces, label, keep=[])
 
 
-def surroundings_section(page, result: Result, name: str) -> None:
+def surroundings_section(
+    page, result: Result, name: str, view_at: str = "its 3D view above"
+) -> None:
     """Adds the clearance of cable ``name`` to a report page (``report.html._Page``)."""
     cable = result.cables[name]
     if cable.surroundings is None:
@@ -190,5 +192,5 @@ def surroundings_section(page, result: Result, name: str) -> None:
     t = cable.time[least_clearance_step(cable)]
     page.note(
         f"the clearance on the surface of {name} at t = {t:.4g} s (its least) with the bodies' "
-        "geometry: the button 'clearance at t = …' of its 3D view above"
+        f"geometry: 'clearance at t = …' in {view_at}"
     )
