@@ -58,11 +58,62 @@ def test_maxima_over_time_draws_fig2(runs, tmp_path):
     qs, dyn = runs
     tension = axes[1].get_lines()
     assert [ln.get_linestyle() for ln in tension] == ["--", "-"]
-    np.testing.assert_allclose(tension[0].get_ydata(), extreme_along(qs.cable.forces[..., 2]))
+    # one variant: one colour, the mode told by the line style
+    assert tension[0].get_color() == tension[1].get_color()
+    np.testing.assert_allclose(tension[0].get_ydata(), np.abs(qs.cable.forces[..., 2]).max(1))
     bending = axes[2].get_lines()[1].get_ydata()
-    np.testing.assert_allclose(bending, 1.5 * np.hypot(*qs.cable.moments[..., :2].T).T.max(1))
+    inner = np.hypot(*qs.cable.moments[:, 1:-1, :2].T).T  # nodes strictly between the clips
+    np.testing.assert_allclose(bending, 1.5 * inner.max(1))
+    assert axes[3].get_ylabel().startswith("|torsion M3|")
     path = save_png(fig, tmp_path / "fig2.png")
     assert path.read_bytes()[:8] == PNG
+
+
+@pytest.fixture(scope="module")
+def three_clips():
+    """A cable whose first span lies between two clips on the world (it does not move) and
+    whose second span ends on a moving body: runs of variants A and B."""
+    from cablelife.scene import scene_from_dict
+    from cablelife.simulate import simulate
+    from conftest import BASE
+
+    d = copy.deepcopy(BASE)
+    d["simulation"].update(mode="quasistatic", duration=1.0, time_step=0.05)
+    sine = {"type": "sine", "amplitude": 0.05, "frequency": 1.0}
+    d["bodies"] = [{"name": "engine", "motion": [{"channel": "z", "signal": sine}]}]
+    clips = d["cables"][0]["clips"]
+    clips[1]["body"] = "engine"
+    middle = {"name": "m", "s": 0.4, "position": [0.35, 0.05, 0.0], "direction": [1.0, 0.0, 0.0],
+              "normal": [0.0, 0.0, 1.0]}  # fmt: skip
+    clips.insert(1, middle)
+    qs = simulate(scene_from_dict(d)).cable
+    dyn = copy.deepcopy(qs)
+    s = 0.5 * (qs.arc_length[1:] + qs.arc_length[:-1])
+    dyn.forces[:, s < 0.4, :] = -1e3  # large constant loads in the span at rest
+    b = copy.deepcopy(qs)
+    b.moments = -2.0 * b.moments  # torsion of the other sign
+    return [Run("A-quasistatic", qs, "quasistatic"), Run("A-dynamic", dyn, "dynamic"),
+            Run("B-dynamic", b, "dynamic")]  # fmt: skip
+
+
+def test_maxima_over_time_plots_magnitudes_over_the_moving_spans(three_clips):
+    """Fig. 2 (PNG) as the report draws it: magnitudes (torsion of either sign positive), over
+    the spans that move (the span at rest with its large constant loads left out), one colour
+    per variant (A's quasistatic and dynamic runs share one), dashed quasistatic."""
+    fig = plot_maxima_over_time(three_clips)
+    shear, tension, _, torsion = (ax.get_lines() for ax in fig.axes)
+    qs, dyn, b = (r.cable for r in three_clips)
+    s = 0.5 * (qs.arc_length[1:] + qs.arc_length[:-1])
+    moving = s > 0.4
+    np.testing.assert_allclose(tension[1].get_ydata(), np.abs(dyn.forces[:, moving, 2]).max(1))
+    assert tension[1].get_ydata().max() < 1e3  # the span at rest is not drawn
+    inner = (qs.arc_length > 0.4 + 1e-9) & (qs.arc_length < 1.0 - 1e-9)
+    np.testing.assert_allclose(torsion[2].get_ydata(), 2 * np.abs(qs.moments[:, inner, 2]).max(1))
+    assert all((ln.get_ydata() >= 0).all() for ax in fig.axes for ln in ax.get_lines())
+    colours = [ln.get_color() for ln in shear]
+    assert colours[0] == colours[1] != colours[2]
+    assert [ln.get_linestyle() for ln in shear] == ["--", "-", "-"]
+    assert fig.get_suptitle() == "largest magnitude over the spans that move, over time"
 
 
 def test_envelopes_bound_every_step(runs):

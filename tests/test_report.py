@@ -324,7 +324,10 @@ def test_interactive_plots_draw_what_the_matplotlib_plots_draw(files):
     runs = [Run("qs", cable, "quasistatic")]
     mpl = plot_maxima_over_time(runs)
     fig = to_plotly(mpl)
-    assert len(fig.data) == 4 and fig.layout.title.text == "largest value along the cable over time"
+    assert (
+        len(fig.data) == 4
+        and fig.layout.title.text == "largest magnitude over the spans that move, over time"
+    )
     for ax, trace in zip(mpl.axes, fig.data, strict=True):
         line = ax.get_lines()[0]
         np.testing.assert_allclose(trace.x, line.get_xdata())

@@ -88,3 +88,57 @@ def test_welch_is_scipys(n, nperseg):
     g, q = scipy_welch(x, fs=250.0, nperseg=nperseg, axis=0)
     np.testing.assert_allclose(f, g, rtol=1e-12)
     np.testing.assert_allclose(p, q, rtol=1e-10, atol=1e-14 * q.max())
+
+
+def _views_of(n_frames: int, seed: float, times=None):
+    """A small 3D view of a moving cable (cable_figure with a second view behind a button)."""
+    import copy
+
+    from cablelife.report.scene3d import cable_figure, with_view
+    from cablelife.scene import scene_from_dict
+    from cablelife.simulate import simulate
+    from conftest import BASE
+
+    d = copy.deepcopy(BASE)
+    d["simulation"].update(mode="quasistatic", duration=times or 0.2, time_step=0.05)
+    sine = {"type": "sine", "amplitude": seed, "frequency": 1.0}
+    d["bodies"] = [{"name": "engine", "motion": [{"channel": "z", "signal": sine}]}]
+    d["cables"][0]["clips"][1]["body"] = "engine"
+    res = simulate(scene_from_dict(d))
+    view = cable_figure(res.cable, frames=n_frames, scene_toml=res.scene_toml, mode=res.mode)
+    extra = {"type": "scatter3d", "x": [0.0], "y": [0.0], "z": [0.0], "name": "extra"}
+    return with_view(view, [extra], "extra view")
+
+
+def test_one_3d_view_for_the_runs_of_a_variant():
+    """merge_runs: both runs' views in one scene, a drop-down "<run>: <view>" whose every entry
+    shows exactly that run's traces of that view, the slider's frames moving both runs'
+    traces; runs saved at other times are not merged."""
+    from cablelife.report.scene3d import merge_runs
+
+    a, b = _views_of(3, 0.01), _views_of(3, 0.02)
+    na, nb = len(a["data"]), len(b["data"])
+    b_frame_traces = b["frames"][1]["traces"]
+    m = merge_runs(copy_of(a), copy_of(b), "A-dynamic", "A-quasistatic")
+    assert len(m["data"]) == na + nb
+    (menu,) = [u for u in m["layout"]["updatemenus"] if u.get("name") == "views"]
+    assert menu["type"] == "dropdown"
+    labels = [bt["label"] for bt in menu["buttons"]]
+    assert labels[0].startswith("A-dynamic: ") and labels[-1] == "A-quasistatic: extra view"
+    for bt in menu["buttons"]:
+        vis = bt["args"][0]["visible"]
+        assert len(vis) == na + nb
+        mine = vis[:na] if bt["label"].startswith("A-dynamic") else vis[na:]
+        other = vis[na:] if bt["label"].startswith("A-dynamic") else vis[:na]
+        assert any(mine) and not any(other)
+    assert all(t.get("visible") is False for t in m["data"][na:])  # A-dynamic shown first
+    f = m["frames"][1]
+    assert f["traces"][-len(b_frame_traces) :] == [na + i for i in b_frame_traces]
+    assert len(f["data"]) == len(f["traces"])
+    assert merge_runs(_views_of(3, 0.01), _views_of(3, 0.02, times=0.3), "a", "b") is None
+
+
+def copy_of(view: dict) -> dict:
+    import copy
+
+    return copy.deepcopy(view)

@@ -577,6 +577,41 @@ def test_report_has_the_clearance_section(scene_dict, tmp_path):
     assert "clearance of hose to the surroundings" in html
     assert "clearance of hose along the cable" in html  # the envelope figure
     assert "least clearance" in html and "floor/plane#0" in html
+    # the clearance in 3D is a view of the run's 3D view (one WebGL scene), not a scene of its
+    # own: its button shows the clearance tube and the floor, nothing of the other views
+    from cablelife.report.page import unpack
+
+    figs = unpack(html)
+    views = [
+        f for f in figs if any(m.get("name") == "views" for m in f["layout"].get("updatemenus", []))
+    ]
+    assert len(views) == 1 and sum("scene" in f["layout"] for f in figs) == 1
+    (menu,) = [m for m in views[0]["layout"]["updatemenus"] if m.get("name") == "views"]
+    labels = [b["label"] for b in menu["buttons"]]
+    assert len(labels) == 2 and labels[1].startswith("clearance at t = ")
+    shown = menu["buttons"][1]["args"][0]["visible"]
+    names = [t.get("name") for t, v in zip(views[0]["data"], shown, strict=True) if v]
+    assert names == ["hose: clearance", "floor"]
+    assert not any(menu["buttons"][0]["args"][0]["visible"][-2:])
+    # and the page as a person sees it: every figure drawn, no script error, no text overprinted
+    from cablelife.report.browser import check_page, find_browser
+
+    if find_browser() is None:
+        pytest.skip("chromium not found (Debian package 'chromium')")
+    seen = check_page(tmp_path / "r.html")
+    assert seen.errors == [] and seen.rendered == seen.expected == len(figs)
+    assert seen.overlaps == [], seen.overlaps
+
+
+def test_report_arrays_of_text_go_as_lists():
+    """Arrays of objects (customdata with body names) are sent as plain lists: a typed array
+    of dtype "O" made plotly.js refuse the clearance figure."""
+    from cablelife.report.decimate import compact
+
+    d = compact({"customdata": np.array([[0.5, "engine"], [1.5, "floor"]], dtype=object),
+                 "x": np.array([0.0, 1.0])})  # fmt: skip
+    assert d["customdata"] == [[0.5, "engine"], [1.5, "floor"]]
+    assert d["x"]["dtype"] == "f4"
 
 
 def test_motion_volume_against_the_bodies(scene_dict):

@@ -138,6 +138,28 @@ def print_summary(result: Result) -> None:
                 console.print(table)
 
 
+def _progress_bar():
+    """A progress bar of the steps of each cable (on stderr) and its callback for
+    :func:`cablelife.simulate.simulate`; not imported with --quiet (start-up time)."""
+    from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
+
+    progress = Progress(
+        TextColumn("{task.description}"),
+        BarColumn(),
+        TextColumn("{task.completed}/{task.total} steps"),
+        TimeRemainingColumn(),
+        console=err_console,
+    )
+    tasks: dict[str, int] = {}
+
+    def on_progress(cable: str, done: int, total: int) -> None:
+        if cable not in tasks:
+            tasks[cable] = progress.add_task(escape(f"cable '{cable}'"), total=total)
+        progress.update(tasks[cable], completed=done)
+
+    return progress, on_progress
+
+
 @app.command()
 def run(
     scene: Annotated[Path, typer.Argument(help="scene TOML file")],
@@ -155,7 +177,7 @@ def run(
     ] = None,
 ) -> None:
     """Simulate a scene and print a summary; with -o, save the result (HDF5)."""
-    from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
+    from contextlib import nullcontext
 
     from cablelife.clitext import print_warning
     from cablelife.interrupt import interrupted
@@ -176,21 +198,7 @@ def run(
         raise fail(f"--output {str(output)!r} {why}; give a file in an existing folder")
     if precision is not None:
         sc.simulation.output_precision = precision
-    progress = Progress(
-        TextColumn("{task.description}"),
-        BarColumn(),
-        TextColumn("{task.completed}/{task.total} steps"),
-        TimeRemainingColumn(),
-        console=err_console,
-        disable=quiet,
-    )
-    tasks: dict[str, int] = {}
-
-    def on_progress(cable: str, done: int, total: int) -> None:
-        if cable not in tasks:
-            tasks[cable] = progress.add_task(escape(f"cable '{cable}'"), total=total)
-        progress.update(tasks[cable], completed=done)
-
+    progress, on_progress = (nullcontext(), None) if quiet else _progress_bar()
     try:
         with progress, warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")

@@ -32,9 +32,10 @@ def viscous_share(c: CableResult) -> np.ndarray | None:
         return np.where(total > 0, np.asarray(peak) / total, 0.0)
 
 
-def cable_summary(c: CableResult) -> dict:
+def cable_summary(c: CableResult, strains: bool = True) -> dict:
     """Maxima over time and arc length, the smallest bend radius, clip reaction maxima and the
-    solver statistics of one cable."""
+    solver statistics of one cable; with ``strains`` the strain extremes (the ``max_*_strain``
+    keys: a third of the cost, the report does not show them)."""
     f, m = c.forces, c.moments
     radius = c.bend_radius()
     i_min = np.unravel_index(np.argmin(radius), radius.shape)
@@ -47,7 +48,7 @@ def cable_summary(c: CableResult) -> dict:
         for name, r in c.clips.items()
     }
     iters = np.asarray(c.solver.get("iterations", [0]))
-    strain = strain_extremes(c)
+    strain = strain_extremes(c) if strains else None
     unstable = np.asarray(c.solver.get("unstable", []))
     snap_t = np.atleast_1d(c.solver.get("snap_time", []))
     return {
@@ -65,9 +66,15 @@ def cable_summary(c: CableResult) -> dict:
         "newton_iterations_mean": float(iters.mean()) if iters.size else 0.0,
         "newton_iterations_max": int(iters.max()) if iters.size else 0,
         "wall_time": float(c.solver.get("wall_time", float("nan"))),
-        "max_axial_strain": strain["axial"],
-        "max_compressive_strain": strain["compression"],
-        "max_shear_strain": strain["shear"],
+        **(
+            {}
+            if strain is None
+            else {
+                "max_axial_strain": strain["axial"],
+                "max_compressive_strain": strain["compression"],
+                "max_shear_strain": strain["shear"],
+            }
+        ),
         "prestrain": float(c.solver.get("prestrain", 0.0)),
         "unstable_steps": int((unstable > 0).sum()),
         "snap_throughs": [

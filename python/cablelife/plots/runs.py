@@ -4,6 +4,7 @@ style (quasistatic dashed, dynamic solid, static dotted)."""
 from __future__ import annotations
 
 import os
+import re
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -36,6 +37,23 @@ class Run:
     @property
     def linestyle(self) -> str:
         return LINESTYLE.get(self.mode, "-")
+
+
+def variant_of(label: str, mode: str) -> str:
+    """The variant a run belongs to: its label without the mode ("A-dynamic" → "A")."""
+    v = re.sub(rf"[\s_\-(]*{mode}\)?$", "", label).strip()
+    return v or label
+
+
+def variant_colours(runs: Sequence[Run]) -> list[str]:
+    """A colour per run: its own, else one of the cycle per variant (the quasistatic and
+    dynamic runs of a variant share it)."""
+    seen: dict[str, int] = {}
+    out = []
+    for r in runs:
+        k = seen.setdefault(variant_of(r.label, r.mode), len(seen))
+        out.append(r.colour(k))
+    return out
 
 
 def as_runs(items, cable: str | None = None) -> list[Run]:

@@ -9,6 +9,7 @@ from __future__ import annotations
 import asyncio
 import base64
 import json
+import os
 import shutil
 import socket
 import subprocess
@@ -19,6 +20,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import NamedTuple
 
 BROWSERS = ("chromium", "chromium-browser", "google-chrome")
 # Software WebGL (SwiftShader) so plotly's 3D scenes draw without a GPU; root needs no sandbox.
@@ -79,6 +81,33 @@ class PageCheck:
     values: dict = field(default_factory=dict)
     first_screen_s: float = -1.0  # navigation start → the figures on the first screen drawn
     on_demand_ms: list[int] = field(default_factory=list)  # drawing time of each other figure
+    # CPU time (s) of all of chromium's processes from the navigation until every figure was
+    # drawn: what the page costs, independent of other load on the machine (-1: no /proc)
+    cpu_s: float = -1.0
+
+
+def tree_cpu(root: int) -> float:
+    """CPU time (user + system, s) of process ``root`` and all its descendants (Linux /proc;
+    -1 elsewhere); children that ended and were waited for are in their parent's figures."""
+    try:
+        names = [d for d in os.listdir("/proc") if d.isdigit()]
+    except OSError:
+        return -1.0
+    parent, cpu = {}, {}
+    for d in names:
+        try:
+            with open(f"/proc/{d}/stat") as f:
+                fields = f.read().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        parent[int(d)] = int(fields[1])
+        cpu[int(d)] = sum(int(x) for x in fields[11:15])  # utime stime cutime cstime
+    tree, todo = set(), [root]
+    while todo:
+        pid = todo.pop()
+        tree.add(pid)
+        todo += [c for c, p in parent.items() if p == pid and c not in tree]
+    return sum(cpu.get(p, 0) for p in tree) / os.sysconf("SC_CLK_TCK")
 
 
 def _free_port() -> int:
@@ -148,12 +177,15 @@ async def _scroll_through(cdp: _Cdp, height: int, t0: float, timeout: float) -> 
     return [ms for fid, ms in drawn if fid not in first]
 
 
-async def _check(url, port, width, height, timeout, shots, scroll_shots, evaluate) -> PageCheck:
+async def _check(
+    url, port, width, height, timeout, shots, scroll_shots, evaluate, pid
+) -> PageCheck:
     cdp = await connect(port)
     ws = cdp.ws
     await cdp.call("Emulation.setDeviceMetricsOverride", width=width, height=height,
                    deviceScaleFactor=1, mobile=False)  # fmt: skip
     t0 = time.perf_counter()
+    cpu0 = tree_cpu(pid)
     await cdp.call("Page.navigate", url=url)
     while True:
         done = await cdp.evaluate("document.body && document.body.dataset.checked")
@@ -164,6 +196,7 @@ async def _check(url, port, width, height, timeout, shots, scroll_shots, evaluat
         await asyncio.sleep(0.02)
     wall = time.perf_counter() - t0
     on_demand = await _scroll_through(cdp, height, t0, timeout)
+    cpu = tree_cpu(pid) - cpu0 if cpu0 >= 0 else -1.0
     data = await cdp.evaluate("JSON.stringify(document.body.dataset)")
     d = json.loads(data)
     overlaps = json.loads(await cdp.evaluate(OVERLAP_JS))
@@ -193,6 +226,7 @@ async def _check(url, port, width, height, timeout, shots, scroll_shots, evaluat
         overlaps=overlaps,
         screenshots=files,
         values=values,
+        cpu_s=cpu,
     )
 
 
@@ -209,25 +243,33 @@ def check_page(
     """Opens ``path`` in a fresh headless Chromium and reports what it saw; with
     ``screenshots`` (a folder) one PNG per screen height down the page; ``evaluate``: name →
     JavaScript expression, their values in ``values``."""
-    with chromium(width, height) as port:
+    with chromium(width, height) as browser:
         return asyncio.run(
             _check(
                 Path(path).resolve().as_uri(),
-                port,
+                browser.port,
                 width,
                 height,
                 timeout,
                 screenshots,
                 scroll_shots,
                 evaluate,
+                browser.pid,
             )  # fmt: skip
         )
 
 
+class Browser(NamedTuple):
+    """A running headless Chromium: its DevTools port and its process id."""
+
+    port: int
+    pid: int
+
+
 @contextmanager
-def chromium(width: int = 1200, height: int = 900) -> Iterator[int]:
-    """A fresh headless Chromium with its own profile; yields its DevTools port (connect to
-    its page with :func:`connect`). Ended when the block ends."""
+def chromium(width: int = 1200, height: int = 900) -> Iterator["Browser"]:
+    """A fresh headless Chromium with its own profile; yields its DevTools port and process id
+    (connect to its page with :func:`connect`). Ended when the block ends."""
     browser = find_browser()
     if browser is None:
         raise FileNotFoundError("chromium not found (Debian package 'chromium')")
@@ -241,7 +283,7 @@ def chromium(width: int = 1200, height: int = 900) -> Iterator[int]:
             stderr=subprocess.DEVNULL,
         )  # fmt: skip
         try:
-            yield port
+            yield Browser(port, proc.pid)
         finally:
             proc.terminate()
             try:

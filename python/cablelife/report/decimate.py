@@ -75,6 +75,8 @@ def compact(obj):
     (half the page; 7 significant digits) and int64 arrays (mesh faces) as int32."""
     a = typed(obj)
     if isinstance(a, np.ndarray):
+        if a.dtype.kind not in "fiub":  # objects, strings: plain lists (no typed array)
+            return [compact(v) for v in a.tolist()]
         if a.dtype == np.float64:
             a = a.astype(np.float32)
         elif a.dtype == np.int64 and (a.size == 0 or np.abs(a).max() < 2**31):

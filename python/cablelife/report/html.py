@@ -37,9 +37,16 @@ from cablelife.plots import (
 )
 from cablelife.plots.bend_radius import DEFAULT_FACTOR
 from cablelife.plots.fatigue_data import DAMAGE_FLOOR
+from cablelife.plots.runs import variant_of
 from cablelife.report.interactive import maxima_over_time_figure
 from cablelife.report.page import Page
-from cablelife.report.scene3d import FRAMES, cable_figure, volumes_figure, with_damage
+from cablelife.report.scene3d import (
+    FRAMES,
+    cable_figure,
+    merge_runs,
+    volumes_figure,
+    with_damage,
+)
 from cablelife.results import Result
 from cablelife.summary import cable_summary
 
@@ -98,12 +105,6 @@ def _g(x: float, unit: str = "", scale: float | None = None) -> str:
 def _scales(c) -> dict[str, float]:
     """The largest force and moment magnitude of a cable (the reference of numerical zeros)."""
     return {"N": float(np.abs(c.forces).max()), "N m": float(np.abs(c.moments).max())}
-
-
-def variant_of(label: str, mode: str) -> str:
-    """The variant a run belongs to: its label without the mode ("A-dynamic" → "A")."""
-    v = re.sub(rf"[\s_\-(]*{mode}\)?$", "", label).strip()
-    return v or label
 
 
 def _colours(runs) -> dict[str, str]:
@@ -296,7 +297,7 @@ def _summary(cache: dict, c) -> dict:
     key = ("summary", id(c))
     got = cache.get(key)
     if got is None:
-        got = cache[key] = cable_summary(c)
+        got = cache[key] = cable_summary(c, strains=False)
     elif hasattr(got, "result"):
         got = cache[key] = got.result()
     return got
@@ -525,13 +526,14 @@ def _run_section(page, k, run: ReportRun, volumes, color_by, frames, factor, cac
                 + " × ".join(f"[{a:.1f}, {b:.1f}]" for a, b in zip(box[0], box[1], strict=True))
                 + " mm"
             )
-        view = cable_figure(
-            c, color_by, frames=frames, volume=vol, scene_toml=res.scene_toml, mode=res.mode
-        )
-        dmg = run.damage_of(name)
-        if dmg is not None and dmg[0].damage.max() > 0:  # the damage map: a button of the view
-            view = with_damage(view, c, dmg[0], scene_toml=res.scene_toml, mode=res.mode)
-        page.plotly(view, f"3D view of {name}")
+        view = cache.get("views", {}).get((run.label, name))
+        view_at = "its 3D view above"
+        if isinstance(view, tuple):  # drawn with another run's view: (note, where)
+            page.note(view[0])
+            view_at = view[1]
+        else:
+            view = view or run_view(run, name, vol, color_by, frames)
+            page.plotly(view, f"3D view of {name}")
         one = [Run(run.label, c, res.mode, _colours([run])[run.label])]
         if alone:
             page.plotly(maxima_over_time_figure(one), f"maxima over time of {name}")
@@ -543,12 +545,61 @@ def _run_section(page, k, run: ReportRun, volumes, color_by, frames, factor, cac
         if c.surroundings is not None:
             from cablelife.report.surroundings import surroundings_section
 
-            surroundings_section(page, res, name)
+            surroundings_section(page, res, name, view_at)
         if run.damage_of(name) is not None:
-            _damage_section(page, run, name, alone)
+            _damage_section(page, run, name, alone, view_at)
 
 
-def _damage_section(page: Page, run: ReportRun, name: str, alone: bool = True) -> None:
+def run_view(run: ReportRun, name: str, volume, color_by: str, frames: int) -> dict:
+    """The 3D view of a run's cable: the tube coloured by ``color_by`` over time, and behind
+    buttons the damage on the surface and the clearance at its least (when there are)."""
+    res, c = run.result, run.result.cables[name]
+    view = cable_figure(
+        c, color_by, frames=frames, volume=volume, scene_toml=res.scene_toml, mode=res.mode
+    )
+    dmg = run.damage_of(name)
+    if dmg is not None and dmg[0].damage.max() > 0:  # the damage map: a button of the view
+        view = with_damage(view, c, dmg[0], scene_toml=res.scene_toml, mode=res.mode)
+    if c.surroundings is not None:  # the clearance at its least: a button of the view
+        from cablelife.report.surroundings import with_clearance
+
+        view = with_clearance(view, c, res)
+    return view
+
+
+def variant_views(runs: list[ReportRun], volumes: dict, color_by: str, frames: int) -> dict:
+    """One 3D view per variant of its dynamic and quasistatic runs (single-cable runs with the
+    same saved times: :func:`cablelife.report.scene3d.merge_runs`), as each WebGL scene costs
+    about a second to draw without a GPU whatever it shows: (run label, cable) → the view (in
+    the dynamic run's section) or, in the quasistatic run's, (the note that replaces it, where
+    its views are)."""
+    by_variant: dict[str, dict[str, ReportRun]] = {}
+    for r in runs:
+        if len(r.result.cables) == 1:
+            by_variant.setdefault(variant_of(r.label, r.result.mode), {})[r.result.mode] = r
+    out: dict = {}
+    for pair in by_variant.values():
+        d, q = pair.get("dynamic"), pair.get("quasistatic")
+        if d is None or q is None:
+            continue
+        (name,) = d.result.cables
+        if list(q.result.cables) != [name]:
+            continue
+        views = [run_view(r, name, volumes.get(r.label), color_by, frames) for r in (d, q)]
+        merged = merge_runs(*views, d.label, q.label)
+        if merged is not None:
+            out[(d.label, name)] = merged
+            out[(q.label, name)] = (
+                f"the 3D view of {name} in this run: in run {d.label}'s section, with that run "
+                f"(its drop-down: '{q.label}: …')",
+                f"run {d.label}'s 3D view (its drop-down, '{q.label}: …')",
+            )
+    return out
+
+
+def _damage_section(
+    page: Page, run: ReportRun, name: str, alone: bool = True, view_at: str = "its 3D view above"
+) -> None:
     """LDA settings, hot spots, the damage along the cable (on the surface: a button of the
     3D view) and the rainflow matrix of the most damaged series."""
     c = run.result.cables[name]
@@ -590,8 +641,8 @@ def _damage_section(page: Page, run: ReportRun, name: str, alone: bool = True) -
         f"damage hot spots (local maxima along the cable above {DAMAGE_FLOOR:g} × the maximum)",
     )
     page.note(
-        f"the {kind} on the surface of {name}: the button 'damage on the surface' of its 3D "
-        "view above (log colours from the floor, hot spots labelled)"
+        f"the {kind} on the surface of {name}: 'damage on the surface' in {view_at} (log "
+        "colours from the floor, hot spots labelled)"
     )
     clips = {n: r.s for n, r in c.clips.items()}
     if alone:  # else the comparison draws the runs of a mode together
@@ -648,7 +699,7 @@ def build_report(
     cache: dict = {}
     for r in runs:
         for name, c in r.result.cables.items():
-            cache[("summary", id(c))] = pool.submit(cable_summary, c)
+            cache[("summary", id(c))] = pool.submit(cable_summary, c, strains=False)
             key = _scene_key(r.result, name)
             if key not in cache:
                 cache[key] = pool.submit(frequency_data, r.result, name)
@@ -667,6 +718,9 @@ def build_report(
     if len(runs) > 1:
         step("comparison")
         _comparison(page, runs, volumes, voxel or 0.004, bend_factor, cache)
+    if len(runs) > 1:
+        step("3D views")
+        cache["views"] = variant_views(runs, volumes, color_by, frames)
     for k, run in enumerate(runs):
         step(f"run {run.label}")
         _run_section(page, k, run, volumes, color_by, frames, bend_factor, cache, len(runs) == 1)

@@ -4,9 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from cablelife.plots.loads import ORDER
-from cablelife.plots.runs import QUANTITIES, as_runs, quantity
-from cablelife.plots.spans import cable_spans
+from cablelife.plots.loads import ORDER, magnitude_label, span_maxima
+from cablelife.plots.runs import QUANTITIES, as_runs, variant_colours
 from cablelife.report.decimate import minmax, nice_range
 
 _DASH = {"--": "dash", "-": "solid", ":": "dot"}
@@ -31,18 +30,12 @@ def maxima_over_time_figure(runs, quantities=ORDER, per_span: bool = True):
 
     runs = as_runs(runs)
     fig = make_subplots(rows=len(quantities), cols=1, shared_xaxes=True, vertical_spacing=0.03)
-    for k, run in enumerate(runs):
-        c = run.cable
-        spans = cable_spans(c)
-        moving = [sp for sp in spans if sp.moves] or spans
-        colour = _hex(run.color, k)
+    for k, (run, colour) in enumerate(zip(runs, variant_colours(runs), strict=True)):
+        colour = _hex(colour, k)
         dash = _DASH[run.linestyle]
         for row, name in enumerate(quantities, 1):
-            _, v = quantity(c, name)
-            where = "edges" if v.shape[1] == c.arc_length.size - 1 else "nodes"
-            mag = np.abs(v)
-            pick = np.concatenate([getattr(sp, where) for sp in moving])
-            t, y = minmax(c.time, mag[:, pick].max(axis=1) if pick.size else mag.max(axis=1))
+            m = span_maxima(run.cable, name)
+            t, y = minmax(m.time, m.largest)
             fig.add_scatter(
                 x=t,
                 y=y,
@@ -53,16 +46,13 @@ def maxima_over_time_figure(runs, quantities=ORDER, per_span: bool = True):
                 row=row,
                 col=1,
             )
-            for sp in moving if per_span and len(moving) > 1 else []:
-                idx = getattr(sp, where)
-                if not idx.size:
-                    continue
-                t, y = minmax(c.time, mag[:, idx].max(axis=1), SPAN_POINTS)
+            for span, values in m.spans if per_span else []:
+                t, y = minmax(m.time, values, SPAN_POINTS)
                 fig.add_scatter(
                     x=t,
                     y=y,
-                    name=f"{run.legend}: span {sp.name}",
-                    legendgroup=f"{run.legend}: {sp.name}",
+                    name=f"{run.legend}: span {span}",
+                    legendgroup=f"{run.legend}: {span}",
                     showlegend=row == 1,
                     visible="legendonly",
                     line={"dash": dash, "color": colour, "width": 1},
@@ -71,8 +61,7 @@ def maxima_over_time_figure(runs, quantities=ORDER, per_span: bool = True):
                     col=1,
                 )
     for row, name in enumerate(quantities, 1):
-        label, unit, _, _ = QUANTITIES[name]
-        label = label if "|" in label else f"|{label}|"
+        label, unit = magnitude_label(name), QUANTITIES[name][1]
         ys = [
             np.asarray(t.y, float) for t in fig.data if t.yaxis == ("y" if row == 1 else f"y{row}")
         ]

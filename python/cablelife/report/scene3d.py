@@ -469,6 +469,54 @@ def volumes_figure(volumes: dict, cables: dict | None = None, title: str | None 
     return fig
 
 
+def with_view(fig: dict, traces: list[dict], label: str, keep: list[int] | None = None) -> dict:
+    """The 3D view ``fig`` (a :func:`cable_figure`) with another view behind a button: the
+    buttons (one menu above the scene) switch between the view's first picture (the quantity
+    the tube is coloured by, animated) and the views added here, each ``traces`` (hidden until
+    its button is pressed) shown together with the traces of ``fig`` at ``keep`` (indices; by
+    default every trace but the coloured tube). One WebGL scene in the page instead of one per
+    view: each costs about a second to draw without a GPU, whatever it shows."""
+    n, e = len(fig["data"]), len(traces)
+    keep = set(range(1, n) if keep is None else keep)
+    for t in traces:
+        t["visible"] = False
+    fig["data"] = [*fig["data"], *traces]
+    menus = fig["layout"].setdefault("updatemenus", [])
+    menu = next((m for m in menus if m.get("name") == "views"), None)
+    if menu is None:
+        first = fig["data"][0].get("colorbar", {}).get("title", {}).get("text", "quantity")
+        menu = {
+            "name": "views",
+            "type": "buttons",
+            "direction": "left",
+            "showactive": True,
+            "active": 0,
+            "x": 0.3,
+            "xanchor": "left",
+            "y": 1.0,
+            "yanchor": "top",
+            "pad": {"t": 4, "l": 4},
+            "buttons": [{"label": first, "method": "restyle", "args": [{"visible": [True] * n}]}],
+        }
+        menus.append(menu)
+    for b in menu["buttons"]:  # the views so far do not show the new traces
+        b["args"][0]["visible"] = [*b["args"][0]["visible"], *[False] * e]
+    visible = [i in keep for i in range(n)] + [True] * e
+    menu["buttons"].append({"label": label, "method": "restyle", "args": [{"visible": visible}]})
+    return fig
+
+
+def extend_range(fig: dict, points: np.ndarray) -> None:
+    """Widens the cube of a 3D view (:func:`_layout`) to hold ``points`` (n, 3) as well."""
+    scene = fig["layout"]["scene"]
+    lo = np.array([scene[f"{a}axis"]["range"][0] for a in "xyz"])
+    hi = np.array([scene[f"{a}axis"]["range"][1] for a in "xyz"])
+    lo, hi = np.minimum(lo, points.min(0)), np.maximum(hi, points.max(0))
+    centre, half = (lo + hi) / 2, (hi - lo).max() / 2 * 1.02
+    for i, a in enumerate("xyz"):
+        scene[f"{a}axis"]["range"] = [centre[i] - half, centre[i] + half]
+
+
 def with_damage(
     fig: dict,
     cable: CableResult,
@@ -479,26 +527,60 @@ def with_damage(
 ) -> dict:
     """The 3D view ``fig`` (a :func:`cable_figure`) with the damage map of
     :func:`damage_figure` (on the tube at the first saved step, hot spots labelled) as a
-    second view behind two buttons, the quantity the tube is coloured by and "damage on the
-    surface": one WebGL scene in the page instead of two (each costs about a second to draw
-    without a GPU). The view starts with the quantity."""
+    view behind the button "damage on the surface" (:func:`with_view`). The view starts with
+    the quantity."""
     extra = [
         t
         for t in damage_figure(cable, damage, scene_toml=scene_toml, mode=mode).to_dict()["data"]
         if t.get("name") == "damage" or str(t.get("name", "")).startswith("hot spot")
     ]
-    n, e = len(fig["data"]), len(extra)
-    for t in extra:
+    title = fig["layout"]["title"]
+    fig["layout"]["title"] = {"text": title["text"] if isinstance(title, dict) else title}
+    fig["layout"]["title"]["text"] += " / damage"
+    return with_view(fig, extra, "damage on the surface")
+
+
+def _view_buttons(fig: dict) -> list[dict]:
+    """The view buttons of a 3D view (:func:`with_view`), one "all traces" button without."""
+    for m in fig["layout"].get("updatemenus", []):
+        if m.get("name") == "views":
+            return m["buttons"]
+    first = fig["data"][0].get("colorbar", {}).get("title", {}).get("text", "quantity")
+    return [{"label": first, "method": "restyle", "args": [{"visible": [True] * len(fig["data"])}]}]
+
+
+def merge_runs(a: dict, b: dict, label_a: str, label_b: str) -> dict | None:
+    """One 3D view of two runs of a cable (e.g. a variant's dynamic and quasistatic runs):
+    the views of both (:func:`cable_figure` with its :func:`with_view` views) in one WebGL
+    scene, chosen from a drop-down ("<run>: <view>"), the slider moving both; ``a`` starts
+    shown. None when their animation frames differ (other saved times): they stay apart."""
+    fa, fb = a.get("frames", []), b.get("frames", [])
+    if [f["name"] for f in fa] != [f["name"] for f in fb]:
+        return None
+    na, nb = len(a["data"]), len(b["data"])
+    buttons = [
+        {**bt, "label": f"{label_a}: {bt['label']}",
+         "args": [{"visible": [*bt["args"][0]["visible"], *[False] * nb]}]}
+        for bt in _view_buttons(a)
+    ] + [
+        {**bt, "label": f"{label_b}: {bt['label']}",
+         "args": [{"visible": [*[False] * na, *bt["args"][0]["visible"]]}]}
+        for bt in _view_buttons(b)
+    ]  # fmt: skip
+    for t in b["data"]:
         t["visible"] = False
-    fig["data"] = [*fig["data"], *extra]
-    quantity = [True] * n + [False] * e
-    surface = [i != 0 for i in range(n)] + [True] * e  # trace 0: the coloured tube
-    label = fig["data"][0].get("colorbar", {}).get("title", {}).get("text", "quantity")
-    fig["layout"]["title"] = {"text": fig["layout"]["title"]["text"] + " / damage"}
-    fig["layout"].setdefault("updatemenus", []).append(
+    out = {**a, "data": [*a["data"], *b["data"]]}
+    out["frames"] = []
+    for x, y in zip(fa, fb, strict=True):
+        traces = [*x["traces"], *(i + na for i in y["traces"])]
+        out["frames"].append({**x, "data": [*x["data"], *y["data"]], "traces": traces})
+    layout = out["layout"] = {**a["layout"]}
+    menus = [m for m in layout.get("updatemenus", []) if m.get("name") != "views"]
+    menus.append(
         {
-            "type": "buttons",
-            "direction": "left",
+            "name": "views",
+            "type": "dropdown",
+            "direction": "down",
             "showactive": True,
             "active": 0,
             "x": 0.3,
@@ -506,14 +588,13 @@ def with_damage(
             "y": 1.0,
             "yanchor": "top",
             "pad": {"t": 4, "l": 4},
-            "buttons": [
-                {"label": label, "method": "restyle", "args": [{"visible": quantity}]},
-                {
-                    "label": "damage on the surface",
-                    "method": "restyle",
-                    "args": [{"visible": surface}],
-                },
-            ],
+            "buttons": buttons,
         }
     )
-    return fig
+    layout["updatemenus"] = menus
+    sb = b["layout"]["scene"]
+    corners = np.array([[sb[f"{x}axis"]["range"][i] for x in "xyz"] for i in (0, 1)])
+    extend_range(out, corners)
+    name = a["data"][0].get("name", "cable")
+    layout["title"] = {"text": f"{name}: runs {label_a} and {label_b} (choose run and view)"}
+    return out

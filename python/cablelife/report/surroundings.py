@@ -38,13 +38,21 @@ def clearance_envelope_figure(cable: CableResult):
         name="largest over time",
         line={"dash": "dot"},
     )
+    # the limits as lines named in the legend (annotations at their ends overprint each other
+    # when the clearance axis spans much more than min_clearance)
+    ends = [float(cable.arc_length[0]), float(cable.arc_length[-1])]
     if cl.min_clearance > 0:
-        fig.add_hline(
-            y=cl.min_clearance * 1e3,
+        fig.add_scatter(
+            x=ends,
+            y=[cl.min_clearance * 1e3] * 2,
+            mode="lines",
+            name=f"min_clearance {cl.min_clearance * 1e3:g} mm",
             line={"color": "orange", "dash": "dash"},
-            annotation_text=f"min_clearance {cl.min_clearance * 1e3:g} mm",
+            hoverinfo="name",
         )
-    fig.add_hline(y=0, line={"color": "red"}, annotation_text="contact")
+    fig.add_scatter(
+        x=ends, y=[0, 0], mode="lines", name="contact (0)", line={"color": "red"}, hoverinfo="name"
+    )
     fig.update_layout(
         title=f"clearance of {cable.name} along the cable",
         xaxis_title="arc length s [m]",
@@ -55,10 +63,17 @@ def clearance_envelope_figure(cable: CableResult):
     return fig
 
 
-def clearance_3d_figure(cable: CableResult, result: Result, step: int, n_angles: int = 16):
-    """The tube at saved step ``step`` coloured by clearance, with the bodies' geometry."""
-    import plotly.graph_objects as go
+def least_clearance_step(cable: CableResult) -> int:
+    """The saved step of the least clearance of ``cable`` (with surroundings)."""
+    v = cable.surroundings.value
+    return int(np.unravel_index(np.argmin(v), v.shape)[0])
 
+
+def clearance_traces(
+    cable: CableResult, result: Result, step: int, n_angles: int = 16
+) -> tuple[list[dict], np.ndarray]:
+    """The tube at saved step ``step`` coloured by clearance and the bodies' geometry there
+    (plotly traces as dicts), and the points they span (n, 3)."""
     from cablelife.report.tube import tube_mesh
 
     cl = cable.surroundings
@@ -70,15 +85,17 @@ def clearance_3d_figure(cable: CableResult, result: Result, step: int, n_angles:
             m.vertices,
             m.faces,
             intensity=values,
+            meta={"tube": n_angles, "radius": radius},
             colorscale="RdYlGn",
             # the colours resolve the near zone: up to 4 × min_clearance or 5 cm
             cmin=min(float(cl.value.min()) * 1e3, 0.0),
             cmax=max(4 * cl.min_clearance, 0.05) * 1e3,
-            colorbar={"title": "clearance [mm]"},
-            name=cable.name,
+            colorbar={"title": {"text": "clearance [mm]", "side": "right"}},
+            name=f"{cable.name}: clearance",
             hovertemplate="clearance %{intensity:.2f} mm<extra></extra>",
-        )
+        ).to_plotly_json()
     ]
+    points = [m.vertices]
     geom = result.surroundings
     if geom is not None:
         t = float(cable.time[step])
@@ -88,6 +105,7 @@ def clearance_3d_figure(cable: CableResult, result: Result, step: int, n_angles:
             f = geom.meshes[b][1]
             if not len(f):
                 continue
+            points.append(v)
             traces.append(
                 mesh_trace(
                     v,
@@ -98,8 +116,16 @@ def clearance_3d_figure(cable: CableResult, result: Result, step: int, n_angles:
                     showlegend=True,
                     hovertemplate=f"{name}<extra></extra>",
                     flatshading=True,
-                )
+                ).to_plotly_json()
             )
+    return traces, np.concatenate(points)
+
+
+def clearance_3d_figure(cable: CableResult, result: Result, step: int, n_angles: int = 16):
+    """The tube at saved step ``step`` coloured by clearance, with the bodies' geometry."""
+    import plotly.graph_objects as go
+
+    traces, _ = clearance_traces(cable, result, step, n_angles)
     fig = go.Figure(traces)
     fig.update_layout(
         title=f"{cable.name} at t = {cable.time[step]:.4g} s (least clearance), surroundings",
@@ -111,7 +137,23 @@ def clearance_3d_figure(cable: CableResult, result: Result, step: int, n_angles:
     return fig
 
 
-def surroundings_section(page, result: Result, name: str) -> None:
+def with_clearance(view: dict, cable: CableResult, result: Result) -> dict:
+    """The run's 3D view (:func:`cablelife.report.scene3d.cable_figure`) with the clearance
+    as another view behind a button: the tube at the step of the least clearance coloured by
+    clearance, and the bodies' geometry where they are then (the cube widened to hold them)."""
+    from cablelife.report.scene3d import extend_range, with_view
+
+    step = least_clearance_step(cable)
+    traces, points = clearance_traces(cable, result, step)
+    extend_range(view, points)
+    label = f"clearance at t = {cable.time[step]:.3g} s (least), surroundings"
+    view["layout"]["title"]["text"] += " / clearance"
+    return with_view(view, traces, label, keep=[])
+
+
+def surroundings_section(
+    page, result: Result, name: str, view_at: str = "its 3D view above"
+) -> None:
     """Adds the clearance of cable ``name`` to a report page (``report.html._Page``)."""
     cable = result.cables[name]
     if cable.surroundings is None:
@@ -147,7 +189,8 @@ def surroundings_section(page, result: Result, name: str) -> None:
         ],
     )
     page.plotly(clearance_envelope_figure(cable), f"clearance of {name} along the cable")
-    step = int(
-        np.unravel_index(np.argmin(cable.surroundings.value), cable.surroundings.value.shape)[0]
+    t = cable.time[least_clearance_step(cable)]
+    page.note(
+        f"the clearance on the surface of {name} at t = {t:.4g} s (its least) with the bodies' "
+        f"geometry: 'clearance at t = …' in {view_at}"
     )
-    page.plotly(clearance_3d_figure(cable, result, step), f"{name} and its surroundings in 3D")

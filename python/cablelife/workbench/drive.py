@@ -129,5 +129,5 @@ def run_page(url: str, script, width: int = 1200, height: int = 800):
         finally:
             cdp.ws.close()
 
-    with chromium(width, height) as port:
-        return asyncio.run(main(port))
+    with chromium(width, height) as browser:
+        return asyncio.run(main(browser.port))
