@@ -267,7 +267,7 @@ class Browser(NamedTuple):
 
 
 @contextmanager
-def chromium(width: int = 1200, height: int = 900) -> Iterator["Browser"]:
+def chromium(width: int = 1200, height: int = 900) -> Iterator[Browser]:
     """A fresh headless Chromium with its own profile; yields its DevTools port and process id
     (connect to its page with :func:`connect`). Ended when the block ends."""
     browser = find_browser()
