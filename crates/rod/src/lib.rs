@@ -9,6 +9,8 @@ pub mod contact_mesh;
 pub mod dynamics;
 #[cfg(test)]
 mod fd_check;
+pub mod harness;
+pub mod junction;
 pub mod modal;
 pub mod model;
 pub mod rotation;
