@@ -162,8 +162,8 @@ impl Harness {
             let mut st = initial;
             let mut target: Vec<Vec<Pose>> = vec![Vec::new(); nc];
             for k in 0..t {
-                for c in 0..nc {
-                    target[c].clone_from(&poses[c][k]);
+                for (tc, pc) in target.iter_mut().zip(&poses) {
+                    tc.clone_from(&pc[k]);
                 }
                 let result = if k == 0 {
                     st.set_clip_poses(tree, &target);
