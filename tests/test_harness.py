@@ -140,3 +140,10 @@ def test_dynamic_harness_is_a_clear_error():
     scene = scene_from_dict(y_scene(mode="dynamic", duration=0.01))
     with pytest.raises(SceneError, match="not supported yet"):
         simulate(scene)
+
+
+def test_modal_analysis_of_a_harness_is_a_clear_error():
+    from cablelife.modal import modes
+
+    with pytest.raises(SceneError, match="modal analysis of harnesses"):
+        modes(scene_from_dict(y_scene()))
