@@ -169,7 +169,7 @@ impl Harness {
                     st.set_clip_poses(tree, &target);
                     solver.solve_static(tree, &mut st)
                 } else {
-                    solver.step_to(tree, &mut st, &target)
+                    solver.sequence_step(tree, &mut st, &target)
                 };
                 let stats = match result {
                     Ok(s) => s,

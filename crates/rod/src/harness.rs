@@ -437,6 +437,12 @@ pub struct HarnessStatics {
     base: HarnessState,
     saved: HarnessState,
     start_poses: Vec<Vec<Pose>>,
+    /// The last two equilibria of a sequence (the predictor of `sequence_step`).
+    last: HarnessState,
+    prev: HarnessState,
+    has_prev: bool,
+    /// Pseudo-transient damping added to the junction pivots by `factor` (position, rotation).
+    junction_shift: (f64, f64),
     force_scale: f64,
     /// Length scales: the shortest cable (steps) and the finest mean segment (moments).
     length: f64,
@@ -491,6 +497,10 @@ impl HarnessStatics {
             base: HarnessState::empty(),
             saved: HarnessState::empty(),
             start_poses: Vec::new(),
+            last: HarnessState::empty(),
+            prev: HarnessState::empty(),
+            has_prev: false,
+            junction_shift: (0.0, 0.0),
             force_scale,
             length,
             h: hmin,
@@ -542,17 +552,26 @@ impl HarnessStatics {
 
     /// Largest scaled residual (N; moments divided by the finest mean segment length).
     pub fn residual_inf(&self) -> f64 {
+        self.residual_norms().1
+    }
+
+    /// Scaled residual norms (2-norm, ∞-norm) over the cables and junctions.
+    pub fn residual_norms(&self) -> (f64, f64) {
         let mut inf = 0.0f64;
+        let mut two = 0.0;
         for ws in &self.ws {
-            inf = inf.max(ws.residual_norms(self.h).1);
+            let (t, i) = ws.residual_norms(self.h);
+            inf = inf.max(i);
+            two += t * t;
         }
         for r in &self.junction_residual {
             for k in 0..6 {
                 let v = if k < 3 { r[k] } else { r[k] / self.h };
                 inf = inf.max(v.abs());
+                two += v * v;
             }
         }
-        inf
+        (two.sqrt(), inf)
     }
 
     /// Factors the assembled system: each cable segment, the Schur complements onto the
@@ -571,6 +590,13 @@ impl HarnessStatics {
                 let e = &h.ends[k];
                 let ee = &self.held[e.cable].ends[e.local].ee;
                 d += cols_to_junction(&rows_to_junction(ee, &e.rel), &e.rel);
+            }
+            for k in 0..6 {
+                d[(k, k)] += if k < 3 {
+                    self.junction_shift.0
+                } else {
+                    self.junction_shift.1
+                };
             }
             self.pivot[j] = d;
         }
@@ -863,6 +889,11 @@ impl HarnessStatics {
             }
             self.assemble(h, st, lf, true)?;
             rinf = self.residual_inf();
+            if std::env::var_os("ROD_DEBUG").is_some() {
+                eprintln!(
+                    "harness it {it} lf {lf} alpha {alpha:.3e} step {step:.3e} rinf {rinf:.3e}"
+                );
+            }
             if alpha == 1.0 && step < self.opts.step_tolerance {
                 stats.residual = rinf;
                 return Ok(stats);
@@ -871,14 +902,117 @@ impl HarnessStatics {
         Err(not_converged(stats.iterations, rinf))
     }
 
-    /// Static equilibrium: plain Newton; then damped Newton; then load continuation from the
-    /// unloaded start (gravity and loads ramped) with damped steps.
+    /// Pseudo-transient continuation (as `Statics::pseudo_transient`): (J + σD) Δ = −r with D
+    /// a viscous medium (δs for positions, Δs³/12 for rotations; the junctions with the finest
+    /// mean segment), σ relaxed to zero by switched evolution relaxation.
+    pub fn pseudo_transient(
+        &mut self,
+        h: &Harness,
+        st: &mut HarnessState,
+        lf: f64,
+        max_iterations: usize,
+    ) -> Result<SolveStats, HarnessError> {
+        const PTC_START: f64 = 1e-3;
+        let damping = |rod: &Rod, b: usize, k: usize| -> f64 {
+            if k < 3 {
+                rod.ds_node[b]
+            } else {
+                rod.ds_edge[b.min(rod.n_edges() - 1)].powi(3) / 12.0
+            }
+        };
+        let junction_damping = (self.h, self.h.powi(3) / 12.0);
+        self.assemble(h, st, lf, true)?;
+        let (mut r_old, mut rinf) = self.residual_norms();
+        let mut sigma = 0.0f64;
+        for (c, rod) in h.cables.iter().enumerate() {
+            for (b, m) in rod.mask.iter().enumerate() {
+                for (k, &active) in m.iter().enumerate() {
+                    if active {
+                        let d = self.ws[c].jac.diag[b][(k, k)].abs() / damping(rod, b, k);
+                        sigma = sigma.max(d);
+                    }
+                }
+            }
+        }
+        sigma *= PTC_START;
+        let sigma0 = sigma;
+        let mut stats = SolveStats::default();
+        let result = (|| {
+            for it in 0..max_iterations {
+                stats.iterations = it + 1;
+                if rinf <= self.opts.residual_tolerance * self.force_scale {
+                    stats.iterations = it;
+                    stats.residual = rinf;
+                    return Ok(stats);
+                }
+                for (c, rod) in h.cables.iter().enumerate() {
+                    for (b, m) in rod.mask.iter().enumerate() {
+                        for (k, &active) in m.iter().enumerate() {
+                            if active {
+                                self.ws[c].jac.diag[b][(k, k)] += sigma * damping(rod, b, k);
+                            }
+                        }
+                    }
+                }
+                self.junction_shift = (sigma * junction_damping.0, sigma * junction_damping.1);
+                self.factor(h)?;
+                self.junction_shift = (0.0, 0.0);
+                let (dx, dth) = self.solve(h, false);
+                let step = (dx / self.length).max(dth);
+                let alpha = 1.0f64.min(self.opts.max_rotation_step / dth.max(1e-300));
+                self.base.clone_from(st);
+                st.apply_increment(h, &self.delta, &self.dj, alpha);
+                let ok = self.assemble(h, st, lf, true).is_ok();
+                let (r_new, r_inf_new) = if ok {
+                    self.residual_norms()
+                } else {
+                    (f64::INFINITY, f64::INFINITY)
+                };
+                if !(step.is_finite() && r_new.is_finite()) || r_new > 10.0 * r_old.max(1e-300) {
+                    st.clone_from(&self.base);
+                    self.assemble(h, st, lf, true)?;
+                    sigma = (sigma * 10.0).max(1e-6 * sigma0);
+                    continue;
+                }
+                if std::env::var_os("ROD_DEBUG").is_some() {
+                    eprintln!(
+                        "harness ptc {it} sigma {sigma:.3e} step {step:.3e} rinf {r_inf_new:.3e}"
+                    );
+                }
+                if sigma == 0.0 && alpha == 1.0 && step < self.opts.step_tolerance {
+                    stats.residual = r_inf_new;
+                    return Ok(stats);
+                }
+                sigma *= (r_new / r_old.max(1e-300)).min(0.5);
+                if sigma < 1e-10 * sigma0 {
+                    sigma = 0.0;
+                }
+                r_old = r_new;
+                rinf = r_inf_new;
+            }
+            Err(HarnessError(format!(
+                "{}",
+                SolveError::NotConverged {
+                    iterations: stats.iterations,
+                    residual: rinf,
+                    load_factor: lf,
+                }
+            )))
+        })();
+        self.junction_shift = (0.0, 0.0);
+        result
+    }
+
+    /// Static equilibrium: plain Newton; then pseudo-transient continuation; then damped
+    /// Newton; then load continuation from the unloaded start (gravity and loads ramped) with
+    /// damped steps.
     pub fn solve_static(
         &mut self,
         h: &Harness,
         st: &mut HarnessState,
     ) -> Result<SolveStats, HarnessError> {
         st.sync_ends(h);
+        self.has_prev = false; // a new sequence starts here
         let start = st.clone();
         let full = self.opts.max_iterations;
         self.opts.max_iterations = full.min(15);
@@ -886,6 +1020,15 @@ impl HarnessStatics {
         self.opts.max_iterations = full;
         match plain {
             Ok(s) => return Ok(s),
+            Err(e) if e.0.contains("singular") => return Err(e),
+            Err(_) => {}
+        }
+        st.clone_from(&start);
+        match self.pseudo_transient(h, st, 1.0, 20 * self.opts.max_iterations) {
+            Ok(mut s) => {
+                s.substeps = 1;
+                return Ok(s);
+            }
             Err(e) if e.0.contains("singular") => return Err(e),
             Err(_) => {}
         }
@@ -987,6 +1130,40 @@ impl HarnessStatics {
             }
         }
         Ok(total)
+    }
+
+    /// The next equilibrium of a sequence (after `solve_static` for the first): the free
+    /// unknowns and the junction poses are extrapolated linearly from the last two equilibria
+    /// (predictor), then `step_to`; if that fails, it is retried from the last equilibrium.
+    pub fn sequence_step(
+        &mut self,
+        h: &Harness,
+        st: &mut HarnessState,
+        target: &[Vec<Pose>],
+    ) -> Result<SolveStats, HarnessError> {
+        self.last.clone_from(st);
+        if self.has_prev {
+            for (c, rod) in h.cables.iter().enumerate() {
+                st.cables[c].extrapolate_free(rod, &self.prev.cables[c], &self.last.cables[c]);
+            }
+            for (j, pose) in st.junctions.iter_mut().enumerate() {
+                let (p0, p1) = (&self.prev.junctions[j], &self.last.junctions[j]);
+                pose.position = 2.0 * p1.position - p0.position;
+                let q = p1.orientation * (p0.orientation.conjugate() * p1.orientation);
+                pose.orientation = q / q.norm();
+            }
+            st.sync_ends(h);
+        }
+        let result = match self.step_to(h, st, target) {
+            Ok(s) => Ok(s),
+            Err(_) => {
+                st.clone_from(&self.last);
+                self.step_to(h, st, target)
+            }
+        };
+        std::mem::swap(&mut self.prev, &mut self.last);
+        self.has_prev = true;
+        result
     }
 
     /// Force and moment (about the junction point, global) that each end's cable applies to

@@ -275,6 +275,33 @@ fn coupled_jacobian_matches_finite_differences() {
         worst = worst.max((fd - jvj[j]).amax());
     }
     assert!(worst < 1e-6 * scale, "worst {worst:e} scale {scale:e}");
+    // Position and rotation rows separately (rotation rows are small against EA terms).
+    for half in 0..2 {
+        let rows = |v: &Vector6<f64>| v.fixed_rows::<3>(3 * half).amax();
+        let scale = jv
+            .iter()
+            .flatten()
+            .chain(&jvj)
+            .map(rows)
+            .fold(0.0, f64::max);
+        let mut worst = 0.0f64;
+        for c in 0..h.cables.len() {
+            for b in 0..jv[c].len() {
+                let fd = (rp[c][b] - rm[c][b]) / (2.0 * eps);
+                worst = worst.max(rows(&(fd - jv[c][b])));
+            }
+        }
+        for j in 0..h.junctions.len() {
+            let fd = (rpj[j] - rmj[j]) / (2.0 * eps);
+            let e = rows(&(fd - jvj[j]));
+            eprintln!("junction {j} half {half}: err {e:e} of {:e}", rows(&jvj[j]));
+            worst = worst.max(e);
+        }
+        assert!(
+            worst < 1e-6 * scale,
+            "half {half}: worst {worst:e} scale {scale:e}"
+        );
+    }
     // The junction rows alone are checked too (they are a small part of the vector).
     let jscale = jvj.iter().map(|x| x.amax()).fold(0.0, f64::max);
     for j in 0..h.junctions.len() {
