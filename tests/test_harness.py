@@ -147,3 +147,24 @@ def test_modal_analysis_of_a_harness_is_a_clear_error():
 
     with pytest.raises(SceneError, match="modal analysis of harnesses"):
         modes(scene_from_dict(y_scene()))
+
+
+def test_example_harness_runs_from_the_command_line(tmp_path):
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    scene = Path(__file__).resolve().parents[1] / "examples" / "harness" / "scene.toml"
+    out = tmp_path / "h.h5"
+    proc = subprocess.run(
+        [sys.executable, "-m", "cablelife", "run", str(scene), "-o", str(out), "--mode", "static"],
+        capture_output=True,
+        text=True,
+    )
+    assert proc.returncode == 0, proc.stderr
+    assert "junctions (max over time)" in proc.stdout and "gearbox:start" in proc.stdout
+    res = load_result(out)
+    j = res.junctions["breakout"]
+    assert len(j.branch_force) == 4
+    total = sum(f[0] for f in j.branch_force.values()) + np.array([0, 0, -9.81 * 0.01])
+    assert np.abs(total).max() < 1e-8 * max(np.abs(f[0]).max() for f in j.branch_force.values())

@@ -220,3 +220,25 @@ def run_harness(scene: Scene, times: np.ndarray, mode: str, progress, stop):
             branch_moment={k: v[1] for k, v in branches.items()},
         )
     return results, junctions, out["error"]
+
+
+def junction_table(result):
+    """A rich table of the junctions: the largest displacement from the first saved step and
+    the largest branch force and moment on each junction."""
+    from rich.markup import escape
+    from rich.table import Table
+
+    t = Table(title="junctions (max over time)", title_justify="left")
+    for col in ("junction", "branch", "|force| [N]", "|moment| [N m]", "moved [mm]"):
+        t.add_column(escape(col), justify="left" if col in ("junction", "branch") else "right")
+    for name, j in result.junctions.items():
+        moved = float(np.linalg.norm(j.position - j.position[:1], axis=1).max(initial=0.0))
+        for k, (end, force) in enumerate(j.branch_force.items()):
+            t.add_row(
+                escape(name) if k == 0 else "",
+                escape(end),
+                f"{np.linalg.norm(force, axis=1).max(initial=0.0):.4g}",
+                f"{np.linalg.norm(j.branch_moment[end], axis=1).max(initial=0.0):.4g}",
+                f"{1e3 * moved:.3g}" if k == 0 else "",
+            )
+    return t
