@@ -126,7 +126,7 @@ def run_harness(scene: Scene, times: np.ndarray, mode: str, progress, stop):
     junction results (by name) and the error message (None: complete)."""
     from cablelife import _core
     from cablelife.scene import SceneError
-    from cablelife.simulate import _stability_info, build_cable, clip_poses
+    from cablelife.simulate import _stability_info, body_motions, build_cable, clip_kinematics
 
     if mode not in ("static", "quasistatic"):
         raise SceneError(
@@ -149,7 +149,9 @@ def run_harness(scene: Scene, times: np.ndarray, mode: str, progress, stop):
         )
     except ValueError as err:
         raise SceneError(f"harness: {err}") from None
-    poses = [clip_poses(scene, c, times) for c in cables]
+    motions = body_motions(scene, times)  # once for all cables
+    kin = [clip_kinematics(scene, c, times, motions=motions) for c in cables]
+    poses = [(k["positions"], k["quaternions"]) for k in kin]
     callback = (lambda k, n: progress("harness", k, n)) if progress else None
     start = _time.perf_counter()
     out = core.run_sequence(

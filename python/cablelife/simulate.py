@@ -130,13 +130,15 @@ def body_motions(scene: Scene, times: np.ndarray, with_motion: bool = True) -> d
 
 
 def clip_kinematics(
-    scene: Scene, cable: Cable, times: np.ndarray, with_motion: bool = True
+    scene: Scene, cable: Cable, times: np.ndarray, with_motion: bool = True, motions=None
 ) -> dict[str, np.ndarray]:
     """Clip kinematics on ``times``: positions (T, C, 3), quaternions scalar first (T, C, 4),
     velocities, angular velocities, accelerations, angular accelerations (T, C, 3), global.
-    Without ``with_motion``: the reference poses (bodies at rest)."""
+    Without ``with_motion``: the reference poses (bodies at rest). ``motions``: the
+    :func:`body_motions` on ``times`` if already at hand (several cables)."""
     n_t, n_c = times.size, len(cable.clips)
-    motions = body_motions(scene, times, with_motion)
+    if motions is None:
+        motions = body_motions(scene, times, with_motion)
     out = {
         k: np.zeros((n_t, n_c, 3))
         for k in (
