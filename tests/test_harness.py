@@ -127,6 +127,7 @@ def test_quasistatic_harness_follows_a_moving_clip():
             ),
             "loop",
         ),
+        (lambda s: [c["clips"].clear() for c in s["cables"]], "held by no clip"),
     ],
 )
 def test_bad_junctions_are_named(change, message):

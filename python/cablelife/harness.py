@@ -81,6 +81,19 @@ def check_junctions(scene: Scene) -> None:
                 f"'{a}' and '{b}'; loops are not supported yet"
             )
         parent[ra] = rb
+    # Every connected harness needs a clip somewhere (else it floats: a rigid-body motion).
+    clipped: dict[str, bool] = {}
+    for j in scene.junctions:
+        r = find(j.name)
+        held_here = any(cables[j.end(i)[0]].clips for i in range(len(j.ends)))
+        clipped[r] = clipped.get(r, False) or held_here
+    for j in scene.junctions:
+        if not clipped[find(j.name)]:
+            group = sorted(k.name for k in scene.junctions if find(k.name) == find(j.name))
+            _fail(
+                f"the harness through junctions {group} is held by no clip: it could move as "
+                "a rigid body; give at least one of its cables a clip"
+            )
 
 
 def end_clip_name(junction: Junction) -> str:
