@@ -367,17 +367,27 @@ impl HarnessState {
     }
 
     /// Sets the poses of the clips that hold cables (not the junction ends) to `poses[c]`
-    /// (all clips of cable c; the entries of junction ends are ignored).
-    pub fn set_clip_poses(&mut self, h: &Harness, poses: &[Vec<Pose>]) {
+    /// (all clips of cable c; the entries of junction ends are ignored). `buffer` is scratch.
+    pub fn set_clip_poses_with(
+        &mut self,
+        h: &Harness,
+        poses: &[Vec<Pose>],
+        buffer: &mut Vec<Pose>,
+    ) {
         for (c, rod) in h.cables.iter().enumerate() {
             let st = &mut self.cables[c];
-            let mut p = poses[c].clone();
+            buffer.clone_from(&poses[c]);
             for &k in &h.cable_ends[c] {
                 let clip = h.ends[k].topo.clip;
-                p[clip] = st.clip_pose[clip];
+                buffer[clip] = st.clip_pose[clip];
             }
-            st.set_clip_poses(rod, &p);
+            st.set_clip_poses(rod, buffer);
         }
+    }
+
+    /// `set_clip_poses_with` with a scratch buffer of its own.
+    pub fn set_clip_poses(&mut self, h: &Harness, poses: &[Vec<Pose>]) {
+        self.set_clip_poses_with(h, poses, &mut Vec::new());
     }
 }
 
@@ -437,6 +447,8 @@ pub struct HarnessStatics {
     base: HarnessState,
     saved: HarnessState,
     start_poses: Vec<Vec<Pose>>,
+    poses: Vec<Vec<Pose>>,
+    pose_buffer: Vec<Pose>,
     /// The last two equilibria of a sequence (the predictor of `sequence_step`).
     last: HarnessState,
     prev: HarnessState,
@@ -497,6 +509,8 @@ impl HarnessStatics {
             base: HarnessState::empty(),
             saved: HarnessState::empty(),
             start_poses: Vec::new(),
+            poses: Vec::new(),
+            pose_buffer: Vec::new(),
             last: HarnessState::empty(),
             prev: HarnessState::empty(),
             has_prev: false,
@@ -1084,9 +1098,12 @@ impl HarnessStatics {
         st: &mut HarnessState,
         target: &[Vec<Pose>],
     ) -> Result<SolveStats, HarnessError> {
-        self.start_poses = st.cables.iter().map(|s| s.clip_pose.clone()).collect();
+        self.start_poses.resize(st.cables.len(), Vec::new());
+        for (sp, c) in self.start_poses.iter_mut().zip(&st.cables) {
+            sp.clone_from(&c.clip_pose);
+        }
         self.saved.clone_from(st);
-        st.set_clip_poses(h, target);
+        st.set_clip_poses_with(h, target, &mut self.pose_buffer);
         match self.newton(h, st, 1.0, false) {
             Ok(s) => return Ok(s),
             Err(e) if e.0.contains("singular") => return Err(e),
@@ -1096,8 +1113,15 @@ impl HarnessStatics {
         let mut done = 0.0f64;
         let mut df = 0.5f64;
         let mut depth = 1;
-        let mut poses = target.to_vec();
-        while done < 1.0 {
+        let mut poses = std::mem::take(&mut self.poses);
+        poses.resize(target.len(), Vec::new());
+        for (p, t) in poses.iter_mut().zip(target) {
+            p.clone_from(t);
+        }
+        let result = loop {
+            if done >= 1.0 {
+                break Ok(total);
+            }
             let f = (done + df).min(1.0);
             for (c, cable) in poses.iter_mut().enumerate() {
                 for (k, pose) in cable.iter_mut().enumerate() {
@@ -1107,7 +1131,7 @@ impl HarnessStatics {
                 }
             }
             self.saved.clone_from(st);
-            st.set_clip_poses(h, &poses);
+            st.set_clip_poses_with(h, &poses, &mut self.pose_buffer);
             match self.newton(h, st, 1.0, false) {
                 Ok(s) => {
                     total.iterations += s.iterations;
@@ -1124,12 +1148,13 @@ impl HarnessStatics {
                     depth += 1;
                     df *= 0.5;
                     if depth > self.opts.max_substep_depth {
-                        return Err(e);
+                        break Err(e);
                     }
                 }
             }
-        }
-        Ok(total)
+        };
+        self.poses = poses;
+        result
     }
 
     /// The next equilibrium of a sequence (after `solve_static` for the first): the free
