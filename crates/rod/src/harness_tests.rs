@@ -4,6 +4,7 @@ use super::*;
 use crate::model::{CableSpec, ClipSpec, PointLoad, Section};
 use crate::rotation::frame_quaternion;
 use crate::routing::route;
+use crate::statics::NewtonOptions;
 
 fn section() -> Section {
     Section {
