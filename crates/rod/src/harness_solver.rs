@@ -34,6 +34,9 @@ fn vec_to_junction(v: &Vector6<f64>, r: &Matrix3<f64>) -> Vector6<f64> {
     out
 }
 
+/// Largest junction displacement per Newton iteration, as a fraction of the shortest cable.
+const JUNCTION_STEP: f64 = 0.1;
+
 /// Inverse of a junction pivot, or None when it is singular to working precision.
 fn invert(m: &Matrix6<f64>) -> Option<Matrix6<f64>> {
     let inv = m.try_inverse()?;
@@ -500,6 +503,12 @@ impl HarnessStatics {
             let step = (dx / self.length).max(dth);
             let norm0 = self.scaled_norm(&self.delta, &self.dj);
             let mut alpha = 1.0f64.min(self.opts.max_rotation_step / dth.max(1e-300));
+            let djx = self
+                .dj
+                .iter()
+                .map(|d| d.fixed_rows::<3>(0).amax())
+                .fold(0.0, f64::max);
+            alpha = alpha.min(JUNCTION_STEP * self.length / djx.max(1e-300));
             self.base.clone_from(st);
             let mut accepted = false;
             for _ in 0..16 {
