@@ -112,6 +112,30 @@ class Cable:
 
 DEFAULT_NEWTON_TOLERANCE: float
 
+class Harness:
+    """A harness: cables (each given with a fixed point clip at every joined end) and junctions."""
+    def __init__(
+        self, cables, names, junctions, max_iterations=40, step_tolerance=1e-9
+    ) -> None: ...
+    @property
+    def ends(self) -> Any:
+        """(cable index, clip index, junction index) of every joined end, in the order of the
+        branch outputs."""
+        ...
+    def run_sequence(
+        self, positions, quaternions, progress=None, progress_every=50, stop=None
+    ) -> Any:
+        """Runs a sequence of equilibria through the clip poses of each cable, `positions[c]`
+        (T, C_c, 3) and `quaternions[c]` (T, C_c, 4) (the entries of joined ends are ignored).
+        Step 0 is a static solve from the routed shapes. Returns `cables` (one dict per cable,
+        as `Cable.run_sequence`), `junction_positions` (T, J, 3), `junction_quaternions`
+        (T, J, 4, scalar first), `branch_force` and `branch_moment` (T, E, 3: what each joined
+        end's cable applies to its junction, global, moment about the junction point),
+        `iterations`, `substeps`, `residual`, `steps` and `error` (None, or why it stopped: the
+        steps before are kept).
+        """
+        ...
+
 INTERRUPTED: str
 
 class StopFlag:

@@ -136,6 +136,10 @@ def print_summary(result: Result) -> None:
 
             for table in clearance_tables(c):
                 console.print(table)
+    if result.junctions:
+        from cablelife.harness import junction_table
+
+        console.print(junction_table(result))
 
 
 def _progress_bar():

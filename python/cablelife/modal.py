@@ -44,6 +44,11 @@ class Modes:
 
 def _equilibrium(scene: Scene, cable: Cable):
     """The solver object at the static equilibrium with the clip poses of t = 0."""
+    if scene.junctions:
+        raise SceneError(
+            "modal analysis of harnesses (scenes with [[junctions]]) is not supported yet: the "
+            "modes of a single cable would ignore its junctions"
+        )
     core = build_cable(scene, cable)
     pos, quat = clip_poses(scene, cable, np.array([0.0]), with_motion=True)
     try:

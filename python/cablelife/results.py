@@ -18,6 +18,9 @@ HDF5 layout (every dataset carries a ``unit`` attribute)::
     /cables/<name>/solver        attrs and datasets: iterations (T,), residual (T,), ...
     /cables/<name>/clearance, clearance_body, clearance_part   (T, N+1) with geometry
                                  (see cablelife.surroundings.data)
+    /junctions/<name>/time, position (T, 3) m, quaternion (T, 4) 1   harnesses (docs/harness.md)
+    /junctions/<name>/branches/<cable:end>/force, moment  (T, 3) N, N m: what that branch
+                                 applies to the junction (global, about the junction point)
 
 Datasets are chunked and compressed (gzip level 1 with the shuffle filter: lossless, readable by
 any HDF5 tool); the histories (positions … clip reactions) are float64, or float32 when the
@@ -218,6 +221,24 @@ class CableResult:
             return np.where(kappa > 0, 1.0 / kappa, np.inf)
 
 
+@dataclass(repr=False)
+class JunctionResult:
+    """A harness junction over time (docs/harness.md): its position, orientation (scalar-first
+    quaternion; identity at the reference: the junction's axes are then the global axes), and
+    per joined end "cable:start|end" the force and moment (about the junction point, global)
+    that branch applies to the junction."""
+
+    name: str
+    time: np.ndarray
+    position: np.ndarray  # (T, 3) m
+    quaternion: np.ndarray  # (T, 4)
+    branch_force: dict[str, np.ndarray] = field(default_factory=dict)  # (T, 3) N
+    branch_moment: dict[str, np.ndarray] = field(default_factory=dict)  # (T, 3) N m
+
+    def __repr__(self) -> str:
+        return f"JunctionResult({self.name!r}, branches {list(self.branch_force)})"
+
+
 @dataclass
 class Result:
     """The result of one run: one :class:`CableResult` per cable."""
@@ -230,6 +251,7 @@ class Result:
     #: Precision of the histories in the file ("float64" or "float32"; docs/results.md).
     precision: str = "float64"
     surroundings: SurroundingsGeometry | None = None  # body geometry and poses, for pictures
+    junctions: dict[str, JunctionResult] = field(default_factory=dict)  # harnesses only
 
     @property
     def cable(self) -> CableResult:
@@ -318,7 +340,44 @@ def save_result(result: Result, path: str | os.PathLike, precision: str | None =
                 c.surroundings.write(g, lambda *a, **k: _put(*a, **k, dtype=hist))
         if result.surroundings is not None:
             result.surroundings.write(f)
+        if result.junctions:
+            _write_junctions(f, result.junctions, hist)
     return path
+
+
+def _write_junctions(f, junctions: dict[str, JunctionResult], hist: str | None) -> None:
+    top = f.create_group("junctions")
+    for name, j in junctions.items():
+        g = top.create_group(name)
+        _put(g, "time", j.time)
+        _put(g, "position", j.position, "m", hist)
+        _put(g, "quaternion", j.quaternion, "1", hist)
+        branches = g.create_group("branches")
+        for end, force in j.branch_force.items():
+            b = branches.create_group(end)
+            _put(b, "force", force, "N", hist)
+            _put(b, "moment", j.branch_moment[end], "N m", hist)
+
+
+def _read_junctions(f) -> dict[str, JunctionResult]:
+    if "junctions" not in f:
+        return {}
+
+    def get(ds) -> np.ndarray:
+        return np.asarray(ds[()], dtype=np.float64)
+
+    out = {}
+    for name, g in f["junctions"].items():
+        br = g["branches"]
+        out[name] = JunctionResult(
+            name=name,
+            time=get(g["time"]),
+            position=get(g["position"]),
+            quaternion=get(g["quaternion"]),
+            branch_force={e: get(b["force"]) for e, b in br.items()},
+            branch_moment={e: get(b["moment"]) for e, b in br.items()},
+        )
+    return out
 
 
 def load_result(path: str | os.PathLike, lazy: bool = True) -> Result:
@@ -373,6 +432,7 @@ def load_result(path: str | os.PathLike, lazy: bool = True) -> Result:
             message=str(f.attrs.get("message", "")),
             precision=str(f.attrs.get("precision", "float64")),
             surroundings=SurroundingsGeometry.read(f),
+            junctions=_read_junctions(f),
         )
     check_result_values(result, path)  # no NaN into reports, VTK files, damage maps
     warn_partial(result, path)

@@ -255,7 +255,8 @@ class Cable(_Model):
     section: Annotated[CircleSection | TubeSection, Field(discriminator="shape")] | None = None
     material: Material | None = None
     stiffness: MeasuredStiffness | None = None
-    clips: Annotated[list[Clip], Field(min_length=1)]
+    # At least one clip, unless a junction holds the cable (checked with the junctions).
+    clips: list[Clip] = []
     loads: list[Load] = []
     damping: Damping = Damping()
 
@@ -408,6 +409,59 @@ def read_pose_table(path: Path, what: str) -> dict[str, np.ndarray]:
     return table
 
 
+class Junction(_Model):
+    """A junction of a harness (docs/harness.md): joins cable ends rigidly at ``position``.
+    ``ends`` name "cable:start" or "cable:end"; ``directions`` give each end's stress-free
+    tangent at the junction, pointing away from it (global, at the reference); ``normals``
+    (optional) its d1 (default: the global axis least aligned with the direction, as for
+    clips). ``mass`` and ``rotary_inertia`` (about the junction's axes) of the tape or
+    connector."""
+
+    name: Name
+    ends: Annotated[list[Annotated[str, Strict()]], Field(min_length=2)]
+    position: Point  # m
+    directions: list[Direction]
+    normals: list[Direction] | None = None
+    mass: NonNegativeFloat = 0.0  # kg
+    rotary_inertia: NonNegativeFloat = 0.0  # kg m², about each axis
+
+    @model_validator(mode="after")
+    def _ends(self):
+        for i, e in enumerate(self.ends):
+            cable, _, which = e.rpartition(":")
+            if not cable or which not in ("start", "end"):
+                raise ValueError(
+                    f"ends[{i}] = {e!r}: allowed: 'cable:start' or 'cable:end' (a cable name, "
+                    "a colon, and which end)"
+                )
+        if len(self.directions) != len(self.ends):
+            raise ValueError(
+                f"{len(self.directions)} directions for {len(self.ends)} ends; give one "
+                "direction per end (its tangent pointing away from the junction)"
+            )
+        if self.normals is not None and len(self.normals) != len(self.ends):
+            raise ValueError(
+                f"{len(self.normals)} normals for {len(self.ends)} ends; give one per end or none"
+            )
+        for i, d in enumerate(self.directions):
+            if math.hypot(*d) < 1e-9:
+                raise ValueError(f"directions[{i}] must not be the zero vector")
+            if self.normals is not None:
+                dd = np.array(d) / np.linalg.norm(d)
+                n = np.array(self.normals[i])
+                if np.linalg.norm(n - dd * n.dot(dd)) < 1e-9 * max(np.linalg.norm(n), 1e-300):
+                    raise ValueError(
+                        f"normals[{i}] = {list(n)} is zero or parallel to directions[{i}] = "
+                        f"{list(d)}; it must have a part orthogonal to it"
+                    )
+        return self
+
+    def end(self, i: int) -> tuple[str, str]:
+        """(cable name, "start" or "end") of end i."""
+        cable, _, which = self.ends[i].rpartition(":")
+        return cable, which
+
+
 class Files(_Model):
     """Files named in the scene (measured signals, motion_file): outside the scene's folder
     only with ``allow_outside = true`` (or the CLI flag ``--allow-outside-files``)."""
@@ -443,6 +497,7 @@ class Scene(_Model):
     files: Files = Files()
     bodies: list[Body] = []
     cables: Annotated[list[Cable], Field(min_length=1)]
+    junctions: list[Junction] = []  # harnesses: cable ends joined at junctions
     clearance: ClearanceSettings | None = None  # settings of the clearance to the geometry
     contact: ContactSettings | None = None  # docs/contact.md
     base_dir: Annotated[Path | None, Field(exclude=True)] = None
@@ -467,6 +522,9 @@ class Scene(_Model):
                         f"cables[{i}].clips[{j}].body = '{clip.body}' is not a body of the scene; "
                         f"allowed: {allowed}"
                     )
+        from cablelife.harness import check_junctions
+
+        check_junctions(self)
         check_geometry(self)
         if self.simulation.mode != "static" and self.simulation.duration is None:
             raise ValueError(f"simulation.duration is required in {self.simulation.mode} mode")

@@ -130,13 +130,15 @@ def body_motions(scene: Scene, times: np.ndarray, with_motion: bool = True) -> d
 
 
 def clip_kinematics(
-    scene: Scene, cable: Cable, times: np.ndarray, with_motion: bool = True
+    scene: Scene, cable: Cable, times: np.ndarray, with_motion: bool = True, motions=None
 ) -> dict[str, np.ndarray]:
     """Clip kinematics on ``times``: positions (T, C, 3), quaternions scalar first (T, C, 4),
     velocities, angular velocities, accelerations, angular accelerations (T, C, 3), global.
-    Without ``with_motion``: the reference poses (bodies at rest)."""
+    Without ``with_motion``: the reference poses (bodies at rest). ``motions``: the
+    :func:`body_motions` on ``times`` if already at hand (several cables)."""
     n_t, n_c = times.size, len(cable.clips)
-    motions = body_motions(scene, times, with_motion)
+    if motions is None:
+        motions = body_motions(scene, times, with_motion)
     out = {
         k: np.zeros((n_t, n_c, 3))
         for k in (
@@ -448,6 +450,31 @@ def _check_strains(scene: Scene, cables) -> list[str]:
     return []
 
 
+def _simulate_harness(scene: Scene, mode: str, times: np.ndarray, env, progress) -> Result:
+    """A scene with junctions: one harness system (cablelife.harness)."""
+    from cablelife.harness import run_harness
+
+    with interrupt.stop_flag() as stop:
+        cables, junctions, error = run_harness(scene, times, mode, progress, stop)
+    errors = [f"harness: {error}"] if error else []
+    stopped = error == interrupt.INTERRUPTED
+    errors += _check_strains(scene, cables.values())
+    result = Result(
+        mode=mode,
+        cables=cables,
+        scene_toml=scene.to_toml(),
+        complete=not errors,
+        message=interrupt.INTERRUPTED if stopped else "; ".join(errors),
+        precision=scene.simulation.output_precision,
+        junctions=junctions,
+    )
+    if env is not None:
+        add_clearance(env, scene, result, times, 1)
+    if errors:
+        raise SimulationError(result.message, result)
+    return result
+
+
 def simulate(scene: Scene, mode: str | None = None, progress: Progress | None = None) -> Result:
     """Runs the scene (``mode`` overrides ``scene.simulation.mode``).
 
@@ -463,6 +490,8 @@ def simulate(scene: Scene, mode: str | None = None, progress: Progress | None = 
     check_run_size(scene, mode)
     times = output_times(scene, mode)
     env = load_surroundings(scene)  # reads and checks the geometry before the run
+    if scene.junctions:
+        return _simulate_harness(scene, mode, times, env, progress)
     workers = max(1, min(len(scene.cables), os.cpu_count() or 1))
     with interrupt.stop_flag() as stop, ThreadPoolExecutor(max_workers=workers) as pool:
         futures = [

@@ -16,7 +16,7 @@ use rod::{
     Pose, Rod, Section, State, Statics,
 };
 
-fn vec3(v: &[f64], what: &str) -> PyResult<Vector3<f64>> {
+pub(crate) fn vec3(v: &[f64], what: &str) -> PyResult<Vector3<f64>> {
     if v.len() != 3 || v.iter().any(|x| !x.is_finite()) {
         return Err(PyValueError::new_err(format!(
             "{what} = {v:?}: must be 3 finite numbers"
@@ -45,7 +45,7 @@ type ClipTuple = (String, f64, f64, String, Vec<f64>, Vec<f64>);
 
 /// Per-step outputs collected during a run (flat, row-major).
 #[derive(Default)]
-struct Record {
+pub(crate) struct Record {
     steps: usize,
     positions: Vec<f64>,
     quaternions: Vec<f64>,
@@ -112,7 +112,7 @@ impl Record {
         }
     }
 
-    fn push(&mut self, rod: &Rod, st: &State, ws: &Workspace, stats: &rod::SolveStats) {
+    pub(crate) fn push(&mut self, rod: &Rod, st: &State, ws: &Workspace, stats: &rod::SolveStats) {
         self.steps += 1;
         for x in &st.x {
             self.positions.extend_from_slice(x.as_slice());
@@ -203,7 +203,7 @@ impl Record {
         self.dissipated_energy.push(e.dissipated);
     }
 
-    fn into_dict<'py>(
+    pub(crate) fn into_dict<'py>(
         self,
         py: Python<'py>,
         n_nodes: usize,
@@ -271,7 +271,7 @@ impl Record {
     }
 }
 
-fn read_poses(
+pub(crate) fn read_poses(
     pos: &numpy::ndarray::ArrayView3<f64>,
     qs: &numpy::ndarray::ArrayView3<f64>,
 ) -> PyResult<Vec<Vec<Pose>>> {
@@ -303,7 +303,7 @@ fn obstacle_at(poses: &[Vec<Pose>], k: usize) -> Option<&[Pose]> {
 /// One cable: mesh, state and solver.
 #[pyclass(module = "cablelife._core")]
 pub struct Cable {
-    rod: Rod,
+    pub(crate) rod: Rod,
     state: Option<State>,
     solver: Statics,
     /// Global poses of the contact obstacles per time step (T, O) (empty: no contact).

@@ -4,6 +4,7 @@ use pyo3::prelude::*;
 mod cable;
 mod fatigue;
 mod geometry;
+mod harness;
 mod stop;
 mod volume;
 
@@ -15,5 +16,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     fatigue::register(m)?;
     stop::register(m)?;
     geometry::register(m)?;
+    harness::register(m)?;
     Ok(())
 }

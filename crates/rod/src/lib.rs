@@ -9,6 +9,9 @@ pub mod contact_mesh;
 pub mod dynamics;
 #[cfg(test)]
 mod fd_check;
+pub mod harness;
+pub mod harness_solver;
+pub mod junction;
 pub mod modal;
 pub mod model;
 pub mod rotation;

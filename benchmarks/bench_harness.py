@@ -1,0 +1,158 @@
+"""Harness speed (issue 16): a 5-branch harness, 400 segments in all.
+
+A trunk from the car body to a junction, a second junction down the line, five branches
+(two from the first junction, three from the second) to clips on the body and on the engine;
+the engine shaken by the ISO 16750-3 engine PSD (as the demo), 1 ms steps. Prints medians of:
+- the static equilibrium (from the routed shape): the solver's wall time and the whole
+  `simulate(scene, "static")` call a user makes;
+- a quasistatic run of 1 s at 1 ms steps through the PSD motion: wall time per simulated
+  second (real-time factor of quasistatic sequences).
+Dynamic analysis of harnesses is not implemented yet (docs/harness.md): no dynamic figure.
+One core: OpenBLAS held to one thread.
+Run: python benchmarks/bench_harness.py [--repeat K]
+"""
+
+from __future__ import annotations
+
+import os
+import statistics
+import sys
+import time
+
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+from cablelife.scene import scene_from_dict  # noqa: E402
+from cablelife.simulate import simulate  # noqa: E402
+
+SECTION = {"shape": "circle", "radius": 0.005}
+MATERIAL = {"youngs_modulus": 5.0e7, "poisson_ratio": 0.4, "density": 2000.0}
+
+
+def cable(name, length, segments, clip=None):
+    c = {"name": name, "length": length, "segments": segments, "section": SECTION}
+    c["material"] = MATERIAL
+    c["clips"] = [] if clip is None else [clip]
+    return c
+
+
+def clip(name, s, position, direction, body="world"):
+    return {
+        "name": name,
+        "s": s,
+        "position": position,
+        "direction": direction,
+        "normal": [0.0, 0.0, 1.0],
+        "body": body,
+    }
+
+
+def scene(mode: str, duration: float | None = None) -> dict:
+    psd = {"type": "psd", "profile": "iso16750-3:2007/I-engine", "f_high": 100.0, "fade_in": 0.2}
+    sim = {"mode": mode, "time_step": 1e-3}
+    if duration is not None:
+        sim["duration"] = duration
+    return {
+        "simulation": sim,
+        "bodies": [
+            {
+                "name": "engine",
+                "origin": [1.0, 0.0, -0.1],
+                "motion": [
+                    {"channel": "z", "signal": {**psd, "seed": 1}},
+                    {"channel": "x", "signal": {**psd, "seed": 2}},
+                ],
+            }
+        ],
+        # 80 + 60 + 70 + 60 + 70 + 60 = 400 segments
+        "cables": [
+            cable("trunk", 0.42, 80, clip("body-1", 0.0, [0.0, 0.0, 0.0], [1.0, 0.0, 0.0])),
+            cable("link", 0.32, 60),
+            cable("a", 0.33, 70, clip("a-end", 0.33, [0.45, 0.3, 0.0], [0.0, 1.0, 0.0])),
+            cable("b", 0.33, 60, clip("b-end", 0.33, [0.45, -0.3, 0.0], [0.0, -1.0, 0.0])),
+            cable(
+                "c",
+                0.35,
+                70,
+                clip("c-end", 0.35, [1.0, 0.1, -0.05], [1.0, 0.0, 0.0], "engine"),
+            ),
+            cable(
+                "d",
+                0.37,
+                60,
+                clip("d-end", 0.37, [1.0, -0.15, -0.1], [1.0, 0.0, 0.0], "engine"),
+            ),
+        ],
+        "junctions": [
+            {
+                "name": "j1",
+                "ends": ["trunk:end", "link:start", "a:start", "b:start"],
+                "position": [0.4, 0.0, 0.0],
+                "directions": [[-1, 0, 0], [1, 0, 0], [0.2, 1, 0], [0.2, -1, 0]],
+            },
+            {
+                "name": "j2",
+                "ends": ["link:end", "c:start", "d:start"],
+                "position": [0.7, 0.0, 0.0],
+                "directions": [[-1, 0, 0], [1, 0.3, 0], [1, -0.4, -0.3]],
+            },
+        ],
+    }
+
+
+def single(mode: str, duration: float) -> dict:
+    """The peer: one 400-segment cable of the harness's length between the body and the
+    engine, the same motion (the speed class a harness should stay in)."""
+    sc = scene(mode, duration)
+    sc["junctions"] = []
+    sc["cables"] = [
+        cable(
+            "single",
+            1.4,
+            400,
+            clip("body-1", 0.0, [0.0, 0.0, 0.0], [1.0, 0.0, 0.0]),
+        )
+    ]
+    sc["cables"][0]["clips"].append(
+        clip("c-end", 1.4, [1.0, 0.1, -0.05], [1.0, 0.0, 0.0], "engine")
+    )
+    return sc
+
+
+def timed(sc, repeat: int) -> tuple[float, float, float]:
+    """Medians of the solver wall time, the whole simulate() call and the mean Newton
+    iterations per step after the first."""
+    solver, whole, iters = [], [], []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        res = simulate(sc)
+        whole.append(time.perf_counter() - t0)
+        s = next(iter(res.cables.values())).solver
+        solver.append(s["wall_time"])
+        it = s["iterations"]
+        iters.append(float(it[1:].mean()) if it.size > 1 else float(it[0]))
+    return statistics.median(solver), statistics.median(whole), statistics.median(iters)
+
+
+def main() -> None:
+    repeat = int(sys.argv[sys.argv.index("--repeat") + 1]) if "--repeat" in sys.argv else 5
+    static = scene_from_dict(scene("static", 1.0))
+    segments = sum(c.n_segments for c in static.cables)
+    print(f"harness: {len(static.cables)} cables ({segments} segments), 2 junctions; peer: one")
+    print("cable of 400 segments, same motion (medians; static of", repeat, "runs)")
+    print(f"{'case':<34} {'harness':>12} {'single cable':>14}")
+    hs = timed(static, repeat)
+    ss = timed(scene_from_dict(single("static", 1.0)), repeat)
+    print(f"{'static: solver [ms]':<34} {1e3 * hs[0]:>12.2f} {1e3 * ss[0]:>14.2f}")
+    print(f"{'static: whole simulate() [ms]':<34} {1e3 * hs[1]:>12.2f} {1e3 * ss[1]:>14.2f}")
+    print(f"{'static: Newton iterations':<34} {hs[2]:>12.0f} {ss[2]:>14.0f}")
+    k = max(1, repeat // 2)
+    hq = timed(scene_from_dict(scene("quasistatic", 1.0)), k)
+    sq = timed(scene_from_dict(single("quasistatic", 1.0)), k)
+    print(f"{'quasistatic 1 s @ 1 ms: solver [s]':<34} {hq[0]:>12.3f} {sq[0]:>14.3f}")
+    print(f"{'  × real time':<34} {1 / hq[0]:>12.2f} {1 / sq[0]:>14.2f}")
+    print(f"{'  Newton iterations per step':<34} {hq[2]:>12.2f} {sq[2]:>14.2f}")
+    print("dynamic: not implemented for harnesses yet (docs/harness.md)")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,230 @@
+//! Bindings of the harness solver (docs/harness.md): cables joined at junctions, static and
+//! quasistatic sequences. Runs release the GIL, poll Ctrl-C and report progress like `Cable`.
+use crate::cable::{read_poses, vec3, Cable, Record};
+use crate::stop::{Poller, StopFlag};
+use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray3};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+use rod::harness::{Harness as Tree, HarnessState, HarnessStatics, JunctionSpec};
+use rod::routing::route;
+use rod::{NewtonOptions, Pose};
+
+/// (name, mass, rotary inertia [3], ends as (cable index, clip index)).
+type JunctionTuple = (String, f64, Vec<f64>, Vec<(usize, usize)>);
+
+/// A harness: cables (each given with a fixed point clip at every joined end) and junctions.
+#[pyclass(module = "cablelife._core")]
+pub struct Harness {
+    tree: Tree,
+    solver: HarnessStatics,
+}
+
+#[pymethods]
+impl Harness {
+    #[new]
+    #[pyo3(signature = (cables, names, junctions, max_iterations=40, step_tolerance=1e-9))]
+    fn new(
+        cables: Vec<PyRef<'_, Cable>>,
+        names: Vec<String>,
+        junctions: Vec<JunctionTuple>,
+        max_iterations: usize,
+        step_tolerance: f64,
+    ) -> PyResult<Self> {
+        if names.len() != cables.len() {
+            return Err(PyValueError::new_err(format!(
+                "{} names for {} cables",
+                names.len(),
+                cables.len()
+            )));
+        }
+        let mut specs = Vec::with_capacity(junctions.len());
+        for (name, mass, inertia, ends) in junctions {
+            let rotary_inertia = vec3(&inertia, &format!("junction '{name}' rotary_inertia"))?;
+            specs.push(JunctionSpec {
+                name,
+                mass,
+                rotary_inertia,
+                ends,
+            });
+        }
+        let rods = cables.iter().map(|c| c.rod.clone()).collect();
+        let tree = Tree::new(names, rods, specs).map_err(|e| PyValueError::new_err(e.0))?;
+        let opts = NewtonOptions {
+            max_iterations,
+            step_tolerance,
+            ..Default::default()
+        };
+        let solver = HarnessStatics::new(&tree, opts);
+        Ok(Harness { tree, solver })
+    }
+
+    /// (cable index, clip index, junction index) of every joined end, in the order of the
+    /// branch outputs.
+    #[getter]
+    fn ends(&self) -> Vec<(usize, usize, usize)> {
+        self.tree
+            .ends
+            .iter()
+            .map(|e| (e.cable, e.topo.clip, e.junction))
+            .collect()
+    }
+
+    /// Runs a sequence of equilibria through the clip poses of each cable, `positions[c]`
+    /// (T, C_c, 3) and `quaternions[c]` (T, C_c, 4) (the entries of joined ends are ignored).
+    /// Step 0 is a static solve from the routed shapes. Returns `cables` (one dict per cable,
+    /// as `Cable.run_sequence`), `junction_positions` (T, J, 3), `junction_quaternions`
+    /// (T, J, 4, scalar first), `branch_force` and `branch_moment` (T, E, 3: what each joined
+    /// end's cable applies to its junction, global, moment about the junction point),
+    /// `iterations`, `substeps`, `residual`, `steps` and `error` (None, or why it stopped: the
+    /// steps before are kept).
+    #[pyo3(signature = (positions, quaternions, progress=None, progress_every=50, stop=None))]
+    fn run_sequence<'py>(
+        &mut self,
+        py: Python<'py>,
+        positions: Vec<PyReadonlyArray3<'py, f64>>,
+        quaternions: Vec<PyReadonlyArray3<'py, f64>>,
+        progress: Option<Py<PyAny>>,
+        progress_every: usize,
+        stop: Option<Bound<'py, StopFlag>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let nc = self.tree.cables.len();
+        if positions.len() != nc || quaternions.len() != nc {
+            return Err(PyValueError::new_err(format!(
+                "clip poses of {} and {} cables given for {nc} cables",
+                positions.len(),
+                quaternions.len()
+            )));
+        }
+        // poses[c][t][clip]
+        let mut poses = Vec::with_capacity(nc);
+        let mut steps = None;
+        for (c, (p, q)) in positions.iter().zip(&quaternions).enumerate() {
+            let (pa, qa) = (p.as_array(), q.as_array());
+            let n_clips = self.tree.cables[c].spec.clips.len();
+            let (t, k, three) = pa.dim();
+            if k != n_clips || three != 3 || qa.dim() != (t, n_clips, 4) {
+                return Err(PyValueError::new_err(format!(
+                    "cable '{}': clip poses must be (T, {n_clips}, 3) and (T, {n_clips}, 4); got \
+                     {:?} and {:?}",
+                    self.tree.names[c],
+                    pa.dim(),
+                    qa.dim()
+                )));
+            }
+            if *steps.get_or_insert(t) != t {
+                return Err(PyValueError::new_err(
+                    "clip poses of all cables must have the same number of steps",
+                ));
+            }
+            poses.push(read_poses(&pa, &qa)?);
+        }
+        let t = steps.unwrap_or(0);
+        let tree = &self.tree;
+        let mut initial = HarnessState {
+            cables: Vec::with_capacity(nc),
+            junctions: tree.reference.clone(),
+        };
+        for (c, rod) in tree.cables.iter().enumerate() {
+            let first: Option<Vec<Pose>> = (t > 0).then(|| poses[c][0].clone());
+            initial
+                .cables
+                .push(route(rod, first.as_deref()).map_err(|e| {
+                    PyValueError::new_err(format!("cable '{}': {}", tree.names[c], e.0))
+                })?);
+        }
+        let solver = &mut self.solver;
+        let mut poller = Poller::new(stop.as_ref(), progress, progress_every, t);
+        let (nj, ne) = (tree.junctions.len(), tree.ends.len());
+        struct Out {
+            records: Vec<Record>,
+            jpos: Vec<f64>,
+            jquat: Vec<f64>,
+            force: Vec<f64>,
+            moment: Vec<f64>,
+            iterations: Vec<i64>,
+            substeps: Vec<i64>,
+            residual: Vec<f64>,
+            steps: usize,
+        }
+        let (out, error) = py.detach(move || {
+            let mut out = Out {
+                records: (0..nc).map(|_| Record::default()).collect(),
+                jpos: Vec::with_capacity(t * nj * 3),
+                jquat: Vec::with_capacity(t * nj * 4),
+                force: Vec::with_capacity(t * ne * 3),
+                moment: Vec::with_capacity(t * ne * 3),
+                iterations: Vec::with_capacity(t),
+                substeps: Vec::with_capacity(t),
+                residual: Vec::with_capacity(t),
+                steps: 0,
+            };
+            let mut st = initial;
+            let mut target: Vec<Vec<Pose>> = vec![Vec::new(); nc];
+            for k in 0..t {
+                for (tc, pc) in target.iter_mut().zip(&poses) {
+                    tc.clone_from(&pc[k]);
+                }
+                let result = if k == 0 {
+                    st.set_clip_poses(tree, &target);
+                    solver.solve_static(tree, &mut st)
+                } else {
+                    solver.sequence_step(tree, &mut st, &target)
+                };
+                let stats = match result {
+                    Ok(s) => s,
+                    Err(e) => return (out, Some(format!("step {k}: {e}"))),
+                };
+                if let Err(e) = solver.assemble(tree, &st, 1.0, false) {
+                    return (out, Some(format!("step {k}: {e}")));
+                }
+                for (c, rod) in tree.cables.iter().enumerate() {
+                    out.records[c].push(rod, &st.cables[c], &solver.ws[c], &stats);
+                }
+                for pose in &st.junctions {
+                    out.jpos.extend_from_slice(pose.position.as_slice());
+                    let q = pose.orientation;
+                    out.jquat.extend_from_slice(&[q.w, q.i, q.j, q.k]);
+                }
+                for (f, m) in solver.branch_loads(tree, &st) {
+                    out.force.extend_from_slice(f.as_slice());
+                    out.moment.extend_from_slice(m.as_slice());
+                }
+                out.iterations.push(stats.iterations as i64);
+                out.substeps.push(stats.substeps as i64);
+                out.residual.push(stats.residual);
+                out.steps += 1;
+                if let Some(why) = poller.poll(k + 1) {
+                    return (out, Some(why));
+                }
+            }
+            (out, None)
+        });
+        let d = PyDict::new(py);
+        let cables = PyList::empty(py);
+        for (c, rec) in out.records.into_iter().enumerate() {
+            let rod = &self.tree.cables[c];
+            let cd = rec.into_dict(py, rod.arc.len(), rod.spec.clips.len())?;
+            cd.set_item("error", error.clone())?;
+            cables.append(cd)?;
+        }
+        let n = out.steps;
+        let shaped =
+            |v: Vec<f64>, shape: &[usize]| PyArray1::from_vec(py, v).reshape(shape.to_vec());
+        d.set_item("cables", cables)?;
+        d.set_item("junction_positions", shaped(out.jpos, &[n, nj, 3])?)?;
+        d.set_item("junction_quaternions", shaped(out.jquat, &[n, nj, 4])?)?;
+        d.set_item("branch_force", shaped(out.force, &[n, ne, 3])?)?;
+        d.set_item("branch_moment", shaped(out.moment, &[n, ne, 3])?)?;
+        d.set_item("iterations", PyArray1::from_vec(py, out.iterations))?;
+        d.set_item("substeps", PyArray1::from_vec(py, out.substeps))?;
+        d.set_item("residual", PyArray1::from_vec(py, out.residual))?;
+        d.set_item("steps", n)?;
+        d.set_item("error", error)?;
+        Ok(d)
+    }
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<Harness>()
+}

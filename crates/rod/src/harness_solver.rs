@@ -1,0 +1,841 @@
+//! The static and quasistatic solver of a harness (docs/solver.md, "Harnesses"): assembly of
+//! the cables with their junction couplings, block elimination on the tree (each cable
+//! segment's chain onto its junctions, then the junction tree leaves first), Newton,
+//! pseudo-transient and load continuation, sequences.
+use crate::assembly::Workspace;
+use crate::harness::{Harness, HarnessError, HarnessState};
+use crate::junction::HeldEnds;
+use crate::model::{Pose, Rod};
+use crate::rotation::slerp;
+use crate::statics::{NewtonOptions, SolveError, SolveStats};
+use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
+
+#[inline]
+fn rows_to_junction(m: &Matrix6<f64>, r: &Matrix3<f64>) -> Matrix6<f64> {
+    let mut out = *m;
+    let low = r * m.fixed_view::<3, 6>(3, 0);
+    out.fixed_view_mut::<3, 6>(3, 0).copy_from(&low);
+    out
+}
+
+#[inline]
+fn cols_to_junction(m: &Matrix6<f64>, r: &Matrix3<f64>) -> Matrix6<f64> {
+    let mut out = *m;
+    let right = m.fixed_view::<6, 3>(0, 3) * r.transpose();
+    out.fixed_view_mut::<6, 3>(0, 3).copy_from(&right);
+    out
+}
+
+#[inline]
+fn vec_to_junction(v: &Vector6<f64>, r: &Matrix3<f64>) -> Vector6<f64> {
+    let mut out = *v;
+    let low = r * v.fixed_rows::<3>(3);
+    out.fixed_rows_mut::<3>(3).copy_from(&low);
+    out
+}
+
+/// Largest junction displacement per Newton iteration, as a fraction of the shortest cable.
+const JUNCTION_STEP: f64 = 0.1;
+
+/// Inverse of a junction pivot, or None when it is singular to working precision.
+fn invert(m: &Matrix6<f64>) -> Option<Matrix6<f64>> {
+    let inv = m.try_inverse()?;
+    let cond = m.amax() * inv.amax();
+    (cond.is_finite() && cond < 1e14).then_some(inv)
+}
+
+/// Static and quasistatic solver of a harness: the cables' workspaces, the coupling terms and
+/// the buffers of the tree elimination (allocated once).
+pub struct HarnessStatics {
+    pub ws: Vec<Workspace>,
+    pub held: Vec<HeldEnds>,
+    pub opts: NewtonOptions,
+    delta: Vec<Vec<Vector6<f64>>>,
+    trial: Vec<Vec<Vector6<f64>>>,
+    y: Vec<Vec<Vector6<f64>>>,
+    dj: Vec<Vector6<f64>>,
+    trial_j: Vec<Vector6<f64>>,
+    /// Junction residuals (∂V/∂(X, Θ)).
+    pub junction_residual: Vec<Vector6<f64>>,
+    /// Per end: A⁻¹ B_k, six block-vector columns over its cable.
+    z: Vec<[Vec<Vector6<f64>>; 6]>,
+    /// Junction pivots (after the tree elimination) and their inverses.
+    pivot: Vec<Matrix6<f64>>,
+    pivot_inv: Vec<Matrix6<f64>>,
+    /// Schur blocks of the links: rows a cols b, rows b cols a.
+    link_ab: Vec<Matrix6<f64>>,
+    link_ba: Vec<Matrix6<f64>>,
+    b: Vec<Vector6<f64>>,
+    base: HarnessState,
+    saved: HarnessState,
+    start_poses: Vec<Vec<Pose>>,
+    poses: Vec<Vec<Pose>>,
+    pose_buffer: Vec<Pose>,
+    /// The last two equilibria of a sequence (the predictor of `sequence_step`).
+    last: HarnessState,
+    prev: HarnessState,
+    has_prev: bool,
+    /// Pseudo-transient damping added to the junction pivots by `factor` (position, rotation).
+    junction_shift: (f64, f64),
+    force_scale: f64,
+    /// Length scales: the shortest cable (steps) and the finest mean segment (moments).
+    length: f64,
+    h: f64,
+}
+
+impl HarnessStatics {
+    pub fn new(h: &Harness, opts: NewtonOptions) -> Self {
+        let mut force_scale = 1e-12f64;
+        let mut length = f64::INFINITY;
+        let mut hmin = f64::INFINITY;
+        for rod in &h.cables {
+            let sec = &rod.spec.section;
+            let l = rod.spec.length;
+            let weight = sec.mass_per_length * l * rod.spec.gravity.norm();
+            let loads = rod
+                .spec
+                .loads
+                .iter()
+                .map(|ld| ld.force.norm() + ld.moment.norm() / l)
+                .fold(0.0, f64::max);
+            let bend = sec.bend_stiffness.max() / (l * l);
+            force_scale = force_scale.max(weight).max(loads).max(bend);
+            length = length.min(l);
+            hmin = hmin.min(rod.mean_ds());
+        }
+        for j in &h.junctions {
+            force_scale = force_scale.max(j.mass * h.gravity.norm());
+        }
+        let blocks = |c: usize| vec![Vector6::zeros(); h.cables[c].arc.len()];
+        let per_cable = || (0..h.cables.len()).map(blocks).collect::<Vec<_>>();
+        let nj = h.junctions.len();
+        HarnessStatics {
+            ws: h.cables.iter().map(Workspace::new).collect(),
+            held: h.held_ends(),
+            opts,
+            delta: per_cable(),
+            trial: per_cable(),
+            y: per_cable(),
+            dj: vec![Vector6::zeros(); nj],
+            trial_j: vec![Vector6::zeros(); nj],
+            junction_residual: vec![Vector6::zeros(); nj],
+            z: h.ends
+                .iter()
+                .map(|e| std::array::from_fn(|_| blocks(e.cable)))
+                .collect(),
+            pivot: vec![Matrix6::zeros(); nj],
+            pivot_inv: vec![Matrix6::zeros(); nj],
+            link_ab: vec![Matrix6::zeros(); h.links.len()],
+            link_ba: vec![Matrix6::zeros(); h.links.len()],
+            b: vec![Vector6::zeros(); nj],
+            base: HarnessState::empty(),
+            saved: HarnessState::empty(),
+            start_poses: Vec::new(),
+            poses: Vec::new(),
+            pose_buffer: Vec::new(),
+            last: HarnessState::empty(),
+            prev: HarnessState::empty(),
+            has_prev: false,
+            junction_shift: (0.0, 0.0),
+            force_scale,
+            length,
+            h: hmin,
+        }
+    }
+
+    fn cable_err(h: &Harness, c: usize, e: SolveError) -> HarnessError {
+        HarnessError(format!("cable '{}': {e}", h.names[c]))
+    }
+
+    /// Assembles every cable (internal forces, loads, coupling blocks of the held ends) and
+    /// the junction residuals at load factor `lf`.
+    pub fn assemble(
+        &mut self,
+        h: &Harness,
+        st: &HarnessState,
+        lf: f64,
+        want_jac: bool,
+    ) -> Result<(), HarnessError> {
+        for (c, rod) in h.cables.iter().enumerate() {
+            self.ws[c]
+                .assemble_terms(rod, &st.cables[c], lf, want_jac, &mut [&mut self.held[c]])
+                .map_err(|k| {
+                    Self::cable_err(
+                        h,
+                        c,
+                        SolveError::Kink {
+                            node: k.node,
+                            s: rod.arc[k.node],
+                        },
+                    )
+                })?;
+        }
+        for (j, js) in h.junctions.iter().enumerate() {
+            let mut r = Vector6::zeros();
+            for &k in &h.junction_ends[j] {
+                let e = &h.ends[k];
+                let local = self.held[e.cable].ends[e.local].residual(&self.ws[e.cable]);
+                r += vec_to_junction(&local, &e.rel);
+            }
+            let w = lf * js.mass * h.gravity;
+            r[0] -= w.x;
+            r[1] -= w.y;
+            r[2] -= w.z;
+            self.junction_residual[j] = r;
+        }
+        Ok(())
+    }
+
+    /// Largest scaled residual (N; moments divided by the finest mean segment length).
+    pub fn residual_inf(&self) -> f64 {
+        self.residual_norms().1
+    }
+
+    /// Scaled residual norms (2-norm, ∞-norm) over the cables and junctions.
+    pub fn residual_norms(&self) -> (f64, f64) {
+        let mut inf = 0.0f64;
+        let mut two = 0.0;
+        for ws in &self.ws {
+            let (t, i) = ws.residual_norms(self.h);
+            inf = inf.max(i);
+            two += t * t;
+        }
+        for r in &self.junction_residual {
+            for k in 0..6 {
+                let v = if k < 3 { r[k] } else { r[k] / self.h };
+                inf = inf.max(v.abs());
+                two += v * v;
+            }
+        }
+        (two.sqrt(), inf)
+    }
+
+    /// Factors the assembled system: each cable segment, the Schur complements onto the
+    /// junctions, the junction tree (leaves first).
+    pub fn factor(&mut self, h: &Harness) -> Result<(), HarnessError> {
+        for (c, rod) in h.cables.iter().enumerate() {
+            for seg in &rod.segments {
+                self.ws[c]
+                    .factor_segment(rod, seg)
+                    .map_err(|e| Self::cable_err(h, c, e))?;
+            }
+        }
+        for (j, list) in h.junction_ends.iter().enumerate() {
+            let mut d = Matrix6::zeros();
+            for &k in list {
+                let e = &h.ends[k];
+                let ee = &self.held[e.cable].ends[e.local].ee;
+                d += cols_to_junction(&rows_to_junction(ee, &e.rel), &e.rel);
+            }
+            for k in 0..6 {
+                d[(k, k)] += if k < 3 {
+                    self.junction_shift.0
+                } else {
+                    self.junction_shift.1
+                };
+            }
+            self.pivot[j] = d;
+        }
+        self.link_ab.iter_mut().for_each(|m| m.fill(0.0));
+        self.link_ba.iter_mut().for_each(|m| m.fill(0.0));
+        // Z_k = A⁻¹ B_k for every end.
+        for (k, e) in h.ends.iter().enumerate() {
+            let Some(s) = e.segment else { continue };
+            let rod = &h.cables[e.cable];
+            let range = rod.segments[s].blocks.clone();
+            let blocks = e.topo.blocks();
+            let eb = &self.held[e.cable].ends[e.local];
+            for col in 0..6 {
+                let z = &mut self.z[k][col];
+                for v in &mut z[range.clone()] {
+                    v.fill(0.0);
+                }
+                for (i, &b) in blocks.iter().enumerate() {
+                    let bk = cols_to_junction(&eb.ce[i], &e.rel);
+                    if range.contains(&b) {
+                        z[b] += bk.column(col);
+                    }
+                }
+                self.ws[e.cable].jac.solve_range(range.clone(), z);
+            }
+        }
+        // Schur complements: S_kl = −C_k A⁻¹ B_l for the ends k, l of one cable segment.
+        for (k, e) in h.ends.iter().enumerate() {
+            let Some(s) = e.segment else { continue };
+            let eb = &self.held[e.cable].ends[e.local];
+            let ck = [
+                rows_to_junction(&eb.ec[0], &e.rel),
+                rows_to_junction(&eb.ec[1], &e.rel),
+            ];
+            let blocks = e.topo.blocks();
+            for &l in &h.cable_ends[e.cable] {
+                if h.ends[l].segment != Some(s) {
+                    continue;
+                }
+                let mut m = Matrix6::zeros();
+                for col in 0..6 {
+                    let z = &self.z[l][col];
+                    let mut v = Vector6::zeros();
+                    for i in 0..2 {
+                        v += ck[i] * z[blocks[i]];
+                    }
+                    m.set_column(col, &v);
+                }
+                if l == k {
+                    self.pivot[e.junction] -= m;
+                } else if let Some(li) = h.links.iter().position(|x| x.end_a == k && x.end_b == l) {
+                    self.link_ab[li] -= m;
+                } else if let Some(li) = h.links.iter().position(|x| x.end_b == k && x.end_a == l) {
+                    self.link_ba[li] -= m;
+                }
+            }
+        }
+        // The junction tree, leaves first.
+        for &j in h.order.iter().rev() {
+            let inv = invert(&self.pivot[j]).ok_or_else(|| {
+                HarnessError(format!(
+                    "the stiffness matrix is singular at junction '{}': the harness is not held \
+                     against a rigid-body motion there (every branch free), or a section \
+                     stiffness is zero",
+                    h.junctions[j].name
+                ))
+            })?;
+            self.pivot_inv[j] = inv;
+            if let Some((p, l)) = h.parent[j] {
+                let (s_pj, s_jp) = self.link_blocks(h, p, l);
+                self.pivot[p] -= s_pj * inv * s_jp;
+            }
+        }
+        Ok(())
+    }
+
+    /// (S_pj, S_jp) of link l whose one junction is p.
+    fn link_blocks(&self, h: &Harness, p: usize, l: usize) -> (Matrix6<f64>, Matrix6<f64>) {
+        if h.links[l].a == p {
+            (self.link_ab[l], self.link_ba[l])
+        } else {
+            (self.link_ba[l], self.link_ab[l])
+        }
+    }
+
+    /// Solves J Δ = −r with the factorisation for the cable residuals `rc` (block vectors, as
+    /// `ws.rhs`) and junction residuals `rj`; returns the largest |Δx| and |θ|.
+    fn solve(&mut self, h: &Harness, use_trial: bool) -> (f64, f64) {
+        for (c, rod) in h.cables.iter().enumerate() {
+            let y = &mut self.y[c];
+            y.copy_from_slice(&self.ws[c].rhs);
+            for seg in &rod.segments {
+                self.ws[c].jac.solve_range(seg.blocks.clone(), y);
+            }
+        }
+        for (j, list) in h.junction_ends.iter().enumerate() {
+            let mut b = self.junction_residual[j];
+            for &k in list {
+                let e = &h.ends[k];
+                if e.segment.is_none() {
+                    continue;
+                }
+                let eb = &self.held[e.cable].ends[e.local];
+                for (i, &blk) in e.topo.blocks().iter().enumerate() {
+                    b -= rows_to_junction(&eb.ec[i], &e.rel) * self.y[e.cable][blk];
+                }
+            }
+            self.b[j] = b;
+        }
+        for &j in h.order.iter().rev() {
+            if let Some((p, l)) = h.parent[j] {
+                let (s_pj, _) = self.link_blocks(h, p, l);
+                let t = s_pj * (self.pivot_inv[j] * self.b[j]);
+                self.b[p] -= t;
+            }
+        }
+        let dj = if use_trial {
+            &mut self.trial_j
+        } else {
+            &mut self.dj
+        };
+        for &j in &h.order {
+            let mut b = self.b[j];
+            if let Some((p, l)) = h.parent[j] {
+                let s_jp = if h.links[l].a == p {
+                    self.link_ba[l]
+                } else {
+                    self.link_ab[l]
+                };
+                b -= s_jp * (-dj[p]);
+            }
+            dj[j] = -(self.pivot_inv[j] * b);
+        }
+        let (mut dx, mut dth) = (0.0f64, 0.0f64);
+        for d in dj.iter() {
+            dx = dx.max(d.fixed_rows::<3>(0).amax());
+            dth = dth.max(d.fixed_rows::<3>(3).amax());
+        }
+        let out = if use_trial {
+            &mut self.trial
+        } else {
+            &mut self.delta
+        };
+        for (oc, yc) in out.iter_mut().zip(&self.y) {
+            for (o, y) in oc.iter_mut().zip(yc) {
+                *o = -y;
+            }
+        }
+        for (k, e) in h.ends.iter().enumerate() {
+            let Some(s) = e.segment else { continue };
+            let range = h.cables[e.cable].segments[s].blocks.clone();
+            let d = dj[e.junction];
+            for col in 0..6 {
+                if d[col] == 0.0 {
+                    continue;
+                }
+                let z = &self.z[k][col];
+                for b in range.clone() {
+                    out[e.cable][b] -= z[b] * d[col];
+                }
+            }
+        }
+        for v in out.iter() {
+            for d in v {
+                dx = dx.max(d.fixed_rows::<3>(0).amax());
+                dth = dth.max(d.fixed_rows::<3>(3).amax());
+            }
+        }
+        (dx, dth)
+    }
+
+    /// The Newton correction of the assembled, factored system (into the solver's buffers).
+    pub fn newton_correction(&mut self, h: &Harness) -> (f64, f64) {
+        self.solve(h, false)
+    }
+
+    /// The last Newton correction: per cable block vectors and per junction (ΔX, Θ).
+    pub fn correction(&self) -> (&[Vec<Vector6<f64>>], &[Vector6<f64>]) {
+        (&self.delta, &self.dj)
+    }
+
+    /// y = J v of the assembled system (before `factor`; for checks): cable blocks and
+    /// junction 6-vectors.
+    pub fn jacobian_times(
+        &self,
+        h: &Harness,
+        v: &[Vec<Vector6<f64>>],
+        vj: &[Vector6<f64>],
+    ) -> (Vec<Vec<Vector6<f64>>>, Vec<Vector6<f64>>) {
+        let mut y: Vec<Vec<Vector6<f64>>> =
+            v.iter().map(|x| vec![Vector6::zeros(); x.len()]).collect();
+        for (c, rod) in h.cables.iter().enumerate() {
+            self.ws[c].jac.mul(&v[c], &mut y[c]);
+            for (yb, m) in y[c].iter_mut().zip(&rod.mask) {
+                for (k, &active) in m.iter().enumerate() {
+                    if !active {
+                        yb[k] = 0.0;
+                    }
+                }
+            }
+        }
+        let mut yj = vec![Vector6::zeros(); h.junctions.len()];
+        for e in &h.ends {
+            let eb = &self.held[e.cable].ends[e.local];
+            let t_v = {
+                let mut t = vj[e.junction];
+                let rot = e.rel.transpose() * t.fixed_rows::<3>(3);
+                t.fixed_rows_mut::<3>(3).copy_from(&rot);
+                t
+            };
+            yj[e.junction] += vec_to_junction(&(eb.ee * t_v), &e.rel);
+            for (i, &b) in e.topo.blocks().iter().enumerate() {
+                yj[e.junction] += vec_to_junction(&(eb.ec[i] * v[e.cable][b]), &e.rel);
+                y[e.cable][b] += eb.ce[i] * t_v;
+            }
+        }
+        (y, yj)
+    }
+
+    fn scaled_norm(&self, delta: &[Vec<Vector6<f64>>], dj: &[Vector6<f64>]) -> f64 {
+        let l = self.length;
+        let mut sum = 0.0;
+        for v in delta.iter().flatten().chain(dj) {
+            for k in 0..6 {
+                let x = if k < 3 { v[k] / l } else { v[k] };
+                sum += x * x;
+            }
+        }
+        sum.sqrt()
+    }
+
+    /// Newton iterations at load factor `lf` (the rules of `Statics::newton`: rotation steps
+    /// capped, halved when a trial kinks; with `damped`, Deuflhard's natural monotonicity test).
+    pub fn newton(
+        &mut self,
+        h: &Harness,
+        st: &mut HarnessState,
+        lf: f64,
+        damped: bool,
+    ) -> Result<SolveStats, HarnessError> {
+        self.assemble(h, st, lf, true)?;
+        let mut rinf = self.residual_inf();
+        let mut stats = SolveStats::default();
+        let not_converged = |it: usize, r: f64| {
+            HarnessError(format!(
+                "{}",
+                SolveError::NotConverged {
+                    iterations: it,
+                    residual: r,
+                    load_factor: lf,
+                }
+            ))
+        };
+        for it in 0..self.opts.max_iterations {
+            stats.iterations = it + 1;
+            if rinf <= self.opts.residual_tolerance * self.force_scale {
+                stats.iterations = it;
+                stats.residual = rinf;
+                return Ok(stats);
+            }
+            self.factor(h)?;
+            let (dx, dth) = self.solve(h, false);
+            if !(dx.is_finite() && dth.is_finite()) {
+                return Err(HarnessError(
+                    "the harness's stiffness matrix is singular (non-finite Newton step)".into(),
+                ));
+            }
+            let step = (dx / self.length).max(dth);
+            let norm0 = self.scaled_norm(&self.delta, &self.dj);
+            let mut alpha = 1.0f64.min(self.opts.max_rotation_step / dth.max(1e-300));
+            let djx = self
+                .dj
+                .iter()
+                .map(|d| d.fixed_rows::<3>(0).amax())
+                .fold(0.0, f64::max);
+            alpha = alpha.min(JUNCTION_STEP * self.length / djx.max(1e-300));
+            self.base.clone_from(st);
+            let mut accepted = false;
+            for _ in 0..16 {
+                st.apply_increment(h, &self.delta, &self.dj, alpha);
+                if self.assemble(h, st, lf, false).is_ok() {
+                    self.solve(h, true);
+                    let theta = self.scaled_norm(&self.trial, &self.trial_j) / norm0.max(1e-300);
+                    let monotone =
+                        theta <= 1.0 - 0.25 * alpha || step * alpha < self.opts.step_tolerance;
+                    if theta.is_finite() && (!damped || monotone) {
+                        accepted = true;
+                        break;
+                    }
+                }
+                st.clone_from(&self.base);
+                alpha *= 0.5;
+            }
+            if !accepted {
+                return Err(not_converged(stats.iterations, rinf));
+            }
+            self.assemble(h, st, lf, true)?;
+            rinf = self.residual_inf();
+            if std::env::var_os("ROD_DEBUG").is_some() {
+                eprintln!(
+                    "harness it {it} lf {lf} alpha {alpha:.3e} step {step:.3e} rinf {rinf:.3e}"
+                );
+            }
+            if alpha == 1.0 && step < self.opts.step_tolerance {
+                stats.residual = rinf;
+                return Ok(stats);
+            }
+        }
+        Err(not_converged(stats.iterations, rinf))
+    }
+
+    /// Pseudo-transient continuation (as `Statics::pseudo_transient`): (J + σD) Δ = −r with D
+    /// a viscous medium (δs for positions, Δs³/12 for rotations; the junctions with the finest
+    /// mean segment), σ relaxed to zero by switched evolution relaxation.
+    pub fn pseudo_transient(
+        &mut self,
+        h: &Harness,
+        st: &mut HarnessState,
+        lf: f64,
+        max_iterations: usize,
+    ) -> Result<SolveStats, HarnessError> {
+        const PTC_START: f64 = 1e-3;
+        let damping = |rod: &Rod, b: usize, k: usize| -> f64 {
+            if k < 3 {
+                rod.ds_node[b]
+            } else {
+                rod.ds_edge[b.min(rod.n_edges() - 1)].powi(3) / 12.0
+            }
+        };
+        let junction_damping = (self.h, self.h.powi(3) / 12.0);
+        self.assemble(h, st, lf, true)?;
+        let (mut r_old, mut rinf) = self.residual_norms();
+        let mut sigma = 0.0f64;
+        for (c, rod) in h.cables.iter().enumerate() {
+            for (b, m) in rod.mask.iter().enumerate() {
+                for (k, &active) in m.iter().enumerate() {
+                    if active {
+                        let d = self.ws[c].jac.diag[b][(k, k)].abs() / damping(rod, b, k);
+                        sigma = sigma.max(d);
+                    }
+                }
+            }
+        }
+        sigma *= PTC_START;
+        let sigma0 = sigma;
+        let mut stats = SolveStats::default();
+        let result = (|| {
+            for it in 0..max_iterations {
+                stats.iterations = it + 1;
+                if rinf <= self.opts.residual_tolerance * self.force_scale {
+                    stats.iterations = it;
+                    stats.residual = rinf;
+                    return Ok(stats);
+                }
+                for (c, rod) in h.cables.iter().enumerate() {
+                    for (b, m) in rod.mask.iter().enumerate() {
+                        for (k, &active) in m.iter().enumerate() {
+                            if active {
+                                self.ws[c].jac.diag[b][(k, k)] += sigma * damping(rod, b, k);
+                            }
+                        }
+                    }
+                }
+                self.junction_shift = (sigma * junction_damping.0, sigma * junction_damping.1);
+                self.factor(h)?;
+                self.junction_shift = (0.0, 0.0);
+                let (dx, dth) = self.solve(h, false);
+                let step = (dx / self.length).max(dth);
+                let alpha = 1.0f64.min(self.opts.max_rotation_step / dth.max(1e-300));
+                self.base.clone_from(st);
+                st.apply_increment(h, &self.delta, &self.dj, alpha);
+                let ok = self.assemble(h, st, lf, true).is_ok();
+                let (r_new, r_inf_new) = if ok {
+                    self.residual_norms()
+                } else {
+                    (f64::INFINITY, f64::INFINITY)
+                };
+                if !(step.is_finite() && r_new.is_finite()) || r_new > 10.0 * r_old.max(1e-300) {
+                    st.clone_from(&self.base);
+                    self.assemble(h, st, lf, true)?;
+                    sigma = (sigma * 10.0).max(1e-6 * sigma0);
+                    continue;
+                }
+                if std::env::var_os("ROD_DEBUG").is_some() {
+                    eprintln!(
+                        "harness ptc {it} sigma {sigma:.3e} step {step:.3e} rinf {r_inf_new:.3e}"
+                    );
+                }
+                if sigma == 0.0 && alpha == 1.0 && step < self.opts.step_tolerance {
+                    stats.residual = r_inf_new;
+                    return Ok(stats);
+                }
+                sigma *= (r_new / r_old.max(1e-300)).min(0.5);
+                if sigma < 1e-10 * sigma0 {
+                    sigma = 0.0;
+                }
+                r_old = r_new;
+                rinf = r_inf_new;
+            }
+            Err(HarnessError(format!(
+                "{}",
+                SolveError::NotConverged {
+                    iterations: stats.iterations,
+                    residual: rinf,
+                    load_factor: lf,
+                }
+            )))
+        })();
+        self.junction_shift = (0.0, 0.0);
+        result
+    }
+
+    /// Static equilibrium: plain Newton; then pseudo-transient continuation; then damped
+    /// Newton; then load continuation from the unloaded start (gravity and loads ramped) with
+    /// damped steps.
+    pub fn solve_static(
+        &mut self,
+        h: &Harness,
+        st: &mut HarnessState,
+    ) -> Result<SolveStats, HarnessError> {
+        st.sync_ends(h);
+        self.has_prev = false; // a new sequence starts here
+        let start = st.clone();
+        let full = self.opts.max_iterations;
+        self.opts.max_iterations = full.min(15);
+        let plain = self.newton(h, st, 1.0, false);
+        self.opts.max_iterations = full;
+        match plain {
+            Ok(s) => return Ok(s),
+            Err(e) if e.0.contains("singular") => return Err(e),
+            Err(_) => {}
+        }
+        st.clone_from(&start);
+        match self.pseudo_transient(h, st, 1.0, 20 * self.opts.max_iterations) {
+            Ok(mut s) => {
+                s.substeps = 1;
+                return Ok(s);
+            }
+            Err(e) if e.0.contains("singular") => return Err(e),
+            Err(_) => {}
+        }
+        st.clone_from(&start);
+        let last = match self.newton(h, st, 1.0, true) {
+            Ok(mut s) => {
+                s.substeps = 1;
+                return Ok(s);
+            }
+            Err(e) if e.0.contains("singular") => return Err(e),
+            Err(e) => e,
+        };
+        st.clone_from(&start);
+        let mut total = match self.newton(h, st, 0.0, true) {
+            Ok(s) => s,
+            Err(_) => {
+                st.clone_from(&start);
+                return Err(last);
+            }
+        };
+        total.substeps = 1;
+        let mut lambda = 0.0;
+        let mut dl = 0.25f64;
+        while lambda < 1.0 {
+            let trial = (lambda + dl).min(1.0);
+            let saved = st.clone();
+            match self.newton(h, st, trial, true) {
+                Ok(s) => {
+                    total.iterations += s.iterations;
+                    total.residual = s.residual;
+                    total.substeps += 1;
+                    lambda = trial;
+                    dl *= 1.5;
+                }
+                Err(e) => {
+                    st.clone_from(&saved);
+                    dl *= 0.5;
+                    if dl < self.opts.min_load_step {
+                        return Err(e);
+                    }
+                }
+            }
+        }
+        Ok(total)
+    }
+
+    /// One step of a sequence of equilibria: from the current state to the clip poses
+    /// `target[c]` (all clips of each cable; junction ends' entries ignored), bisecting the
+    /// clip motion when Newton fails.
+    pub fn step_to(
+        &mut self,
+        h: &Harness,
+        st: &mut HarnessState,
+        target: &[Vec<Pose>],
+    ) -> Result<SolveStats, HarnessError> {
+        self.start_poses.resize(st.cables.len(), Vec::new());
+        for (sp, c) in self.start_poses.iter_mut().zip(&st.cables) {
+            sp.clone_from(&c.clip_pose);
+        }
+        self.saved.clone_from(st);
+        st.set_clip_poses_with(h, target, &mut self.pose_buffer);
+        match self.newton(h, st, 1.0, false) {
+            Ok(s) => return Ok(s),
+            Err(e) if e.0.contains("singular") => return Err(e),
+            Err(_) => st.clone_from(&self.saved),
+        }
+        let mut total = SolveStats::default();
+        let mut done = 0.0f64;
+        let mut df = 0.5f64;
+        let mut depth = 1;
+        let mut poses = std::mem::take(&mut self.poses);
+        poses.resize(target.len(), Vec::new());
+        for (p, t) in poses.iter_mut().zip(target) {
+            p.clone_from(t);
+        }
+        let result = loop {
+            if done >= 1.0 {
+                break Ok(total);
+            }
+            let f = (done + df).min(1.0);
+            for (c, cable) in poses.iter_mut().enumerate() {
+                for (k, pose) in cable.iter_mut().enumerate() {
+                    let from = self.start_poses[c][k];
+                    pose.position = from.position.lerp(&target[c][k].position, f);
+                    pose.orientation = slerp(&from.orientation, &target[c][k].orientation, f);
+                }
+            }
+            self.saved.clone_from(st);
+            st.set_clip_poses_with(h, &poses, &mut self.pose_buffer);
+            match self.newton(h, st, 1.0, false) {
+                Ok(s) => {
+                    total.iterations += s.iterations;
+                    total.residual = s.residual;
+                    total.substeps += 1;
+                    done = f;
+                    if depth > 1 {
+                        depth -= 1;
+                        df *= 2.0;
+                    }
+                }
+                Err(e) => {
+                    st.clone_from(&self.saved);
+                    depth += 1;
+                    df *= 0.5;
+                    if depth > self.opts.max_substep_depth {
+                        break Err(e);
+                    }
+                }
+            }
+        };
+        self.poses = poses;
+        result
+    }
+
+    /// The next equilibrium of a sequence (after `solve_static` for the first): the free
+    /// unknowns and the junction poses are extrapolated linearly from the last two equilibria
+    /// (predictor), then `step_to`; if that fails, it is retried from the last equilibrium.
+    pub fn sequence_step(
+        &mut self,
+        h: &Harness,
+        st: &mut HarnessState,
+        target: &[Vec<Pose>],
+    ) -> Result<SolveStats, HarnessError> {
+        self.last.clone_from(st);
+        if self.has_prev {
+            for (c, rod) in h.cables.iter().enumerate() {
+                st.cables[c].extrapolate_free(rod, &self.prev.cables[c], &self.last.cables[c]);
+            }
+            for (j, pose) in st.junctions.iter_mut().enumerate() {
+                let (p0, p1) = (&self.prev.junctions[j], &self.last.junctions[j]);
+                pose.position = 2.0 * p1.position - p0.position;
+                let q = p1.orientation * (p0.orientation.conjugate() * p1.orientation);
+                pose.orientation = q / q.norm();
+            }
+            st.sync_ends(h);
+        }
+        let result = match self.step_to(h, st, target) {
+            Ok(s) => Ok(s),
+            Err(_) => {
+                st.clone_from(&self.last);
+                self.step_to(h, st, target)
+            }
+        };
+        std::mem::swap(&mut self.prev, &mut self.last);
+        self.has_prev = true;
+        result
+    }
+
+    /// Force and moment (about the junction point, global) that each end's cable applies to
+    /// its junction, after an assembly at `st`.
+    pub fn branch_loads(
+        &self,
+        h: &Harness,
+        st: &HarnessState,
+    ) -> Vec<(Vector3<f64>, Vector3<f64>)> {
+        h.ends
+            .iter()
+            .map(|e| {
+                let (f, m) = self.ws[e.cable].clip_reaction(
+                    &h.cables[e.cable],
+                    &st.cables[e.cable],
+                    e.topo.clip,
+                );
+                (-f, -m)
+            })
+            .collect()
+    }
+}

@@ -1,0 +1,259 @@
+"""Harnesses (docs/harness.md): cables joined at junctions into a tree, solved as one system.
+
+Each joined cable end gets a fixed point clip ("junction <name>") whose pose follows the
+junction; the Rust harness solver (``_core.Harness``) eliminates the cables onto the junctions
+and solves the junction tree. Static and quasistatic runs; dynamic and modal analyses of
+harnesses are not supported yet (a clear error).
+"""
+
+from __future__ import annotations
+
+import time as _time
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from cablelife.results import CableResult, ClipReaction, JunctionResult
+
+if TYPE_CHECKING:
+    from cablelife.scene import Cable, Junction, Scene
+
+
+def _fail(msg: str):
+    raise ValueError(msg)
+
+
+def check_junctions(scene: Scene) -> None:
+    """Cross-checks the junctions against the cables (inside the scene's validation: errors
+    are ValueErrors naming the junction, the end and what is allowed)."""
+    cables = {c.name: c for c in scene.cables}
+    names = [j.name for j in scene.junctions]
+    dup = {n for n in names if names.count(n) > 1}
+    if dup:
+        _fail(f"junction names must be unique; repeated: {sorted(dup)}")
+    used: dict[tuple[str, str], str] = {}
+    for j in scene.junctions:
+        for i in range(len(j.ends)):
+            cable, which = j.end(i)
+            where = f"junctions '{j.name}' ends[{i}] = {j.ends[i]!r}"
+            if cable not in cables:
+                _fail(f"{where}: no cable named {cable!r}; cables: {sorted(cables)}")
+            if (cable, which) in used:
+                _fail(
+                    f"{where}: that end is already joined at junction '{used[cable, which]}'; "
+                    "a cable end can be joined once"
+                )
+            used[cable, which] = j.name
+            c = cables[cable]
+            s_end = 0.0 if which == "start" else c.length
+            for clip in c.clips:
+                lo, hi = clip.s - clip.length / 2, clip.s + clip.length / 2
+                if lo - 1e-9 * c.length <= s_end <= hi + 1e-9 * c.length:
+                    _fail(
+                        f"{where}: clip '{clip.name}' of cable '{cable}' already holds that "
+                        f"end (s = {s_end:g} m); the junction holds it: remove the clip or "
+                        "join the other end"
+                    )
+    held = {cable for cable, _ in used}
+    for i, c in enumerate(scene.cables):
+        if not c.clips and c.name not in held:
+            _fail(
+                f"cables[{i}] ('{c.name}') has no clips and no junction joins it; give at "
+                "least one clip"
+            )
+    # Loops: union–find over the junctions; a cable joined at both ends links two.
+    parent = {j.name: j.name for j in scene.junctions}
+
+    def find(a: str) -> str:
+        while parent[a] != a:
+            parent[a] = parent[parent[a]]
+            a = parent[a]
+        return a
+
+    for c in scene.cables:
+        a, b = used.get((c.name, "start")), used.get((c.name, "end"))
+        if a is None or b is None:
+            continue
+        ra, rb = find(a), find(b)
+        if ra == rb:
+            _fail(
+                f"harness with a loop: cable '{c.name}' closes a loop through junctions "
+                f"'{a}' and '{b}'; loops are not supported yet"
+            )
+        parent[ra] = rb
+    # Every connected harness needs a clip somewhere (else it floats: a rigid-body motion).
+    clipped: dict[str, bool] = {}
+    for j in scene.junctions:
+        r = find(j.name)
+        held_here = any(cables[j.end(i)[0]].clips for i in range(len(j.ends)))
+        clipped[r] = clipped.get(r, False) or held_here
+    for j in scene.junctions:
+        if not clipped[find(j.name)]:
+            group = sorted(k.name for k in scene.junctions if find(k.name) == find(j.name))
+            _fail(
+                f"the harness through junctions {group} is held by no clip: it could move as "
+                "a rigid body; give at least one of its cables a clip"
+            )
+
+
+def end_clip_name(junction: Junction) -> str:
+    """The name of the point clip that holds a joined end."""
+    return f"junction {junction.name}"
+
+
+def harness_cables(scene: Scene) -> tuple[list[Cable], list[tuple]]:
+    """The scene's cables with a fixed point clip at every joined end, and the junctions as
+    (name, mass, rotary inertia [3], ends as (cable index, clip index))."""
+    from cablelife.scene import Clip
+
+    index = {c.name: k for k, c in enumerate(scene.cables)}
+    extra: dict[str, list] = {c.name: [] for c in scene.cables}
+    specs = []
+    for j in scene.junctions:
+        ends = []
+        for i in range(len(j.ends)):
+            cable, which = j.end(i)
+            c = scene.cables[index[cable]]
+            d = np.asarray(j.directions[i], float)
+            tangent = d if which == "start" else -d  # d3 runs along increasing s
+            clip = Clip(
+                name=end_clip_name(j),
+                s=0.0 if which == "start" else c.length,
+                position=j.position,
+                direction=tuple(float(v) for v in tangent),
+                normal=None if j.normals is None else j.normals[i],
+                type="fixed",
+            )
+            ends.append((index[cable], len(c.clips) + len(extra[cable])))
+            extra[cable].append(clip)
+        specs.append((j.name, float(j.mass), [float(j.rotary_inertia)] * 3, ends))
+    cables = [
+        c.model_copy(update={"clips": [*c.clips, *extra[c.name]]}) if extra[c.name] else c
+        for c in scene.cables
+    ]
+    return cables, specs
+
+
+def run_harness(scene: Scene, times: np.ndarray, mode: str, progress, stop):
+    """Runs a harness scene (static or quasistatic). Returns the cable results (by name), the
+    junction results (by name) and the error message (None: complete)."""
+    from cablelife import _core
+    from cablelife.scene import SceneError
+    from cablelife.simulate import _stability_info, body_motions, build_cable, clip_kinematics
+
+    if mode not in ("static", "quasistatic"):
+        raise SceneError(
+            f"mode = {mode!r}: {mode} analysis of harnesses (scenes with [[junctions]]) is not "
+            "supported yet; allowed for harnesses: 'static', 'quasistatic'"
+        )
+    if scene.contact is not None:
+        raise SceneError(
+            "contact with the geometry is not supported yet for harnesses (scenes with "
+            "[[junctions]]); remove [contact] or the junctions"
+        )
+    cables, specs = harness_cables(scene)
+    cores = [build_cable(scene, c) for c in cables]
+    try:
+        core = _core.Harness(
+            cores,
+            [c.name for c in cables],
+            specs,
+            max_iterations=scene.simulation.max_iterations,
+        )
+    except ValueError as err:
+        raise SceneError(f"harness: {err}") from None
+    motions = body_motions(scene, times)  # once for all cables
+    kin = [clip_kinematics(scene, c, times, motions=motions) for c in cables]
+    poses = [(k["positions"], k["quaternions"]) for k in kin]
+    callback = (lambda k, n: progress("harness", k, n)) if progress else None
+    start = _time.perf_counter()
+    out = core.run_sequence(
+        [p for p, _ in poses],
+        [q for _, q in poses],
+        callback,
+        max(1, times.size // 100),
+        stop=stop,
+    )
+    wall = _time.perf_counter() - start
+    n = int(out["steps"])
+    saved = times[:n]
+    simulated = float(saved[-1] - saved[0]) if n > 1 else 0.0
+    results: dict[str, CableResult] = {}
+    for k, (c, co, o) in enumerate(zip(cables, cores, out["cables"], strict=True)):
+        n_own = len(scene.cables[k].clips)
+        clips = {
+            clip.name: ClipReaction(
+                clip.name,
+                clip.s,
+                o["reaction_force"][:, j].copy(),
+                o["reaction_moment"][:, j].copy(),
+            )
+            for j, clip in enumerate(c.clips[:n_own])
+        }
+        solver = dict(
+            iterations=out["iterations"],
+            substeps=out["substeps"],
+            residual=out["residual"],
+            segments=int(co.arc_length.size - 1),
+            wall_time=wall,
+            real_time_factor=wall / simulated if simulated > 0 else float("nan"),
+            error=out["error"] or "",
+            harness=1,
+        )
+        solver.update(_stability_info(o, saved, co.arc_length, c.name))
+        results[c.name] = CableResult(
+            name=c.name,
+            time=saved.copy(),
+            arc_length=co.arc_length,
+            positions=o["positions"],
+            quaternions=o["quaternions"],
+            forces=o["forces"],
+            moments=o["moments"],
+            clips=clips,
+            section=c.properties().as_attrs(),
+            solver=solver,
+            energies={"elastic_energy": o["elastic_energy"]},
+        )
+    junctions: dict[str, JunctionResult] = {}
+    ends = core.ends
+    for jj, j in enumerate(scene.junctions):
+        branches = {}
+        for e, (ci, clip, ji) in enumerate(ends):
+            if ji != jj:
+                continue
+            which = "start" if cables[ci].clips[clip].s == 0.0 else "end"
+            branches[f"{cables[ci].name}:{which}"] = (
+                out["branch_force"][:, e].copy(),
+                out["branch_moment"][:, e].copy(),
+            )
+        junctions[j.name] = JunctionResult(
+            name=j.name,
+            time=saved.copy(),
+            position=out["junction_positions"][:, jj].copy(),
+            quaternion=out["junction_quaternions"][:, jj].copy(),
+            branch_force={k: v[0] for k, v in branches.items()},
+            branch_moment={k: v[1] for k, v in branches.items()},
+        )
+    return results, junctions, out["error"]
+
+
+def junction_table(result):
+    """A rich table of the junctions: the largest displacement from the first saved step and
+    the largest branch force and moment on each junction."""
+    from rich.markup import escape
+    from rich.table import Table
+
+    t = Table(title="junctions (max over time)", title_justify="left")
+    for col in ("junction", "branch", "|force| [N]", "|moment| [N m]", "moved [mm]"):
+        t.add_column(escape(col), justify="left" if col in ("junction", "branch") else "right")
+    for name, j in result.junctions.items():
+        moved = float(np.linalg.norm(j.position - j.position[:1], axis=1).max(initial=0.0))
+        for k, (end, force) in enumerate(j.branch_force.items()):
+            t.add_row(
+                escape(name) if k == 0 else "",
+                escape(end),
+                f"{np.linalg.norm(force, axis=1).max(initial=0.0):.4g}",
+                f"{np.linalg.norm(j.branch_moment[end], axis=1).max(initial=0.0):.4g}",
+                f"{1e3 * moved:.3g}" if k == 0 else "",
+            )
+    return t

@@ -1,0 +1,171 @@
+"""Harness scenes (docs/harness.md): junction validation, static and quasistatic runs through
+the Python workflow, junction equilibrium and symmetry, results round trip."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from cablelife.results import load_result
+from cablelife.scene import SceneError, scene_from_dict
+from cablelife.simulate import simulate
+
+C30, S30 = math.cos(math.radians(30)), math.sin(math.radians(30))
+SECTION = {"shape": "circle", "radius": 0.004}
+MATERIAL = {"youngs_modulus": 5e7, "poisson_ratio": 0.4, "density": 2000.0}
+
+
+def y_scene(**sim) -> dict:
+    """A trunk from a clamp to a junction at the origin, two branches at ±30° to clamps."""
+
+    def cable(name, length, clip_s, pos, direction):
+        return {
+            "name": name,
+            "length": length,
+            "segments": 24,
+            "section": SECTION,
+            "material": MATERIAL,
+            "clips": [
+                {
+                    "name": f"{name}-clamp",
+                    "s": clip_s,
+                    "position": pos,
+                    "direction": direction,
+                    "normal": [0.0, 0.0, 1.0],
+                    "body": "bracket" if name == "trunk" else "world",
+                }
+            ],
+        }
+
+    return {
+        "simulation": {"mode": "static", **sim},
+        "bodies": [{"name": "bracket"}],
+        "cables": [
+            cable("trunk", 0.5, 0.0, [-0.5, 0.0, 0.0], [1.0, 0.0, 0.0]),
+            cable("a", 0.4, 0.4, [0.4 * C30, 0.4 * S30, 0.0], [C30, S30, 0.0]),
+            cable("b", 0.4, 0.4, [0.4 * C30, -0.4 * S30, 0.0], [C30, -S30, 0.0]),
+        ],
+        "junctions": [
+            {
+                "name": "y",
+                "ends": ["trunk:end", "a:start", "b:start"],
+                "position": [0.0, 0.0, 0.0],
+                "directions": [[-1.0, 0.0, 0.0], [C30, S30, 0.0], [C30, -S30, 0.0]],
+                "normals": [[0.0, 0.0, 1.0]] * 3,
+                "mass": 0.02,
+            }
+        ],
+    }
+
+
+def test_static_y_is_symmetric_and_the_junction_in_equilibrium(tmp_path):
+    result = simulate(scene_from_dict(y_scene()))
+    j = result.junctions["y"]
+    assert set(j.branch_force) == {"trunk:end", "a:start", "b:start"}
+    fa, fb = j.branch_force["a:start"][0], j.branch_force["b:start"][0]
+    mirror = np.array([1.0, -1.0, 1.0])
+    scale = np.abs(fa).max()
+    assert scale > 0.01
+    np.testing.assert_allclose(fb, fa * mirror, atol=1e-8 * scale)
+    ma, mb = j.branch_moment["a:start"][0], j.branch_moment["b:start"][0]
+    np.testing.assert_allclose(mb, -ma * mirror, atol=1e-8 * np.abs(ma).max())
+    weight = np.array([0.0, 0.0, -9.81 * 0.02])
+    total_f = sum(f[0] for f in j.branch_force.values()) + weight
+    total_m = sum(m[0] for m in j.branch_moment.values())
+    # The junction's equilibrium is its residual: within the Newton tolerance of the forces.
+    assert np.abs(total_f).max() < 1e-9 * scale
+    assert np.abs(total_m).max() < 1e-9 * scale
+    # The joined ends sit at the junction; the junction sags under the weights.
+    pos = j.position[0]
+    assert pos[2] < -1e-4 and abs(pos[1]) < 1e-10
+    np.testing.assert_allclose(result.cables["trunk"].positions[0, -1], pos, atol=1e-14)
+    np.testing.assert_allclose(result.cables["a"].positions[0, 0], pos, atol=1e-14)
+    # Only the scene's clips are clip outputs; the junction loads are the junction's.
+    assert list(result.cables["a"].clips) == ["a-clamp"]
+    path = result.save(tmp_path / "y.h5")
+    back = load_result(path)
+    np.testing.assert_array_equal(back.junctions["y"].position, j.position)
+    np.testing.assert_array_equal(
+        back.junctions["y"].branch_force["trunk:end"], j.branch_force["trunk:end"]
+    )
+
+
+def test_quasistatic_harness_follows_a_moving_clip():
+    scene = y_scene(mode="quasistatic", duration=0.2, time_step=0.05)
+    scene["bodies"][0]["motion"] = [
+        {"channel": "y", "signal": {"type": "sine", "amplitude": 0.03, "frequency": 1.25}}
+    ]
+    result = simulate(scene_from_dict(scene))
+    j = result.junctions["y"]
+    assert j.position.shape == (5, 3)
+    # The trunk's clamp moves along +y: the junction follows it, less than the clamp.
+    dy = j.position[:, 1]
+    assert dy[-1] > 1e-4 and dy[-1] < 0.03
+    assert np.all(result.cables["trunk"].solver["iterations"] < 40)
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        (lambda s: s["junctions"][0].update(ends=["trunk:end", "c:start", "b:start"]), "no cable"),
+        (lambda s: s["junctions"][0].update(ends=["trunk:end", "a:start", "a:start"]), "already"),
+        (lambda s: s["junctions"][0].update(directions=[[1.0, 0, 0]]), "1 directions for 3"),
+        (lambda s: s["junctions"][0].update(ends=["trunk:end", "a:middle", "b:start"]), "allowed"),
+        (lambda s: s["junctions"][0].update(ends=["trunk:start", "a:start", "b:start"]), "holds"),
+        (
+            lambda s: (
+                s["junctions"].append(
+                    {
+                        "name": "z",
+                        "ends": ["a:end", "b:end"],
+                        "position": [0.4 * C30, 0.0, 0.0],
+                        "directions": [[-1.0, 0, 0], [1.0, 0, 0]],
+                    }
+                )
+                or [c["clips"].clear() for c in s["cables"][1:]]
+            ),
+            "loop",
+        ),
+        (lambda s: [c["clips"].clear() for c in s["cables"]], "held by no clip"),
+    ],
+)
+def test_bad_junctions_are_named(change, message):
+    scene = y_scene()
+    change(scene)
+    with pytest.raises(SceneError, match=message):
+        scene_from_dict(scene)
+
+
+def test_dynamic_harness_is_a_clear_error():
+    scene = scene_from_dict(y_scene(mode="dynamic", duration=0.01))
+    with pytest.raises(SceneError, match="not supported yet"):
+        simulate(scene)
+
+
+def test_modal_analysis_of_a_harness_is_a_clear_error():
+    from cablelife.modal import modes
+
+    with pytest.raises(SceneError, match="modal analysis of harnesses"):
+        modes(scene_from_dict(y_scene()))
+
+
+def test_example_harness_runs_from_the_command_line(tmp_path):
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    scene = Path(__file__).resolve().parents[1] / "examples" / "harness" / "scene.toml"
+    out = tmp_path / "h.h5"
+    proc = subprocess.run(
+        [sys.executable, "-m", "cablelife", "run", str(scene), "-o", str(out), "--mode", "static"],
+        capture_output=True,
+        text=True,
+    )
+    assert proc.returncode == 0, proc.stderr
+    assert "junctions (max over time)" in proc.stdout and "gearbox:start" in proc.stdout
+    res = load_result(out)
+    j = res.junctions["breakout"]
+    assert len(j.branch_force) == 4
+    total = sum(f[0] for f in j.branch_force.values()) + np.array([0, 0, -9.81 * 0.01])
+    assert np.abs(total).max() < 1e-8 * max(np.abs(f[0]).max() for f in j.branch_force.values())
