@@ -30,7 +30,7 @@ impl EndTopology {
     /// The end held by point clip `clip` (fixed, at s = 0 or s = L, with a ghost rotation).
     pub fn new(rod: &Rod, clip: usize) -> Option<EndTopology> {
         let ghost = rod.clip_ghost.get(clip).copied().flatten()?;
-        if rod.ghosts[ghost].twist_free {
+        if rod.ghosts[ghost].is_free() {
             return None;
         }
         let node = rod.ghosts[ghost].node;
