@@ -555,6 +555,20 @@ pub struct Contact {
     pub min_gap: f64,
     /// Samples inside the barrier (gap below d̂) in the last assembly.
     pub active: usize,
+    /// Broad phase by exact signed distances (a start inside the geometry being resolved: a
+    /// point deeper inside a mesh than the barrier's reach reads as far otherwise).
+    exact_broad_phase: bool,
+}
+
+/// A node of the cable inside an obstacle deeper than the allowed penetration.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Penetration {
+    pub node: usize,
+    /// Index and name of the obstacle.
+    pub obstacle: usize,
+    pub name: String,
+    /// How far the cable surface is inside, m (> 0).
+    pub depth: f64,
 }
 
 /// Invalid contact settings.
@@ -651,6 +665,7 @@ impl Contact {
             body_force: vec![Vector3::zeros(); n_bodies],
             min_gap: f64::INFINITY,
             active: 0,
+            exact_broad_phase: false,
         })
     }
 
@@ -741,6 +756,30 @@ impl Contact {
         })
     }
 
+    /// Broad phase by exact signed distances (`true` while a start inside the geometry is
+    /// resolved; slower on meshes, where the bounded query prunes the hierarchy otherwise).
+    pub fn set_exact_broad_phase(&mut self, exact: bool) {
+        self.exact_broad_phase = exact;
+    }
+
+    /// Where the cable surface (the capsules of its edges) lies deepest inside an obstacle, if
+    /// deeper than the documented tolerance (1 % of r): exact signed distances, the node
+    /// nearest the deepest point of the edge.
+    pub fn deepest_penetration(&self, st: &State) -> Option<Penetration> {
+        let (gap, e, k) = self.surface_gap(st);
+        if gap >= -0.01 * self.opts.radius {
+            return None;
+        }
+        let o = &self.obstacles[k];
+        let t = o.segment_query(&st.x[e], &st.x[e + 1]).t;
+        Some(Penetration {
+            node: if t < 0.5 { e } else { e + 1 },
+            obstacle: k,
+            name: o.name.clone(),
+            depth: -gap,
+        })
+    }
+
     /// Whether a free node of the state lies inside an obstacle (negative gap).
     pub fn penetrates(&self, rod: &Rod, st: &State) -> bool {
         self.obstacles.iter().any(|o| {
@@ -790,7 +829,12 @@ impl Contact {
         if far.is_finite() && (mid - o.position).norm() - half - far > reach {
             return;
         }
-        if o.distance_within(&mid, half + reach) - half >= reach {
+        let d_mid = if self.exact_broad_phase {
+            o.distance(&mid)
+        } else {
+            o.distance_within(&mid, half + reach)
+        };
+        if d_mid - half >= reach {
             return;
         }
         let kk = self.samples[k];

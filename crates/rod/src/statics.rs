@@ -99,6 +99,14 @@ pub enum SolveError {
         residual: f64,
         load_factor: f64,
     },
+    /// With contact: the equilibrium leaves the cable inside the geometry (a start deep
+    /// inside that the barrier could not push out, e.g. a clip inside a solid).
+    Penetration {
+        node: usize,
+        s: f64,
+        obstacle: String,
+        depth: f64,
+    },
 }
 
 impl fmt::Display for SolveError {
@@ -145,6 +153,19 @@ impl fmt::Display for SolveError {
                 f,
                 "Newton did not converge: {iterations} iterations, last residual {residual:.3e} N \
                  at load factor {load_factor:.4}"
+            ),
+            SolveError::Penetration {
+                node,
+                s,
+                obstacle,
+                depth,
+            } => write!(
+                f,
+                "the cable stays inside the geometry '{obstacle}': node {node} (s = {s:.4} m), \
+                 its surface {:.2} mm deep; contact could not push it out (a clip inside the \
+                 solid, or a route through it that the clips hold): route the cable outside \
+                 the geometry",
+                depth * 1e3
             ),
         }
     }
@@ -449,16 +470,53 @@ impl Statics {
         self.has_prev = false; // a new sequence starts here
         self.check_held(rod, st)?;
         let mut pre = SolveStats::default();
-        if self.contact.as_ref().is_some_and(|c| c.penetrates(rod, st)) {
-            let contact = self.contact.take();
+        let inside = self.contact.as_ref().is_some_and(|c| c.penetrates(rod, st));
+        let start_state = st.clone();
+        if inside {
+            let mut contact = self.contact.take();
             let start = st.clone();
             match self.solve_any(rod, st) {
                 Ok(s) => pre = s,
                 Err(_) => st.clone_from(&start),
             }
+            // Deep inside a mesh the bounded broad phase sees nothing: exact distances.
+            if let Some(c) = &mut contact {
+                c.set_exact_broad_phase(true);
+            }
             self.contact = contact;
         }
-        let mut stats = self.solve_any(rod, st)?;
+        // Never a silent wrong answer: a cable left inside the geometry, or a start inside it
+        // that the solver could not resolve, is an error naming where.
+        let inside_at = |s: &Self, st: &State| {
+            s.contact
+                .as_ref()
+                .and_then(|c| c.deepest_penetration(st))
+                .map(|p| SolveError::Penetration {
+                    node: p.node,
+                    s: rod.arc[p.node],
+                    obstacle: p.name,
+                    depth: p.depth,
+                })
+        };
+        let start_inside = if inside {
+            inside_at(self, &start_state)
+        } else {
+            None
+        };
+        let result = self.solve_any(rod, st);
+        if let Some(c) = &mut self.contact {
+            c.set_exact_broad_phase(false);
+        }
+        let mut stats = match (result, start_inside) {
+            (Ok(s), _) => s,
+            (Err(SolveError::NotConverged { .. }), Some(e)) => return Err(e),
+            (Err(e), _) => return Err(e),
+        };
+        if inside {
+            if let Some(e) = inside_at(self, st) {
+                return Err(e);
+            }
+        }
         stats.iterations += pre.iterations;
         self.ensure_stable(rod, st, &mut stats, 0.0)?;
         stats.snap = None; // leaving an unstable first solution is no jump of the cable

@@ -7,12 +7,13 @@ mod common;
 use common::*;
 use nalgebra::{Vector3, Vector6};
 use rod::contact::{
-    Contact, ContactOptions, Cylinder, Obstacle, Plane, Shape, Sphere, NO_CONTACT, SLIP, STICK,
+    Contact, ContactOptions, Cuboid, Cylinder, Obstacle, Plane, Shape, Sphere, NO_CONTACT, SLIP,
+    STICK,
 };
 use rod::rotation::{frame_quaternion, Quat};
 use rod::{
     CableSpec, ClipKind, ClipMotion, DynamicOptions, Dynamics, NewtonOptions, PointLoad, Pose, Rod,
-    Section, State, Statics,
+    Section, SolveError, State, Statics,
 };
 use std::f64::consts::PI;
 
@@ -630,4 +631,79 @@ fn bad_contact_settings_are_named() {
     assert!(e.0.contains("distance") && e.0.contains("-1"), "{e}");
     let e = Contact::new(&rod, vec![o(0.1)], ContactOptions::for_radius(f64::NAN), 1).unwrap_err();
     assert!(e.0.contains("radius"), "{e}");
+}
+
+/// A cantilever (r = 4 mm, along x, clamped at x = 0) whose straight start ends in a box, 8 mm
+/// below its top face: deeper than the barrier's reach (r + d̂ + half an edge), where a mesh's
+/// bounded broad phase sees nothing. Never a silent answer inside the box: as a box primitive
+/// and as a box mesh, the static solve either pushes the cable out or fails with the
+/// penetration error naming a node inside the box — and both shapes give the same outcome.
+/// (Measured: both fail, the barrier's Taylor continuation is too stiff to push 12 mm out.)
+#[test]
+fn a_cable_starting_deep_inside_a_box_or_mesh_is_never_a_silent_answer() {
+    let r = 0.004;
+    let half = Vector3::new(0.1, 0.05, 0.02);
+    let centre = Vector3::new(0.25, 0.0, -0.02 + 0.008);
+    let shapes: [Box<dyn Shape>; 2] = [
+        Box::new(Cuboid { half }),
+        Box::new(rod::contact_mesh::box_mesh(half)),
+    ];
+    let mut outcomes = Vec::new();
+    for shape in shapes {
+        let rod = Rod::new(cantilever(0.3, 60, section(1e5, 1e-2, 0.1))).unwrap();
+        let x = rod.arc.iter().map(|&s| Vector3::new(s, 0.0, 0.0)).collect();
+        let mut st = state_through(&rod, x, Vector3::z());
+        let o = Obstacle::new("box", 0, shape, 0.0, &at(centre, Vector3::z()));
+        let mut s = Statics::new(&rod, NewtonOptions::default());
+        s.contact = Some(contact(&rod, vec![o], r));
+        assert!(s.contact.as_ref().unwrap().penetrates(&rod, &st));
+        match s.solve(&rod, &mut st) {
+            Ok(_) => {
+                let ct = s.contact.as_ref().unwrap();
+                let (gap, _, _) = ct.surface_gap(&st);
+                assert!(gap > -0.01 * r, "Ok, but still inside: gap {gap}");
+                assert!(ct.deepest_penetration(&st).is_none());
+                outcomes.push(Ok(st.x[60]));
+            }
+            Err(e @ SolveError::Penetration { .. }) => {
+                let SolveError::Penetration { node, depth, .. } = &e else {
+                    unreachable!()
+                };
+                assert!(rod.arc[*node] > 0.15 - r && *depth > 0.01 * r, "{e}");
+                assert!(e.to_string().contains("'box'"));
+                outcomes.push(Err(*node));
+            }
+            Err(e) => panic!("not the penetration error: {e}"),
+        }
+    }
+    match (&outcomes[0], &outcomes[1]) {
+        (Ok(a), Ok(b)) => assert!((a - b).norm() < 1e-6, "{a} vs {b}"),
+        (Err(a), Err(b)) => assert_eq!(a, b),
+        _ => panic!("primitive and mesh differ: {outcomes:?}"),
+    }
+}
+
+/// A clip inside a box mesh (the cable cannot leave it): a clear error naming the geometry and
+/// the node, not an equilibrium inside the solid.
+#[test]
+fn a_cable_held_inside_a_mesh_is_an_error_naming_node_and_geometry() {
+    let r = 0.004;
+    let rod = Rod::new(cantilever(0.3, 60, section(1e5, 1e-2, 0.1))).unwrap();
+    let x = rod.arc.iter().map(|&s| Vector3::new(s, 0.0, 0.0)).collect();
+    let mut st = state_through(&rod, x, Vector3::z());
+    let mesh = rod::contact_mesh::box_mesh(Vector3::new(0.05, 0.05, 0.05));
+    let o = Obstacle::new("engine block", 0, Box::new(mesh), 0.0, &origin());
+    let mut s = Statics::new(&rod, NewtonOptions::default());
+    s.contact = Some(contact(&rod, vec![o], r));
+    match s.solve(&rod, &mut st) {
+        Err(e @ SolveError::Penetration { .. }) => {
+            let SolveError::Penetration { node, depth, .. } = &e else {
+                unreachable!()
+            };
+            assert!(rod.arc[*node] < 0.05 && *depth > 0.01 * r, "{e}");
+            let msg = e.to_string();
+            assert!(msg.contains("'engine block'") && msg.contains(&format!("node {node}")));
+        }
+        other => panic!("expected a penetration error, got {other:?}"),
+    }
 }
