@@ -181,8 +181,10 @@ fn capstan_on(mu: f64, drum: Box<dyn Shape>, corner: f64) -> (Capstan, Statics) 
         .collect();
     let st = state_through(&rod, x, Vector3::new(0.0, 1.0, 0.0));
     let mut statics = Statics::new(&rod, NewtonOptions::default());
-    // At most 2 samples per edge: with the default 8 on the sharp corners of a mesh, the static
-    // solve of the wrap does not converge (open: the same happens on a box primitive).
+    // At most 2 samples per edge: with the default 8 on the sharp corners of a mesh the static
+    // solve of the wrap does not converge (docs/contact.md: the deepest sample of a chord then
+    // carries a quarter of the load, needs more than the barrier's Taylor continuation below
+    // d̂/1000 can give at zero gap, and the 90 % gap bound stalls Newton short of it).
     let mut opts = ContactOptions::for_radius(r);
     opts.max_samples = 2;
     statics.contact = Some(Contact::new(&rod, vec![o], opts, 1).unwrap());
@@ -430,9 +432,10 @@ fn friction_holds_on_an_incline_below_the_friction_angle_and_slides_above() {
     assert!((free - exact).abs() < 0.02 * exact, "{free} vs {exact}");
 }
 
-/// A cable dropped from 2 cm (tilted) onto a frictionless plane: total energy never grows, the
-/// capsules never go through the plane, and it comes to rest on it.
-fn drop(r: f64) {
+/// A cable dropped from 2 cm (tilted) onto a plane with friction μ: total energy never grows, the
+/// capsules never go through the plane, and it comes to rest on it (frictionless: the
+/// horizontal momentum of the tilted impact stays; with friction it is stopped too).
+fn drop(r: f64, mu: f64) {
     let l = 0.4;
     let n = 40;
     let rho = 1500.0;
@@ -453,7 +456,7 @@ fn drop(r: f64) {
         .map(|&s| Vector3::new(s, 0.0, r + 0.02 + 0.01 * s))
         .collect();
     let mut st = state_through(&rod, x, Vector3::z());
-    let floor = Obstacle::new("floor", 0, Box::new(Plane), 0.0, &origin());
+    let floor = Obstacle::new("floor", 0, Box::new(Plane), mu, &origin());
     let opts = DynamicOptions {
         tau_bend: Vector3::new(1e-3, 1e-3, 1e-3),
         tau_shear: Vector3::new(1e-4, 1e-4, 1e-4),
@@ -478,16 +481,20 @@ fn drop(r: f64) {
         }
         let e = total(&dy);
         let en = dy.energies;
-        // Never above the start; per step, within the integrator's fluctuation of the energy
-        // in motion (measured ≤ 0.3 % after the impact excites the cable's bending modes).
+        // Never above the start; per step, within the step guard's bound on the growth of the
+        // energy in motion (`energy_tolerance` = 1e-3 of the energies at play, a larger growth
+        // splits the step; its scale differs from this one by the clip work and the start's
+        // contact energy: a factor 2 of margin; measured 1.13e-3 (r = 1 mm), 1.22e-3 (30 mm)).
         assert!(
             e <= e0 + 1e-6 * drop_energy,
-            "r = {r}: step {k}: {e} > {e0}"
+            "r = {r}, μ = {mu}: step {k}: {e} > {e0}"
         );
+        // With friction the per-step bound does not hold (open, docs/contact.md: measured
+        // 0.67 % of the energy in motion at one step at μ = 0.3); never above the start does.
         let scale = last_kinetic + en.kinetic + last_elastic.abs() + last_contact;
         assert!(
-            e <= last + 1e-2 * scale,
-            "r = {r}: energy grew at step {k}: {last} → {e} (scale {scale}, {en:?})"
+            mu > 0.0 || e <= last + 2e-3 * scale,
+            "r = {r}, μ = {mu}: energy grew at step {k}: {last} → {e} (scale {scale}, {en:?})"
         );
         (last, last_kinetic, last_elastic, last_contact) = (e, en.kinetic, en.elastic, en.contact);
         let ct = dy.contact.as_ref().unwrap();
@@ -506,6 +513,19 @@ fn drop(r: f64) {
         vertical < 1e-4 * drop_energy,
         "r = {r}: still bouncing, {vertical} J"
     );
+    if mu > 0.0 {
+        // Friction stops the sliding too: every node at rest within the stick zone's creep.
+        let v_max = dy
+            .velocities()
+            .iter()
+            .map(|v| v.fixed_rows::<3>(0).norm())
+            .fold(0.0, f64::max);
+        let creep = ContactOptions::for_radius(r).stick_velocity;
+        assert!(
+            v_max < creep,
+            "r = {r}, μ = {mu}: still sliding at {v_max} m/s"
+        );
+    }
     assert!(st.x.iter().all(|x| (x.z - r).abs() < 0.01 * r));
     let ct = dy.contact.as_ref().unwrap();
     assert!(ct.node_state.iter().all(|&s| s == STICK));
@@ -514,8 +534,9 @@ fn drop(r: f64) {
 #[test]
 fn dropped_cable_comes_to_rest_without_gaining_energy_or_tunnelling() {
     for r in [0.001, 0.03] {
-        drop(r);
+        drop(r, 0.0);
     }
+    drop(0.003, 0.3);
 }
 
 /// The assembled Jacobian with contact and friction equals the finite-difference derivative
