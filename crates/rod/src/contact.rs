@@ -454,9 +454,10 @@ pub struct Contact {
     pub min_gap: f64,
     /// Samples inside the barrier (gap below d̂) in the last assembly.
     pub active: usize,
-    /// Broad phase by exact signed distances (a start inside the geometry being resolved: a
-    /// point deeper inside a mesh than the barrier's reach reads as far otherwise).
-    exact_broad_phase: bool,
+    /// Edges (per obstacle: k · edges + e) whose broad phase uses exact signed distances (a
+    /// start inside the geometry being resolved: a point deeper inside a mesh than the
+    /// barrier's reach reads as far otherwise).
+    deep: Vec<bool>,
 }
 
 /// A node of the cable inside an obstacle deeper than the allowed penetration.
@@ -550,6 +551,7 @@ impl Contact {
             })
             .collect();
         let n = rod.arc.len();
+        let n_obstacles = obstacles.len();
         Ok(Contact {
             obstacles,
             kappa,
@@ -564,7 +566,7 @@ impl Contact {
             body_force: vec![Vector3::zeros(); n_bodies],
             min_gap: f64::INFINITY,
             active: 0,
-            exact_broad_phase: false,
+            deep: vec![false; n_obstacles * n.saturating_sub(1)],
         })
     }
 
@@ -655,28 +657,58 @@ impl Contact {
         })
     }
 
-    /// Broad phase by exact signed distances (`true` while a start inside the geometry is
-    /// resolved; slower on meshes, where the bounded query prunes the hierarchy otherwise).
-    pub fn set_exact_broad_phase(&mut self, exact: bool) {
-        self.exact_broad_phase = exact;
+    /// While a start inside the geometry is resolved: the edges at a node of `x` inside an
+    /// obstacle (its centreline, exact signed distance) take the broad phase by exact distances
+    /// (slower on meshes, where the bounded query prunes the hierarchy); `None` clears.
+    pub fn mark_deep_edges(&mut self, x: Option<&[Vector3<f64>]>) {
+        self.deep.fill(false);
+        let Some(x) = x else { return };
+        let ne = x.len().saturating_sub(1);
+        for (k, o) in self.obstacles.iter().enumerate() {
+            for (n, p) in x.iter().enumerate() {
+                if o.distance(p) < 0.0 {
+                    if n > 0 {
+                        self.deep[k * ne + n - 1] = true;
+                    }
+                    if n < ne {
+                        self.deep[k * ne + n] = true;
+                    }
+                }
+            }
+        }
     }
 
     /// Where the cable surface (the capsules of its edges) lies deepest inside an obstacle, if
     /// deeper than the documented tolerance (1 % of r): exact signed distances, the node
-    /// nearest the deepest point of the edge.
+    /// nearest the deepest point of the edge. Edges the bounded broad phase finds clear are
+    /// skipped unless marked deep (`mark_deep_edges`).
     pub fn deepest_penetration(&self, st: &State) -> Option<Penetration> {
-        let (gap, e, k) = self.surface_gap(st);
-        if gap >= -0.01 * self.opts.radius {
-            return None;
+        let r = self.opts.radius;
+        let mut worst: Option<Penetration> = None;
+        for (k, o) in self.obstacles.iter().enumerate() {
+            for e in 0..st.x.len().saturating_sub(1) {
+                let (a, b) = (st.x[e], st.x[e + 1]);
+                let mid = 0.5 * (a + b);
+                let half = 0.5 * (b - a).norm();
+                let deep = self.deep[k * (st.x.len() - 1) + e];
+                if o.distance_within(&mid, half + r) - half >= r
+                    && (!deep || o.distance(&mid) - half >= r)
+                {
+                    continue;
+                }
+                let q = o.segment_query(&a, &b);
+                let depth = r - q.distance;
+                if depth > 0.01 * r && worst.as_ref().is_none_or(|w| depth > w.depth) {
+                    worst = Some(Penetration {
+                        node: if q.t < 0.5 { e } else { e + 1 },
+                        obstacle: k,
+                        name: o.name.clone(),
+                        depth,
+                    });
+                }
+            }
         }
-        let o = &self.obstacles[k];
-        let t = o.segment_query(&st.x[e], &st.x[e + 1]).t;
-        Some(Penetration {
-            node: if t < 0.5 { e } else { e + 1 },
-            obstacle: k,
-            name: o.name.clone(),
-            depth: -gap,
-        })
+        worst
     }
 
     /// Whether a free node of the state lies inside an obstacle (negative gap).
@@ -728,11 +760,10 @@ impl Contact {
         if far.is_finite() && (mid - o.position).norm() - half - far > reach {
             return;
         }
-        let d_mid = if self.exact_broad_phase {
-            o.distance(&mid)
-        } else {
-            o.distance_within(&mid, half + reach)
-        };
+        let mut d_mid = o.distance_within(&mid, half + reach);
+        if self.deep[k * rod.n_edges() + e] && d_mid >= half + reach {
+            d_mid = o.distance(&mid); // deeper inside than the bound, or far
+        }
         if d_mid - half >= reach {
             return;
         }

@@ -479,38 +479,42 @@ impl Statics {
                 Ok(s) => pre = s,
                 Err(_) => st.clone_from(&start),
             }
-            // Deep inside a mesh the bounded broad phase sees nothing: exact distances.
+            // Deep inside a mesh the bounded broad phase sees nothing: exact distances there.
             if let Some(c) = &mut contact {
-                c.set_exact_broad_phase(true);
+                c.mark_deep_edges(Some(&st.x));
             }
             self.contact = contact;
         }
         // Never a silent wrong answer: a cable left inside the geometry, or a start inside it
         // that the solver could not resolve, is an error naming where.
-        let inside_at = |s: &Self, st: &State| {
-            s.contact
-                .as_ref()
-                .and_then(|c| c.deepest_penetration(st))
-                .map(|p| SolveError::Penetration {
-                    node: p.node,
-                    s: rod.arc[p.node],
-                    obstacle: p.name,
-                    depth: p.depth,
-                })
-        };
-        let start_inside = if inside {
-            inside_at(self, &start_state)
-        } else {
-            None
+        let inside_at = |s: &mut Self, st: &State| {
+            let c = s.contact.as_mut()?;
+            c.mark_deep_edges(Some(&st.x));
+            let p = c.deepest_penetration(st);
+            c.mark_deep_edges(None);
+            p.map(|p| SolveError::Penetration {
+                node: p.node,
+                s: rod.arc[p.node],
+                obstacle: p.name,
+                depth: p.depth,
+            })
         };
         let result = self.solve_any(rod, st);
         if let Some(c) = &mut self.contact {
-            c.set_exact_broad_phase(false);
+            c.mark_deep_edges(None);
         }
-        let mut stats = match (result, start_inside) {
-            (Ok(s), _) => s,
-            (Err(SolveError::NotConverged { .. }), Some(e)) => return Err(e),
-            (Err(e), _) => return Err(e),
+        let mut stats = match result {
+            Ok(s) => s,
+            Err(SolveError::NotConverged { .. }) if inside => {
+                return Err(
+                    inside_at(self, &start_state).unwrap_or(SolveError::NotConverged {
+                        iterations: 0,
+                        residual: f64::NAN,
+                        load_factor: 0.0,
+                    }),
+                );
+            }
+            Err(e) => return Err(e),
         };
         if inside {
             if let Some(e) = inside_at(self, st) {
