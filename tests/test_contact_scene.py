@@ -227,3 +227,24 @@ def test_example_hose_rests_on_the_tray():
     assert np.all(res.contact["contact_gap"] > -0.01 * r)
     assert np.all((res.contact["contact_state"] > 0).sum(axis=1) >= 1)
     assert np.all(res.contact["body_contact_force"][:, 2, 2] > 0.0)
+
+
+def test_a_cable_held_inside_the_geometry_is_a_clear_error(scene_dict):
+    """A clip inside a solid: the run stops with an error naming the geometry, the node and
+    the depth (docs/contact.md, a start inside the geometry), not an equilibrium inside it."""
+    from cablelife.simulate import SimulationError
+
+    scene_dict["bodies"] = [
+        {
+            "name": "engine",
+            "geometry": [
+                {"shape": "box", "name": "block", "center": [0, 0, 0], "size": [0.1, 0.1, 0.1]}
+            ],
+        }
+    ]
+    scene_dict["contact"] = {"enabled": True}
+    with pytest.raises(SimulationError) as err:
+        simulate(scene_from_dict(scene_dict))
+    message = str(err.value)
+    assert "inside the geometry" in message and "block" in message, message
+    assert "node" in message and "mm deep" in message, message

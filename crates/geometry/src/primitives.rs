@@ -3,10 +3,165 @@
 //! it), exact for the half-space and the sphere, and for the box and the cylinder the minimum
 //! of the convex function t ↦ dist(a + t (b − a), solid) by golden-section search to
 //! round-off.
+//!
+//! One distance code for clearance and contact: the functions `*_local` give the signed
+//! distance, the outward normal and the normal's gradient (the distance's Hessian, which the
+//! contact Jacobian needs) of a point in a primitive's own frame; the placed primitives below
+//! (clearance) and the contact obstacles of `rod::contact` (placed by their bodies' poses) both
+//! call them.
 use nalgebra::Matrix3;
 
 use crate::closest::point_segment;
 use crate::{PointProjection, SegmentProjection, Surface, V3};
+
+/// Signed distance of a point to a primitive (positive outside), the outward normal (its
+/// gradient) and the normal's gradient (the Hessian of the distance; zero on flat parts, and
+/// when not asked for).
+#[derive(Clone, Copy, Debug)]
+pub struct PointDistance {
+    pub distance: f64,
+    pub normal: V3,
+    pub hessian: Matrix3<f64>,
+}
+
+impl PointDistance {
+    /// The closest point on the surface.
+    pub fn closest_point(&self, p: &V3) -> V3 {
+        p - self.distance * self.normal
+    }
+}
+
+fn flat(distance: f64, normal: V3) -> PointDistance {
+    PointDistance {
+        distance,
+        normal,
+        hessian: Matrix3::zeros(),
+    }
+}
+
+/// The half-space z ≤ 0 (normal +z).
+#[inline]
+pub fn half_space_local(p: &V3) -> PointDistance {
+    flat(p.z, V3::z())
+}
+
+/// The ball of a radius about the origin.
+#[inline]
+pub fn sphere_local(radius: f64, p: &V3, hessian: bool) -> PointDistance {
+    let rho = p.norm();
+    if rho < 1e-12 * radius {
+        return flat(-radius, V3::z());
+    }
+    let n = p / rho;
+    PointDistance {
+        distance: rho - radius,
+        normal: n,
+        hessian: if hessian {
+            (Matrix3::identity() - n * n.transpose()) / rho
+        } else {
+            Matrix3::zeros()
+        },
+    }
+}
+
+/// The solid cylinder about the z axis, centred at the origin, with flat caps at
+/// z = ±`half_length` (∞: infinite, no caps).
+#[inline]
+pub fn cylinder_local(radius: f64, half_length: f64, p: &V3, hessian: bool) -> PointDistance {
+    let rho = (p.x * p.x + p.y * p.y).sqrt();
+    let (radial, tangential) = if rho > 1e-12 * radius {
+        let r = V3::new(p.x / rho, p.y / rho, 0.0);
+        (r, V3::new(-r.y, r.x, 0.0))
+    } else {
+        (V3::x(), V3::y())
+    };
+    let qs = rho - radius;
+    let qc = p.z.abs() - half_length;
+    let axial = V3::new(0.0, 0.0, if p.z < 0.0 { -1.0 } else { 1.0 });
+    let side = |d: f64| PointDistance {
+        distance: d,
+        normal: radial,
+        // Distance to the axis: curvature 1/ρ about it.
+        hessian: if hessian {
+            tangential * tangential.transpose() / rho.max(1e-300)
+        } else {
+            Matrix3::zeros()
+        },
+    };
+    if qs <= 0.0 && qc <= 0.0 {
+        // Inside: the nearer of side and cap.
+        return if qs >= qc { side(qs) } else { flat(qc, axial) };
+    }
+    if qc <= 0.0 {
+        return side(qs);
+    }
+    if qs <= 0.0 {
+        return flat(qc, axial);
+    }
+    // Outside beyond the rim circle: distance to the circle.
+    let d = (qs * qs + qc * qc).sqrt();
+    let n = (qs * radial + qc * axial) / d;
+    PointDistance {
+        distance: d,
+        normal: n,
+        hessian: if hessian {
+            let in_plane =
+                Matrix3::identity() - n * n.transpose() - tangential * tangential.transpose();
+            in_plane / d + (qs / (d * rho)) * tangential * tangential.transpose()
+        } else {
+            Matrix3::zeros()
+        },
+    }
+}
+
+/// The box with half extents `half` along the axes, centred at the origin.
+#[inline]
+pub fn cuboid_local(half: &V3, p: &V3, hessian: bool) -> PointDistance {
+    let q = p.abs() - half;
+    let sign = p.map(|v| if v < 0.0 { -1.0 } else { 1.0 });
+    let out = q.map(|v| v.max(0.0));
+    let n_out = (0..3).filter(|&k| q[k] > 0.0).count();
+    if n_out == 0 {
+        // Inside: the nearest face.
+        let k = q.imax();
+        let mut n = V3::zeros();
+        n[k] = sign[k];
+        return flat(q[k], n);
+    }
+    let d = out.norm();
+    let n = sign.component_mul(&out) / d;
+    let hessian = match (hessian, n_out) {
+        (false, _) | (true, 1) => Matrix3::zeros(),
+        (true, 2) => {
+            // Distance to an edge line along the axis that is inside.
+            let k = (0..3).find(|&k| q[k] <= 0.0).unwrap();
+            let mut l = V3::zeros();
+            l[k] = 1.0;
+            (Matrix3::identity() - n * n.transpose() - l * l.transpose()) / d
+        }
+        _ => (Matrix3::identity() - n * n.transpose()) / d,
+    };
+    PointDistance {
+        distance: d,
+        normal: n,
+        hessian,
+    }
+}
+
+/// Signed distance alone (cheaper) of the cylinder of [`cylinder_local`].
+#[inline]
+pub fn cylinder_local_distance(radius: f64, half_length: f64, p: &V3) -> f64 {
+    let qs = (p.x * p.x + p.y * p.y).sqrt() - radius;
+    let qc = p.z.abs() - half_length;
+    qs.max(qc).min(0.0) + (qs.max(0.0).powi(2) + qc.max(0.0).powi(2)).sqrt()
+}
+
+/// Signed distance alone (cheaper) of the box of [`cuboid_local`].
+#[inline]
+pub fn cuboid_local_distance(half: &V3, p: &V3) -> f64 {
+    let q = p.abs() - half;
+    q.max().min(0.0) + q.map(|v| v.max(0.0)).norm()
+}
 
 /// A unit vector orthogonal to `n` (unit).
 fn any_orthogonal(n: &V3) -> V3 {
@@ -71,49 +226,30 @@ trait Convex {
 
 impl Convex for HalfSpace {
     fn project(&self, p: &V3) -> (f64, V3, V3) {
-        let d = (p - self.point).dot(&self.normal);
-        (d, p - self.normal * d, self.normal)
+        let q = half_space_local(&V3::new(0.0, 0.0, (p - self.point).dot(&self.normal)));
+        (q.distance, p - self.normal * q.distance, self.normal)
     }
 }
 
 impl Convex for Sphere {
     fn project(&self, p: &V3) -> (f64, V3, V3) {
-        let r = p - self.center;
-        let len = r.norm();
-        let n = if len > 0.0 { r / len } else { V3::z() };
-        (len - self.radius, self.center + n * self.radius, n)
+        let q = sphere_local(self.radius, &(p - self.center), false);
+        (q.distance, q.closest_point(p), q.normal)
     }
 }
 
 impl Convex for Cuboid {
     fn project(&self, p: &V3) -> (f64, V3, V3) {
         let l = self.rotation.transpose() * (p - self.center);
-        let e = &self.half_extents;
-        let q = l.abs() - e;
-        if q.iter().any(|&x| x > 0.0) {
-            let c = V3::new(
-                l.x.clamp(-e.x, e.x),
-                l.y.clamp(-e.y, e.y),
-                l.z.clamp(-e.z, e.z),
-            );
-            let d = l - c;
-            let dist = d.norm();
-            let point = self.center + self.rotation * c;
-            (dist, point, self.rotation * (d / dist))
-        } else {
-            let k = q.imax();
-            let mut c = l;
-            let s = if l[k] < 0.0 { -1.0 } else { 1.0 };
-            c[k] = s * e[k];
-            let mut n = V3::zeros();
-            n[k] = s;
-            (q[k], self.center + self.rotation * c, self.rotation * n)
-        }
+        let q = cuboid_local(&self.half_extents, &l, false);
+        let n = self.rotation * q.normal;
+        (q.distance, p - n * q.distance, n)
     }
 }
 
 impl Convex for Cylinder {
     fn project(&self, p: &V3) -> (f64, V3, V3) {
+        // In the frame (radial, ·, axis) of the point: local (ρ, 0, z).
         let r = p - self.center;
         let z = r.dot(&self.axis);
         let rho = r - self.axis * z;
@@ -123,26 +259,9 @@ impl Convex for Cylinder {
         } else {
             any_orthogonal(&self.axis)
         };
-        let dr = rl - self.radius;
-        let dz = z.abs() - self.half_length;
-        let sz = if z < 0.0 { -1.0 } else { 1.0 };
-        if dr > 0.0 || dz > 0.0 {
-            let cr = rl.min(self.radius);
-            let cz = z.clamp(-self.half_length, self.half_length);
-            let point = self.center + radial * cr + self.axis * cz;
-            let d = p - point;
-            let dist = d.norm();
-            (dist, point, d / dist)
-        } else if dr > dz {
-            (
-                dr,
-                self.center + radial * self.radius + self.axis * z,
-                radial,
-            )
-        } else {
-            let point = self.center + rho + self.axis * (sz * self.half_length);
-            (dz, point, self.axis * sz)
-        }
+        let q = cylinder_local(self.radius, self.half_length, &V3::new(rl, 0.0, z), false);
+        let n = radial * q.normal.x + self.axis * q.normal.z;
+        (q.distance, p - n * q.distance, n)
     }
 }
 

@@ -21,24 +21,14 @@ use crate::assembly::{Eval, KinkAt, Part, Term, Workspace};
 use crate::model::{NodeKind, Pose, Rod};
 use crate::rotation::rotation_matrix;
 use crate::state::State;
+use geometry::primitives;
 use nalgebra::{Matrix3, Vector3};
 use std::fmt;
 
 /// Signed distance of a point to a shape, its gradient (the outward normal) and the gradient of
-/// the normal (the Hessian of the distance; zero on flat parts).
-#[derive(Clone, Copy, Debug)]
-pub struct PointQuery {
-    pub distance: f64,
-    pub normal: Vector3<f64>,
-    pub hessian: Matrix3<f64>,
-}
-
-impl PointQuery {
-    /// The closest point on the surface.
-    pub fn closest_point(&self, p: &Vector3<f64>) -> Vector3<f64> {
-        p - self.distance * self.normal
-    }
-}
+/// the normal (the Hessian of the distance; zero on flat parts): the geometry crate's, whose
+/// primitives' distance code contact and clearance share.
+pub type PointQuery = geometry::primitives::PointDistance;
 
 /// Closest points between a segment and a shape.
 #[derive(Clone, Copy, Debug)]
@@ -106,29 +96,12 @@ pub struct Cuboid {
     pub half: Vector3<f64>,
 }
 
-fn flat(distance: f64, normal: Vector3<f64>) -> PointQuery {
-    PointQuery {
-        distance,
-        normal,
-        hessian: Matrix3::zeros(),
-    }
-}
-
-/// Distance to a point c at distance d > 0 with unit direction n: Hessian (I − n nᵀ)/d.
-fn around_point(d: f64, n: Vector3<f64>) -> PointQuery {
-    PointQuery {
-        distance: d,
-        normal: n,
-        hessian: (Matrix3::identity() - n * n.transpose()) / d,
-    }
-}
-
 impl Shape for Plane {
     fn query(&self, p: &Vector3<f64>) -> PointQuery {
-        flat(p.z, Vector3::z())
+        primitives::half_space_local(p)
     }
     fn distance(&self, p: &Vector3<f64>) -> f64 {
-        p.z
+        primitives::half_space_local(p).distance
     }
     fn min_radius(&self) -> f64 {
         f64::INFINITY
@@ -143,19 +116,10 @@ impl Shape for Plane {
 
 impl Shape for Sphere {
     fn query(&self, p: &Vector3<f64>) -> PointQuery {
-        let rho = p.norm();
-        if rho < 1e-12 * self.radius {
-            return flat(-self.radius, Vector3::z());
-        }
-        let n = p / rho;
-        PointQuery {
-            distance: rho - self.radius,
-            normal: n,
-            hessian: (Matrix3::identity() - n * n.transpose()) / rho,
-        }
+        primitives::sphere_local(self.radius, p, true)
     }
     fn distance(&self, p: &Vector3<f64>) -> f64 {
-        p.norm() - self.radius
+        primitives::sphere_local(self.radius, p, false).distance
     }
     fn min_radius(&self) -> f64 {
         self.radius
@@ -170,47 +134,10 @@ impl Shape for Sphere {
 
 impl Shape for Cylinder {
     fn distance(&self, p: &Vector3<f64>) -> f64 {
-        let qs = (p.x * p.x + p.y * p.y).sqrt() - self.radius;
-        let qc = p.z.abs() - 0.5 * self.length;
-        qs.max(qc).min(0.0) + (qs.max(0.0).powi(2) + qc.max(0.0).powi(2)).sqrt()
+        primitives::cylinder_local_distance(self.radius, 0.5 * self.length, p)
     }
     fn query(&self, p: &Vector3<f64>) -> PointQuery {
-        let rho = (p.x * p.x + p.y * p.y).sqrt();
-        let (radial, tangential) = if rho > 1e-12 * self.radius {
-            let r = Vector3::new(p.x / rho, p.y / rho, 0.0);
-            (r, Vector3::new(-r.y, r.x, 0.0))
-        } else {
-            (Vector3::x(), Vector3::y())
-        };
-        let qs = rho - self.radius;
-        let qc = p.z.abs() - 0.5 * self.length;
-        let axial = Vector3::new(0.0, 0.0, p.z.signum());
-        let side = |d: f64| PointQuery {
-            distance: d,
-            normal: radial,
-            // Distance to the axis: curvature 1/ρ about it.
-            hessian: tangential * tangential.transpose() / rho.max(1e-300),
-        };
-        if qs <= 0.0 && qc <= 0.0 {
-            // Inside: the nearer of side and cap.
-            return if qs >= qc { side(qs) } else { flat(qc, axial) };
-        }
-        if qc <= 0.0 {
-            return side(qs);
-        }
-        if qs <= 0.0 {
-            return flat(qc, axial);
-        }
-        // Outside beyond the rim circle: distance to the circle.
-        let d = (qs * qs + qc * qc).sqrt();
-        let n = (qs * radial + qc * axial) / d;
-        let in_plane =
-            Matrix3::identity() - n * n.transpose() - tangential * tangential.transpose();
-        PointQuery {
-            distance: d,
-            normal: n,
-            hessian: in_plane / d + (qs / (d * rho)) * tangential * tangential.transpose(),
-        }
+        primitives::cylinder_local(self.radius, 0.5 * self.length, p, true)
     }
     fn min_radius(&self) -> f64 {
         if self.length.is_finite() {
@@ -229,38 +156,10 @@ impl Shape for Cylinder {
 
 impl Shape for Cuboid {
     fn distance(&self, p: &Vector3<f64>) -> f64 {
-        let q = p.abs() - self.half;
-        q.max().min(0.0) + q.map(|v| v.max(0.0)).norm()
+        primitives::cuboid_local_distance(&self.half, p)
     }
     fn query(&self, p: &Vector3<f64>) -> PointQuery {
-        let q = p.abs() - self.half;
-        let sign = p.map(|v| if v < 0.0 { -1.0 } else { 1.0 });
-        let out = q.map(|v| v.max(0.0));
-        let n_out = (0..3).filter(|&k| q[k] > 0.0).count();
-        if n_out == 0 {
-            // Inside: the nearest face.
-            let k = q.imax();
-            let mut n = Vector3::zeros();
-            n[k] = sign[k];
-            return flat(q[k], n);
-        }
-        let d = out.norm();
-        let n = sign.component_mul(&out) / d;
-        match n_out {
-            1 => flat(d, n),
-            2 => {
-                // Distance to an edge line along the axis that is inside.
-                let k = (0..3).find(|&k| q[k] <= 0.0).unwrap();
-                let mut l = Vector3::zeros();
-                l[k] = 1.0;
-                PointQuery {
-                    distance: d,
-                    normal: n,
-                    hessian: (Matrix3::identity() - n * n.transpose() - l * l.transpose()) / d,
-                }
-            }
-            _ => around_point(d, n),
-        }
+        primitives::cuboid_local(&self.half, p, true)
     }
     fn min_radius(&self) -> f64 {
         0.0
@@ -555,6 +454,21 @@ pub struct Contact {
     pub min_gap: f64,
     /// Samples inside the barrier (gap below d̂) in the last assembly.
     pub active: usize,
+    /// Edges (per obstacle: k · edges + e) whose broad phase uses exact signed distances (a
+    /// start inside the geometry being resolved: a point deeper inside a mesh than the
+    /// barrier's reach reads as far otherwise).
+    deep: Vec<bool>,
+}
+
+/// A node of the cable inside an obstacle deeper than the allowed penetration.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Penetration {
+    pub node: usize,
+    /// Index and name of the obstacle.
+    pub obstacle: usize,
+    pub name: String,
+    /// How far the cable surface is inside, m (> 0).
+    pub depth: f64,
 }
 
 /// Invalid contact settings.
@@ -637,6 +551,7 @@ impl Contact {
             })
             .collect();
         let n = rod.arc.len();
+        let n_obstacles = obstacles.len();
         Ok(Contact {
             obstacles,
             kappa,
@@ -651,6 +566,7 @@ impl Contact {
             body_force: vec![Vector3::zeros(); n_bodies],
             min_gap: f64::INFINITY,
             active: 0,
+            deep: vec![false; n_obstacles * n.saturating_sub(1)],
         })
     }
 
@@ -741,6 +657,60 @@ impl Contact {
         })
     }
 
+    /// While a start inside the geometry is resolved: the edges at a node of `x` inside an
+    /// obstacle (its centreline, exact signed distance) take the broad phase by exact distances
+    /// (slower on meshes, where the bounded query prunes the hierarchy); `None` clears.
+    pub fn mark_deep_edges(&mut self, x: Option<&[Vector3<f64>]>) {
+        self.deep.fill(false);
+        let Some(x) = x else { return };
+        let ne = x.len().saturating_sub(1);
+        for (k, o) in self.obstacles.iter().enumerate() {
+            for (n, p) in x.iter().enumerate() {
+                if o.distance(p) < 0.0 {
+                    if n > 0 {
+                        self.deep[k * ne + n - 1] = true;
+                    }
+                    if n < ne {
+                        self.deep[k * ne + n] = true;
+                    }
+                }
+            }
+        }
+    }
+
+    /// Where the cable surface (the capsules of its edges) lies deepest inside an obstacle, if
+    /// deeper than the documented tolerance (1 % of r): exact signed distances, the node
+    /// nearest the deepest point of the edge. Edges the bounded broad phase finds clear are
+    /// skipped unless marked deep (`mark_deep_edges`).
+    pub fn deepest_penetration(&self, st: &State) -> Option<Penetration> {
+        let r = self.opts.radius;
+        let mut worst: Option<Penetration> = None;
+        for (k, o) in self.obstacles.iter().enumerate() {
+            for e in 0..st.x.len().saturating_sub(1) {
+                let (a, b) = (st.x[e], st.x[e + 1]);
+                let mid = 0.5 * (a + b);
+                let half = 0.5 * (b - a).norm();
+                let deep = self.deep[k * (st.x.len() - 1) + e];
+                if o.distance_within(&mid, half + r) - half >= r
+                    && (!deep || o.distance(&mid) - half >= r)
+                {
+                    continue;
+                }
+                let q = o.segment_query(&a, &b);
+                let depth = r - q.distance;
+                if depth > 0.01 * r && worst.as_ref().is_none_or(|w| depth > w.depth) {
+                    worst = Some(Penetration {
+                        node: if q.t < 0.5 { e } else { e + 1 },
+                        obstacle: k,
+                        name: o.name.clone(),
+                        depth,
+                    });
+                }
+            }
+        }
+        worst
+    }
+
     /// Whether a free node of the state lies inside an obstacle (negative gap).
     pub fn penetrates(&self, rod: &Rod, st: &State) -> bool {
         self.obstacles.iter().any(|o| {
@@ -790,7 +760,11 @@ impl Contact {
         if far.is_finite() && (mid - o.position).norm() - half - far > reach {
             return;
         }
-        if o.distance_within(&mid, half + reach) - half >= reach {
+        let mut d_mid = o.distance_within(&mid, half + reach);
+        if self.deep[k * rod.n_edges() + e] && d_mid >= half + reach {
+            d_mid = o.distance(&mid); // deeper inside than the bound, or far
+        }
+        if d_mid - half >= reach {
             return;
         }
         let kk = self.samples[k];

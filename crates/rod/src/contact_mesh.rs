@@ -118,8 +118,8 @@ impl MeshShape {
     }
 }
 
-#[cfg(test)]
-pub(crate) fn box_mesh(half: Vector3<f64>) -> MeshShape {
+/// A box with half extents `half` about the origin as a closed 12-triangle mesh (tests).
+pub fn box_mesh(half: Vector3<f64>) -> MeshShape {
     let mut v = Vec::new();
     for k in 0..8 {
         v.push(Vector3::new(

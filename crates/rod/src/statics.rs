@@ -104,6 +104,14 @@ pub enum SolveError {
     SlidOff {
         clip: String,
     },
+    /// With contact: the equilibrium leaves the cable inside the geometry (a start deep
+    /// inside that the barrier could not push out, e.g. a clip inside a solid).
+    Penetration {
+        node: usize,
+        s: f64,
+        obstacle: String,
+        depth: f64,
+    },
 }
 
 impl fmt::Display for SolveError {
@@ -154,6 +162,19 @@ impl fmt::Display for SolveError {
             SolveError::SlidOff { clip } => write!(
                 f,
                 "the cable ran out of sliding clip '{clip}': its guide reaches beyond a cable end"
+            ),
+            SolveError::Penetration {
+                node,
+                s,
+                obstacle,
+                depth,
+            } => write!(
+                f,
+                "the cable stays inside the geometry '{obstacle}': node {node} (s = {s:.4} m), \
+                 its surface {:.2} mm deep; contact could not push it out (a clip inside the \
+                 solid, or a route through it that the clips hold): route the cable outside \
+                 the geometry",
+                depth * 1e3
             ),
         }
     }
@@ -476,16 +497,57 @@ impl Statics {
         self.has_prev = false; // a new sequence starts here
         self.check_held(rod, st)?;
         let mut pre = SolveStats::default();
-        if self.contact.as_ref().is_some_and(|c| c.penetrates(rod, st)) {
-            let contact = self.contact.take();
+        let inside = self.contact.as_ref().is_some_and(|c| c.penetrates(rod, st));
+        let start_state = st.clone();
+        if inside {
+            let mut contact = self.contact.take();
             let start = st.clone();
             match self.solve_any(rod, st) {
                 Ok(s) => pre = s,
                 Err(_) => st.clone_from(&start),
             }
+            // Deep inside a mesh the bounded broad phase sees nothing: exact distances there.
+            if let Some(c) = &mut contact {
+                c.mark_deep_edges(Some(&st.x));
+            }
             self.contact = contact;
         }
-        let mut stats = self.solve_any(rod, st)?;
+        // Never a silent wrong answer: a cable left inside the geometry, or a start inside it
+        // that the solver could not resolve, is an error naming where.
+        let inside_at = |s: &mut Self, st: &State| {
+            let c = s.contact.as_mut()?;
+            c.mark_deep_edges(Some(&st.x));
+            let p = c.deepest_penetration(st);
+            c.mark_deep_edges(None);
+            p.map(|p| SolveError::Penetration {
+                node: p.node,
+                s: rod.arc[p.node],
+                obstacle: p.name,
+                depth: p.depth,
+            })
+        };
+        let result = self.solve_any(rod, st);
+        if let Some(c) = &mut self.contact {
+            c.mark_deep_edges(None);
+        }
+        let mut stats = match result {
+            Ok(s) => s,
+            Err(SolveError::NotConverged { .. }) if inside => {
+                return Err(
+                    inside_at(self, &start_state).unwrap_or(SolveError::NotConverged {
+                        iterations: 0,
+                        residual: f64::NAN,
+                        load_factor: 0.0,
+                    }),
+                );
+            }
+            Err(e) => return Err(e),
+        };
+        if inside {
+            if let Some(e) = inside_at(self, st) {
+                return Err(e);
+            }
+        }
         stats.iterations += pre.iterations;
         self.ensure_stable(rod, st, &mut stats, 0.0)?;
         stats.snap = None; // leaving an unstable first solution is no jump of the cable
