@@ -5,7 +5,7 @@ use crate::assembly::{KinkAt, Workspace};
 use crate::contact::Contact;
 use crate::model::{NodeKind, Pose, Rod};
 use crate::rotation::slerp;
-use crate::stability::{free_rigid_motions, Inertia, StabilityCheck};
+use crate::stability::{free_rigid_motions, Inertia};
 use crate::state::State;
 use nalgebra::{Vector3, Vector6};
 use std::fmt;
@@ -178,8 +178,7 @@ pub struct Statics {
     prev: State,
     has_prev: bool,
     force_scale: f64,
-    /// Stability check (block LDLᵀ inertia) and the state before an escape.
-    pub stability: StabilityCheck,
+    /// The state before an escape from an unstable equilibrium.
     before: State,
     relax_start: State,
 }
@@ -209,7 +208,6 @@ impl Statics {
             prev: State::empty(),
             has_prev: false,
             force_scale: weight.max(loads).max(bend).max(1e-12),
-            stability: StabilityCheck::new(rod.n_edges() + 1),
             before: State::empty(),
             relax_start: State::empty(),
         }
@@ -547,7 +545,7 @@ impl Statics {
             self.assemble(rod, st, 1.0, true)
                 .map_err(|k| Self::kink_err(rod, k))?;
         }
-        Ok(self.stability.inertia(&self.ws.jac, 0..rod.arc.len()))
+        Ok(self.ws.jac.inertia(0..rod.arc.len()))
     }
 
     /// Checks the equilibrium `st` (just converged: the Jacobian is assembled there) for
@@ -655,7 +653,7 @@ impl Statics {
     /// matrix is positive definite). The workspace Jacobian is left as it was.
     fn unstable_mode(&mut self, rod: &Rod) -> bool {
         let nb = rod.arc.len();
-        if !self.stability.negative_direction(0..nb, &mut self.trial) {
+        if !self.ws.jac.negative_direction(0..nb, &mut self.trial) {
             return false;
         }
         let damping = |b: usize, k: usize| -> f64 {
@@ -702,7 +700,7 @@ impl Statics {
         let mut ok = false;
         for _ in 0..30 {
             shift(&mut self.ws.jac, mu);
-            let inertia = self.stability.inertia(&self.ws.jac, 0..nb);
+            let inertia = self.ws.jac.inertia(0..nb);
             if inertia.negative == 0 && inertia.zero == 0 && self.ws.jac.factor().is_ok() {
                 ok = true;
                 break;
@@ -734,7 +732,7 @@ impl Statics {
         for gap in [0.01, 0.1] {
             let mu = rho * (1.0 + gap);
             shift(&mut self.ws.jac, mu);
-            let inertia = self.stability.inertia(&self.ws.jac, 0..nb);
+            let inertia = self.ws.jac.inertia(0..nb);
             let pd = inertia.negative == 0 && inertia.zero == 0 && self.ws.jac.factor().is_ok();
             if pd {
                 iterate(&mut self.ws, &mut self.trial, 40);
@@ -837,7 +835,7 @@ impl Statics {
             let mut pd = false;
             for _ in 0..40 {
                 add_damping(&mut self.ws.jac, sigma);
-                let inertia = self.stability.inertia(&self.ws.jac, 0..nb);
+                let inertia = self.ws.jac.inertia(0..nb);
                 if inertia.negative == 0 && inertia.zero == 0 && self.ws.factor(rod).is_ok() {
                     pd = true;
                     break;
@@ -906,7 +904,7 @@ impl Statics {
                 self.base.clone_from(st);
                 if let Ok(s) = self.newton(rod, st, 1.0, false) {
                     stats.iterations += s.iterations;
-                    if self.stability.inertia(&self.ws.jac, 0..nb).negative == 0 {
+                    if self.ws.jac.inertia(0..nb).negative == 0 {
                         stats.residual = s.residual;
                         return Ok(stats);
                     }
