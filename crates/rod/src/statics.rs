@@ -162,6 +162,14 @@ const SNAP_DEPTH: usize = 6;
 /// 2⁻⁶ of a step is reported as a snap-through.
 const SNAP_JUMP: f64 = 0.01;
 
+/// Relative round-off of the potential energy (to |elastic| + |load potential|) within which a
+/// descent step that does not pass Armijo may still be accepted by the monotonicity test.
+const ENERGY_ROUND_OFF: f64 = 1e-10;
+
+/// The damping σ of the energy descent (relative to the stiffest diagonal entry per damping)
+/// below which its steps count as Newton steps for convergence (see `descend`).
+const NEUTRAL_SIGMA: f64 = 1e-9;
+
 /// A static/quasistatic solver for one cable: the workspace and options.
 pub struct Statics {
     pub ws: Workspace,
@@ -181,6 +189,8 @@ pub struct Statics {
     /// The state before an escape from an unstable equilibrium.
     before: State,
     relax_start: State,
+    /// The descent's state before a Newton shortcut.
+    shortcut_start: State,
 }
 
 impl Statics {
@@ -210,6 +220,7 @@ impl Statics {
             force_scale: weight.max(loads).max(bend).max(1e-12),
             before: State::empty(),
             relax_start: State::empty(),
+            shortcut_start: State::empty(),
         }
     }
 
@@ -868,12 +879,19 @@ impl Statics {
                 if self.assemble(rod, st, 1.0, false).is_ok() {
                     let e = self.ws.elastic_energy + self.ws.load_potential;
                     let armijo = conservative && e <= energy + 1e-4 * alpha * slope;
+                    // The monotonicity test stands in for Armijo only where the energy change
+                    // is round-off: it must not let the iteration climb back to the saddle it
+                    // left (measured: a round column returned to its straight state, 1.3e-4
+                    // higher, in 8 of 12 cases).
+                    let round_off = ENERGY_ROUND_OFF
+                        * (self.ws.elastic_energy.abs() + self.ws.load_potential.abs());
+                    let level = !conservative || e <= energy + round_off;
                     for (d, r) in self.trial.iter_mut().zip(&self.ws.rhs) {
                         *d = -r;
                     }
                     self.ws.jac.solve_factored(&mut self.trial);
                     let theta = scaled_norm(&self.trial, l) / norm0.max(1e-300);
-                    if e.is_finite() && (armijo || theta <= 1.0 - 0.25 * alpha) {
+                    if e.is_finite() && (armijo || (level && theta <= 1.0 - 0.25 * alpha)) {
                         energy = e;
                         accepted = true;
                         break;
@@ -894,14 +912,21 @@ impl Statics {
             if std::env::var_os("ROD_DEBUG").is_some() {
                 eprintln!("descend {it} sigma {sigma:.3e} alpha {alpha:.3e} E {energy:.9e} rinf {rinf:.3e}");
             }
-            if sigma == 0.0 && alpha == 1.0 && step < self.opts.step_tolerance {
+            // Converged: a full step below the step tolerance with σ zero — or negligible
+            // (≤ 1e-9 of the stiffest entry's), where the equilibrium is neutral: a round
+            // section's buckled shape turns freely about the load line, the tangent is
+            // singular there and only J + σD with σ > 0 is positive definite (measured: the
+            // residual's round-off floor, ~3e-8 of the force scale, lies above its tolerance).
+            if sigma <= NEUTRAL_SIGMA * sigma_ref && alpha == 1.0 && step < self.opts.step_tolerance
+            {
                 stats.residual = rinf;
                 return Ok(stats);
             }
             if newton_shortcut && sigma == 0.0 && it >= next_newton {
                 // Positive definite: Newton from here, which does not creep along a nearly
                 // neutral direction as the backtracking does; kept if it ends stable.
-                self.base.clone_from(st);
+                // (Not in `base`: `newton` uses it for its own steps.)
+                self.shortcut_start.clone_from(st);
                 if let Ok(s) = self.newton(rod, st, 1.0, false) {
                     stats.iterations += s.iterations;
                     if self.ws.jac.inertia(0..nb).negative == 0 {
@@ -910,7 +935,7 @@ impl Statics {
                     }
                 }
                 next_newton = it + 10;
-                st.clone_from(&self.base);
+                st.clone_from(&self.shortcut_start);
                 self.assemble(rod, st, 1.0, true)
                     .map_err(|k| Self::kink_err(rod, k))?;
             }

@@ -158,6 +158,29 @@ fn the_buckled_column_converges_to_the_elastica_at_second_order() {
     assert!(errs[3] < 1e-3, "{errs:?}");
 }
 
+#[test]
+fn a_round_column_escapes_to_the_buckled_elastica_at_second_order() {
+    // EI₁ = EI₂, no imperfection: two equal negative eigenvalues at the straight state, and
+    // the buckled state can turn its plane about the load line freely (a neutral equilibrium:
+    // its tangent is singular). Before the fix the escape returned to the straight state
+    // (N = 40) or crept (400–800 descent steps). Imperfect round columns: docs/solver.md.
+    let p = 1.5 * euler_load(1.0);
+    for imperfection in [0.0] {
+        let errs: Vec<f64> = [10, 20, 40, 80]
+            .iter()
+            .map(|&n| elastica_error(n, p, 1.0, imperfection))
+            .collect();
+        for w in errs.windows(2) {
+            let order = (w[0] / w[1]).log2();
+            assert!(
+                (1.8..2.2).contains(&order),
+                "imperfection {imperfection}: order {order}: {errs:?}"
+            );
+        }
+        assert!(errs[3] < 1e-3, "{errs:?}");
+    }
+}
+
 /// A straight cable of length 1 along x between fixed point clips at x = 0 and x = `d`.
 fn between_clips(d: f64, sec: Section, kinds: [ClipKind; 2]) -> CableSpec {
     CableSpec {
