@@ -935,9 +935,21 @@ impl Statics {
                     }
                 }
                 next_newton = it + 10;
-                st.clone_from(&self.shortcut_start);
+                // Where Newton went (an unstable equilibrium, or where it stopped) is kept if
+                // it is lower in energy: descent from there; otherwise back to the start (a
+                // Newton run back up to the saddle left the descent there).
+                let lower = self.assemble(rod, st, 1.0, false).is_ok() && {
+                    let e = self.ws.elastic_energy + self.ws.load_potential;
+                    e.is_finite() && e < energy
+                };
+                if lower {
+                    energy = self.ws.elastic_energy + self.ws.load_potential;
+                } else {
+                    st.clone_from(&self.shortcut_start);
+                }
                 self.assemble(rod, st, 1.0, true)
                     .map_err(|k| Self::kink_err(rod, k))?;
+                (_, rinf) = self.ws.residual_norms(h);
             }
             sigma = if sigma <= floor { 0.0 } else { 0.1 * sigma };
         }
