@@ -114,3 +114,13 @@ def test_a_segment_ratio_of_1e5_is_scaled_away():
     ds = np.diff(core.arc_length)
     assert ds.max() / ds.min() > 1e4
     assert core.condition()[0] < 1e-2 * CONDITION_WARNING
+
+
+def test_a_singular_tangent_is_left_to_the_solve_error():
+    # one ball clip leaves the cable free to turn: singular, which the solve names (a rigid-body
+    # motion), not an ill-conditioning warning
+    d = hose()
+    d["cables"][0]["clips"] = [{**d["cables"][0]["clips"][0], "type": "ball"}]
+    cond, msgs = conditioning(d)
+    assert not np.isfinite(cond)
+    assert msgs == []

@@ -150,8 +150,10 @@ def report(messages: list[str], category: type[Warning]) -> None:
 def conditioning_message(name: str, props, arc_length: np.ndarray, condition: float) -> str | None:
     """The warning for an ill-conditioned tangent (estimated ``condition`` of the Jacobi-scaled
     tangent stiffness, ``_core.Cable.condition``), with the causes found in the section ``props``
-    and the mesh, or None below ``CONDITION_WARNING``."""
-    if condition < CONDITION_WARNING:
+    and the mesh, or None below ``CONDITION_WARNING`` — and for a singular tangent (infinite
+    estimate): a free rigid-body motion or a zero stiffness is an error of the solve, which
+    names it."""
+    if condition < CONDITION_WARNING or not np.isfinite(condition):
         return None
     causes = []
     ea = props.EA
@@ -175,9 +177,9 @@ def conditioning_message(name: str, props, arc_length: np.ndarray, condition: fl
             f"{ds.size} segments: a slender, finely meshed cable (the condition grows with the "
             "ratio of shear to bending stiffness at the segment scale, GA·Δs²/EI, and with N)"
         )
-    cond = "singular" if not np.isfinite(condition) else f"≈ {condition:.2g}"
     return (
-        f"cable '{name}': the tangent stiffness is ill-conditioned (estimated condition {cond}, "
+        f"cable '{name}': the tangent stiffness is ill-conditioned (estimated condition "
+        f"≈ {condition:.2g}, "
         f"above {CONDITION_WARNING:.0e}): {'; '.join(causes)}. Round-off then reaches "
         "~1e-5 of the soft (bending) response and the stability verdict may be wrong"
     )
