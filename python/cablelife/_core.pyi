@@ -25,6 +25,13 @@ class Cable:
     ) -> None: ...
     @property
     def arc_length(self) -> Any: ...
+    def condition(self) -> Any:
+        """Condition estimate of the tangent stiffness (Jacobi-scaled, `rod::conditioning`) about
+        the state of the last run, or about the initial routing (reference clip poses) before
+        any run. Returns (condition, λ_max, |λ|_min) of the scaled matrix; infinite condition
+        for a singular one.
+        """
+        ...
     def linearize(self) -> Any:
         """Linearisation about the state of the last run (a static equilibrium): the tangent
         stiffness K (n × n, dense, active unknowns only), the diagonal mass (n,), and for each

@@ -242,7 +242,20 @@ def build_cable(scene: Scene, cable: Cable) -> _core.Cable:
             f"the cable into {used} intervals that need one segment each; allowed: segments "
             f">= {used} (or max_segment_length)"
         )
+    _check_conditioning(cable, props, core)
     return core
+
+
+def _check_conditioning(cable: Cable, props, core: _core.Cable) -> None:
+    """Warns when the tangent stiffness at the initial routing is ill-conditioned."""
+    from cablelife import validity
+
+    try:
+        condition = core.condition()[0]
+    except ValueError:
+        return  # a kinked routing: the solve reports it
+    msg = validity.conditioning_message(cable.name, props, core.arc_length, condition)
+    validity.report([msg] if msg else [], validity.ConditioningWarning)
 
 
 def output_every(scene: Scene) -> int:

@@ -946,6 +946,25 @@ impl Cable {
         Ok(d)
     }
 
+    /// Condition estimate of the tangent stiffness (Jacobi-scaled, `rod::conditioning`) about
+    /// the state of the last run, or about the initial routing (reference clip poses) before
+    /// any run. Returns (condition, λ_max, |λ|_min) of the scaled matrix; infinite condition
+    /// for a singular one.
+    fn condition(&self) -> PyResult<(f64, f64, f64)> {
+        let routed;
+        let st = match &self.state {
+            Some(st) => st,
+            None => {
+                routed = route(&self.rod, None).map_err(|e| PyValueError::new_err(e.0))?;
+                &routed
+            }
+        };
+        let k = rod::modal::tangent_stiffness(&self.rod, st)
+            .map_err(|e| PyValueError::new_err(e.to_string()))?;
+        let c = rod::conditioning::condition_estimate(&k);
+        Ok((c.condition, c.lambda_max, c.lambda_min))
+    }
+
     /// Linearisation about the state of the last run (a static equilibrium): the tangent
     /// stiffness K (n × n, dense, active unknowns only), the diagonal mass (n,), and for each
     /// unknown its (block, slot); slots 0–2 node displacement, 3–5 edge rotation (body frame).

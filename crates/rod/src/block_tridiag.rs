@@ -1,7 +1,7 @@
 //! Block-tridiagonal matrices with 6×6 blocks and their O(N) solve (block Thomas algorithm; the
 //! pivot blocks are LU-factored in place with partial pivoting). Storage is allocated once;
 //! factor and solve do not allocate.
-use nalgebra::{Matrix3, Matrix6, Vector6};
+use nalgebra::{Matrix3, Matrix6, SymmetricEigen, Vector6};
 use std::ops::Range;
 
 pub type Block = Matrix6<f64>;
@@ -22,7 +22,21 @@ pub struct BlockTridiag {
     /// D'_n⁻¹ L_n: the forward substitution y_n = D'_n⁻¹ r_n − (D'_n⁻¹ L_n) y_{n−1} has one
     /// matrix–vector product on its dependency chain.
     inv_lower: Vec<Block>,
+    /// The block and eigenvector of the most negative pivot eigenvalue of the last `ldlt`.
+    negative_pivot: Option<(usize, Vector6<f64>)>,
 }
+
+/// Inertia of a symmetric matrix (the counts of its eigenvalue signs); `zero` counts pivots
+/// below the round-off of their block (`ZERO_PIVOT`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Inertia {
+    pub negative: usize,
+    pub zero: usize,
+}
+
+/// Relative size (to the largest diagonal entry of its block before the elimination) below
+/// which an eigenvalue of a pivot block counts as zero.
+pub const ZERO_PIVOT: f64 = 1e-11;
 
 /// A pivot block of the elimination is singular: the system has a free (zero-stiffness) mode.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -39,6 +53,7 @@ impl BlockTridiag {
             inv: vec![Block::zeros(); n_blocks],
             elim: vec![Block::zeros(); n_blocks],
             inv_lower: vec![Block::zeros(); n_blocks],
+            negative_pivot: None,
         }
     }
 
@@ -127,43 +142,109 @@ impl BlockTridiag {
         Ok(())
     }
 
-    /// Symmetric block LDLᵀ factorisation of the blocks `r` and its inertia: the number of
-    /// negative eigenvalues of the (symmetric) matrix of these blocks. The matrix must be
-    /// symmetric (`lower[b] = upper[b−1]ᵀ`, `diag[b]` symmetric; only `diag` and `upper` are
-    /// read for the pivots' symmetry). The pivot blocks D'_b = D_b − L_b D'_{b−1}⁻¹ U_{b−1} are
-    /// those of `factor_range`, and by Sylvester's law of inertia (A = L D Lᵀ with D block
-    /// diagonal) the inertia of A is the sum of the inertias of the pivots, read from their
-    /// symmetric eigenvalues. Afterwards `solve_range` solves with this factorisation. With
-    /// A = K − σM this is the Sturm count: the number of eigenvalues of K φ = λ M φ below σ.
-    /// A pivot eigenvalue below 1e-14 of the pivot's largest is `Singular` (σ on or next to an
-    /// eigenvalue: shift it).
-    pub fn inertia(&mut self, r: Range<usize>) -> Result<usize, Singular> {
-        let mut negative = 0;
+    /// Symmetric block LDLᵀ factorisation of the symmetric part ½(J + Jᵀ) of the blocks `r`
+    /// and its inertia — the one inertia code of the crate (stability of an equilibrium, Sturm
+    /// counts of the modal solver; a tree solver counts the negative pivots of its own
+    /// elimination the same way, with `pivot_inertia`).
+    ///
+    /// H = L D Lᵀ with D = diag(S_b), S_b = H_bb − H_b,b−1 S_{b−1}⁻¹ H_b−1,b, and by
+    /// Sylvester's law of inertia inertia(H) = Σ inertia(S_b). With H = K − σM it is the Sturm
+    /// count: the number of eigenvalues of K φ = λ M φ below σ. A pivot block is first
+    /// Cholesky-factored (hand-written 6×6 kernel: the hot path of the stability check); only
+    /// if that fails are its eigenvalues computed. A pivot eigenvalue below `ZERO_PIVOT` of the
+    /// largest diagonal entry of its block before the elimination counts as zero (and its
+    /// direction is dropped: pseudo-inverse). Afterwards `solve_range` solves with the
+    /// symmetric part (meaningful when `zero` is 0), and `negative_direction` gives a direction
+    /// of negative curvature. The matrix blocks are read, not changed. No allocation.
+    pub fn ldlt(&mut self, r: Range<usize>) -> Inertia {
+        self.symmetric_factor(r, true)
+    }
+
+    /// The inertia of `ldlt` without keeping what `solve_range` needs (the pivot inverses):
+    /// the stability check, 1.6× cheaper (`examples/bench_assembly`). `negative_direction`
+    /// works after it; a solve needs `ldlt` or `factor_range`.
+    pub fn inertia(&mut self, r: Range<usize>) -> Inertia {
+        self.symmetric_factor(r, false)
+    }
+
+    fn symmetric_factor(&mut self, r: Range<usize>, for_solve: bool) -> Inertia {
+        let mut out = Inertia::default();
+        self.negative_pivot = None;
+        let mut worst = 0.0f64;
+        // H_{b−1,b} (symmetric part) of the previous block: H_{b,b−1} is its transpose.
+        let mut prev_upper = Block::zeros();
         for b in r.clone() {
-            let mut d = self.diag[b];
+            let d = &self.diag[b];
+            let mut s = 0.5 * (d + d.transpose());
+            // Scales before the Schur update: the size of its round-off, per slot and per block
+            // (units differ between slots: positions and rotations).
+            let tiny = s.diagonal().map(|v| ZERO_PIVOT * v.abs());
+            let scale = s.diagonal().amax().max(1e-300);
             if b > r.start {
-                d -= self.lower[b] * self.elim[b - 1];
+                s -= prev_upper.transpose() * self.elim[b - 1];
+                s = 0.5 * (s + s.transpose());
             }
-            let d = 0.5 * (d + d.transpose());
-            let eig = d.symmetric_eigen();
-            let top = eig.eigenvalues.amax();
-            if !(top.is_finite() && top > 0.0)
-                || eig.eigenvalues.iter().any(|mu| mu.abs() <= 1e-14 * top)
-            {
-                return Err(Singular { block: b });
+            let upper = if b + 1 < r.end {
+                0.5 * (self.upper[b] + self.lower[b + 1].transpose())
+            } else {
+                Block::zeros()
+            };
+            let mut l = s;
+            let inv = if cholesky_in_place(&mut l, &tiny) {
+                // S⁻¹H_{b,b+1} by substitution, not by the product with S⁻¹: the Schur
+                // complements of a stiff rod cancel to the soft eigenvalues (1e-10 of their
+                // block), and the product's round-off, ε·cond(S) larger, would hide them.
+                if b + 1 < r.end {
+                    self.elim[b] = upper;
+                    cholesky_solve(&l, &mut self.elim[b]);
+                }
+                if !for_solve {
+                    prev_upper = upper;
+                    continue;
+                }
+                let mut inv = Block::identity();
+                cholesky_solve(&l, &mut inv);
+                inv
+            } else {
+                let (inv, pivot) = pivot_inertia(&s, scale, &mut out);
+                if let Some((lam, v)) = pivot {
+                    if -lam / scale > worst {
+                        worst = -lam / scale;
+                        self.negative_pivot = Some((b, v));
+                    }
+                }
+                if b + 1 < r.end {
+                    self.elim[b] = inv * upper;
+                }
+                inv
+            };
+            if for_solve {
+                self.inv[b] = inv;
+                if b > r.start {
+                    self.inv_lower[b] = inv * prev_upper.transpose();
+                }
             }
-            negative += eig.eigenvalues.iter().filter(|&&mu| mu < 0.0).count();
-            let v = &eig.eigenvectors;
-            let inv = v * Block::from_diagonal(&eig.eigenvalues.map(|mu| 1.0 / mu)) * v.transpose();
-            self.inv[b] = inv;
-            if b > r.start {
-                self.inv_lower[b] = inv * self.lower[b];
-            }
-            if b + 1 < r.end {
-                self.elim[b] = inv * self.upper[b];
-            }
+            prev_upper = upper;
         }
-        Ok(negative)
+        out
+    }
+
+    /// A direction z of negative curvature (zᵀHz < 0) from the last `ldlt` over `r`, in the
+    /// block layout of the unknowns: Lᵀz = e_n v with v the eigenvector of the most negative
+    /// pivot eigenvalue (relative to its block), so zᵀHz = vᵀS_n v < 0. Returns false (and
+    /// leaves `z` alone) if there was none.
+    pub fn negative_direction(&self, r: Range<usize>, z: &mut [Vector6<f64>]) -> bool {
+        let Some((n, v)) = self.negative_pivot else {
+            return false;
+        };
+        for b in r.clone() {
+            z[b].fill(0.0);
+        }
+        z[n] = v;
+        for b in (r.start..n).rev() {
+            z[b] = -(self.elim[b] * z[b + 1]);
+        }
+        true
     }
 
     /// Solves J x = rhs in place with the current factorisation.
@@ -292,6 +373,86 @@ fn lu_solve_matrix(lu: &Block, piv: &[u8; 6], inv: &[f64; 6], x: &mut Block) {
     }
 }
 
+/// Inertia of one symmetric pivot block `s` of a block elimination, added to `out`, from its
+/// eigenvalues (an eigenvalue within `ZERO_PIVOT · scale` of zero counts as zero); returns the
+/// pseudo-inverse of `s` (zero directions dropped: they couple nothing onward) and the most
+/// negative eigenvalue with its eigenvector, if any. For a block LDLᵀ of any structure (a
+/// chain here, a tree elsewhere): the inertia of the matrix is the sum over its pivots.
+pub fn pivot_inertia(
+    s: &Block,
+    scale: f64,
+    out: &mut Inertia,
+) -> (Block, Option<(f64, Vector6<f64>)>) {
+    let eig = SymmetricEigen::new(*s);
+    let mut inv = Block::zeros();
+    let mut most_negative: Option<(f64, Vector6<f64>)> = None;
+    for k in 0..6 {
+        let lam = eig.eigenvalues[k];
+        let v = eig.eigenvectors.column(k);
+        if lam.is_nan() || lam.abs() <= ZERO_PIVOT * scale {
+            out.zero += 1;
+            continue;
+        }
+        if lam < 0.0 {
+            out.negative += 1;
+            if most_negative.is_none_or(|(l, _)| lam < l) {
+                most_negative = Some((lam, v.into_owned()));
+            }
+        }
+        inv += v * v.transpose() / lam;
+    }
+    (inv, most_negative)
+}
+
+/// Cholesky factor L (lower triangle, in place) of a symmetric 6×6 block; false if the pivot of
+/// slot j is not above `tiny[j]` (not positive definite, or nearly singular). Hand-written: it
+/// is the hot path of the stability check (nalgebra's generic Cholesky and solve cost 2× more
+/// here).
+#[inline]
+fn cholesky_in_place(a: &mut Block, tiny: &Vector6<f64>) -> bool {
+    for j in 0..6 {
+        let mut d = a[(j, j)];
+        for k in 0..j {
+            d -= a[(j, k)] * a[(j, k)];
+        }
+        if d.is_nan() || d <= tiny[j] {
+            return false;
+        }
+        let d = d.sqrt();
+        a[(j, j)] = d;
+        let inv = 1.0 / d;
+        for i in j + 1..6 {
+            let mut v = a[(i, j)];
+            for k in 0..j {
+                v -= a[(i, k)] * a[(j, k)];
+            }
+            a[(i, j)] = v * inv;
+        }
+    }
+    true
+}
+
+/// X ← (L Lᵀ)⁻¹ X with the factor of `cholesky_in_place`.
+#[inline]
+fn cholesky_solve(l: &Block, x: &mut Block) {
+    for c in 0..6 {
+        for i in 0..6 {
+            let mut v = x[(i, c)];
+            for k in 0..i {
+                v -= l[(i, k)] * x[(k, c)];
+            }
+            x[(i, c)] = v / l[(i, i)];
+        }
+        for i in (0..6).rev() {
+            let mut v = x[(i, c)];
+            for k in i + 1..6 {
+                v -= l[(k, i)] * x[(k, c)];
+            }
+            x[(i, c)] = v / l[(i, i)];
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -326,7 +487,14 @@ mod tests {
                 a.diag[b] -= Block::identity() * sigma;
             }
             let expected = eig.iter().filter(|&&l| l < sigma).count();
-            assert_eq!(a.inertia(0..n).unwrap(), expected, "σ = {sigma}");
+            assert_eq!(
+                a.ldlt(0..n),
+                Inertia {
+                    negative: expected,
+                    zero: 0
+                },
+                "σ = {sigma}"
+            );
             // and the factorisation solves
             let x: Vec<Vector6<f64>> = (0..n)
                 .map(|b| Vector6::from_fn(|k, _| (b * 6 + k) as f64))
@@ -341,11 +509,17 @@ mod tests {
                 );
             }
         }
-        // σ on an eigenvalue of a pivot: singular
+        // σ on an eigenvalue of a pivot: a zero pivot
         let mut a = BlockTridiag::new(1);
         a.diag[0] = Block::identity();
         a.diag[0][(2, 2)] = 0.0;
-        assert_eq!(a.inertia(0..1), Err(Singular { block: 0 }));
+        assert_eq!(
+            a.ldlt(0..1),
+            Inertia {
+                negative: 0,
+                zero: 1
+            }
+        );
     }
 
     #[test]
@@ -382,6 +556,68 @@ mod tests {
         j.solve_range(0..3, &mut rhs);
         for b in 0..n {
             assert!((rhs[b] - x[b]).norm() < 1e-12);
+        }
+    }
+
+    fn rnd(seed: &mut u64) -> f64 {
+        *seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((*seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
+    }
+
+    /// A symmetric block-tridiagonal matrix with a prescribed spectrum shift: its inertia by
+    /// the block LDLᵀ equals the count of negative eigenvalues of the dense matrix.
+    #[test]
+    fn ldlt_inertia_matches_the_dense_eigenvalues_of_the_symmetric_part() {
+        let n = 9;
+        let mut seed = 7u64;
+        for shift in [-3.0, -1.0, 0.0, 0.5, 1.5, 4.0] {
+            let mut j = BlockTridiag::new(n);
+            for b in 0..n {
+                let a = Block::from_fn(|_, _| rnd(&mut seed));
+                j.diag[b] = a + a.transpose() + Block::identity() * shift;
+                if b + 1 < n {
+                    let u = Block::from_fn(|_, _| rnd(&mut seed));
+                    j.upper[b] = u;
+                    j.lower[b + 1] = u.transpose();
+                }
+            }
+            // A skew part (like ½[g]×) must not change the answer.
+            let k = Block::from_fn(|_, _| rnd(&mut seed));
+            j.diag[3] += k - k.transpose();
+            let mut dense = nalgebra::DMatrix::<f64>::zeros(6 * n, 6 * n);
+            for b in 0..n {
+                let d = 0.5 * (j.diag[b] + j.diag[b].transpose());
+                dense.view_mut((6 * b, 6 * b), (6, 6)).copy_from(&d);
+                if b + 1 < n {
+                    dense
+                        .view_mut((6 * b, 6 * b + 6), (6, 6))
+                        .copy_from(&j.upper[b]);
+                    dense
+                        .view_mut((6 * b + 6, 6 * b), (6, 6))
+                        .copy_from(&j.lower[b + 1]);
+                }
+            }
+            let expected = dense
+                .clone()
+                .symmetric_eigenvalues()
+                .iter()
+                .filter(|&&l| l < 0.0)
+                .count();
+            let inertia = j.ldlt(0..n);
+            assert_eq!(j.inertia(0..n), inertia, "the same factorisation");
+            assert_eq!(inertia.negative, expected, "shift {shift}");
+            assert_eq!(inertia.zero, 0);
+            let mut z = vec![Vector6::zeros(); n];
+            assert_eq!(j.negative_direction(0..n, &mut z), expected > 0);
+            if expected > 0 {
+                let zv = nalgebra::DVector::from_iterator(
+                    6 * n,
+                    z.iter().flat_map(|v| v.iter().copied()),
+                );
+                assert!((zv.transpose() * &dense * &zv)[0] < 0.0);
+            }
         }
     }
 }

@@ -4,6 +4,7 @@
 pub mod assembly;
 pub mod bending;
 pub mod block_tridiag;
+pub mod conditioning;
 pub mod contact;
 pub mod contact_mesh;
 pub mod dynamics;

@@ -14,7 +14,7 @@
 //! exactly, and rotations with a tiny rotary inertia are treated alike (their inertia only
 //! weights the M inner product). Multiple eigenvalues (the two bending planes of a round
 //! section) are found together by the block of vectors. Completeness is proved by the Sturm
-//! count: the number of negative pivots of K − μM (`BlockTridiag::inertia`) is the number of
+//! count: the number of negative pivots of K − μM (`BlockTridiag::ldlt`) is the number of
 //! eigenvalues below μ; a cut above the last returned mode must count exactly the modes
 //! found, otherwise the subspace is enlarged and the iteration repeated.
 //!
@@ -22,7 +22,7 @@
 //! equilibrium). A negative eigenvalue smaller in magnitude than 1e-8 of the largest returned
 //! eigenvalue is round-off of a zero mode (a free rigid motion), not an instability.
 use crate::assembly::Workspace;
-use crate::block_tridiag::{Block, BlockTridiag, Singular};
+use crate::block_tridiag::{Block, BlockTridiag};
 use crate::model::{EdgeKind, NodeKind, Rod};
 use crate::rotation::rotation_matrix;
 use crate::sliding::SlidingClips;
@@ -178,15 +178,17 @@ impl Pencil {
         self.m.len()
     }
 
-    /// Factors K − σM; returns its inertia (the number of eigenvalues below σ).
-    fn factor(&mut self, sigma: f64) -> Result<usize, Singular> {
+    /// Factors K − σM; returns its inertia (the number of eigenvalues below σ), or None if a
+    /// pivot is zero (σ on or next to an eigenvalue).
+    fn factor(&mut self, sigma: f64) -> Option<usize> {
         let n = self.n();
         for b in 0..n {
             self.work.diag[b] = self.k.diag[b] - Block::from_diagonal(&(self.m[b] * sigma));
             self.work.lower[b] = self.k.lower[b];
             self.work.upper[b] = self.k.upper[b];
         }
-        self.work.inertia(0..n)
+        let inertia = self.work.ldlt(0..n);
+        (inertia.zero == 0).then_some(inertia.negative)
     }
 
     /// Factors K − σM, moving σ down by `step`, 2 `step`, 4 `step` … off an eigenvalue if it
@@ -194,7 +196,7 @@ impl Pencil {
     fn factor_near(&mut self, sigma: f64, step: f64) -> (f64, usize) {
         let mut s = sigma;
         for k in 0..60 {
-            if let Ok(nu) = self.factor(s) {
+            if let Some(nu) = self.factor(s) {
                 return (s, nu);
             }
             s = sigma - step * 2f64.powi(k);
