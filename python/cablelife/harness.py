@@ -56,6 +56,13 @@ def check_junctions(scene: Scene) -> None:
                     )
     held = {cable for cable, _ in used}
     for i, c in enumerate(scene.cables):
+        sliding = [clip.name for clip in c.clips if clip.type == "sliding"]
+        if c.name in held and sliding:
+            _fail(
+                f"cables[{i}] ('{c.name}'): sliding clip '{sliding[0]}' on a cable of a harness "
+                "is not supported yet; use a fixed, swivel or hinge clip there"
+            )
+    for i, c in enumerate(scene.cables):
         if not c.clips and c.name not in held:
             _fail(
                 f"cables[{i}] ('{c.name}') has no clips and no junction joins it; give at "

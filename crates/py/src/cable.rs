@@ -153,7 +153,7 @@ impl Record {
     }
 
     /// The slid length of every clip at the step just pushed.
-    fn push_sliding(&mut self, rod: &Rod, sliding: Option<&SlidingClips>) {
+    pub(crate) fn push_sliding(&mut self, rod: &Rod, sliding: Option<&SlidingClips>) {
         let start = self.slid_length.len();
         self.slid_length
             .extend(std::iter::repeat_n(0.0, rod.spec.clips.len()));
@@ -710,6 +710,7 @@ impl Cable {
                     Ok(()) => {
                         let mut rec = Record::with_capacity(1, rod);
                         rec.push(rod, &st, &solver.ws, &stats);
+                        rec.push_sliding(rod, solver.sliding.as_ref());
                         if let Some(c) = &solver.contact {
                             rec.push_contact(c);
                         }

@@ -180,6 +180,8 @@ impl Harness {
                 }
                 for (c, rod) in tree.cables.iter().enumerate() {
                     out.records[c].push(rod, &st.cables[c], &solver.ws[c], &stats);
+                    // sliding clips are refused on harness cables (harness.py)
+                    out.records[c].push_sliding(rod, None);
                 }
                 for pose in &st.junctions {
                     out.jpos.extend_from_slice(pose.position.as_slice());
