@@ -8,7 +8,7 @@
 //! point is.
 use std::fmt;
 
-use crate::closest::{point_segment, point_triangle, segment_triangle, Feature};
+use crate::closest::{point_triangle, segment_triangle, Feature};
 use crate::{PointProjection, SegmentProjection, Surface, V3};
 
 const LEAF_SIZE: usize = 4;
@@ -34,6 +34,10 @@ struct Node {
     axis: V3,
     lo: f64,
     hi: f64,
+    /// With a slab: a ball (center, radius) holding the node's triangles (radius infinite
+    /// without a slab). Slab and ball together bound the distance like a thin disk.
+    center: V3,
+    radius: f64,
     /// Leaf: first triangle; inner node: index of the right child (the left one follows).
     index: u32,
     /// Leaf: number of triangles (> 0); inner node: 0.
@@ -41,6 +45,10 @@ struct Node {
 }
 
 impl Node {
+    /// Lower bound of the squared distance of p: the box's, and with a slab
+    /// h² + (|w| − radius)₊², h the gap to the slab and w the offset of p from the center
+    /// across the axis (every z of the node has axis·z in the slab and |z − center| ≤ radius,
+    /// so its offset across the axis is at most the radius too).
     #[inline]
     fn distance2_point(&self, p: &V3) -> f64 {
         let mut d2 = 0.0;
@@ -48,29 +56,121 @@ impl Node {
             let e = (self.min[k] - p[k]).max(p[k] - self.max[k]).max(0.0);
             d2 += e * e;
         }
-        let x = self.axis.dot(p);
-        let e = (self.lo - x).max(x - self.hi).max(0.0);
-        d2.max(e * e)
-    }
-
-    /// Lower bound of the squared distance of segment [a, b] (with box lo..hi).
-    #[inline]
-    fn distance2_segment(&self, a: &V3, b: &V3, lo: &V3, hi: &V3) -> f64 {
-        let d2 = self.distance2_box(lo, hi);
-        let (xa, xb) = (self.axis.dot(a), self.axis.dot(b));
-        let e = (self.lo - xa.max(xb)).max(xa.min(xb) - self.hi).max(0.0);
-        d2.max(e * e)
-    }
-
-    #[inline]
-    fn distance2_box(&self, lo: &V3, hi: &V3) -> f64 {
-        let mut d2 = 0.0;
-        for k in 0..3 {
-            let e = (self.min[k] - hi[k]).max(lo[k] - self.max[k]).max(0.0);
-            d2 += e * e;
+        if self.radius.is_finite() {
+            let x = self.axis.dot(p);
+            let h = (self.lo - x).max(x - self.hi).max(0.0);
+            let v = p - self.center;
+            let w = v - self.axis * self.axis.dot(&v);
+            let lat = (w.norm() - self.radius).max(0.0);
+            d2 = d2.max((h * h + lat * lat) * (1.0 - 1e-10));
         }
         d2
     }
+
+    /// Whether segment [a, b] (with box lo..hi, midpoint mid, half length half) is farther
+    /// than sqrt(best_d2) from the node: by the boxes, by the box and the ball about mid,
+    /// and with a slab by [`disk_excludes`] (slab and ball).
+    #[inline]
+    #[allow(clippy::too_many_arguments)]
+    fn excludes_segment(
+        &self,
+        a: &V3,
+        b: &V3,
+        lo: &V3,
+        hi: &V3,
+        mid: &V3,
+        half: f64,
+        best_d2: f64,
+    ) -> bool {
+        let mut d2 = 0.0;
+        let mut dm = 0.0;
+        for k in 0..3 {
+            let e = (self.min[k] - hi[k]).max(lo[k] - self.max[k]).max(0.0);
+            d2 += e * e;
+            let e = (self.min[k] - mid[k]).max(mid[k] - self.max[k]).max(0.0);
+            dm += e * e;
+        }
+        let dm = (dm.sqrt() - half).max(0.0);
+        if d2.max(dm * dm) > best_d2 {
+            return true;
+        }
+        if !self.radius.is_finite() {
+            return false;
+        }
+        let n = &self.axis;
+        let (u, w) = (a - self.center, b - self.center);
+        let pu = u - n * n.dot(&u);
+        let e = (w - n * n.dot(&w)) - pu;
+        disk_excludes(
+            n.dot(a),
+            n.dot(b),
+            self.lo,
+            self.hi,
+            &pu,
+            &e,
+            self.radius,
+            best_d2,
+        )
+    }
+}
+
+/// Whether a thin disk-like set is farther than sqrt(best_d2) from a segment, exactly
+/// (round-off kept on the safe side). The set: points z with axial coordinate n·z in [lo, hi]
+/// and in-plane offset |P(z − c)| ≤ r from a center c (P the projection across the unit axis
+/// n). The segment: axial coordinates xa, xb of its ends, in-plane offsets pu (start) and
+/// pu + e (end) from c. For y(s) on the segment, |y − z|² ≥ gap(s)² + (|q(s)| − r)₊², gap the
+/// distance of the axial coordinate to [lo, hi] and q(s) = pu + s e. If this is above best
+/// with the least gap and the least offset (taken apart), the set is out; else only the
+/// part of the segment with |q(s)| ≤ r + m, m² = best_d2 − (least gap)², can come nearer,
+/// and the set is out if the gap there exceeds the bound.
+#[inline]
+#[allow(clippy::too_many_arguments)]
+fn disk_excludes(
+    xa: f64,
+    xb: f64,
+    lo: f64,
+    hi: f64,
+    pu: &V3,
+    e: &V3,
+    r: f64,
+    best_d2: f64,
+) -> bool {
+    const SAFE: f64 = 1.0 - 1e-10;
+    let gap = |x1: f64, x2: f64| (lo - x1.max(x2)).max(x1.min(x2) - hi).max(0.0);
+    let g = gap(xa, xb);
+    let l2 = e.norm_squared();
+    let (s0, lat0) = if l2 > 0.0 {
+        let s0 = -pu.dot(e) / l2;
+        (s0, (pu + e * s0).norm())
+    } else {
+        (0.0, pu.norm())
+    };
+    let latc = if (0.0..=1.0).contains(&s0) {
+        lat0
+    } else {
+        (pu + e * s0.clamp(0.0, 1.0)).norm()
+    };
+    let out = (latc - r).max(0.0);
+    if (g * g + out * out) * SAFE > best_d2 {
+        return true;
+    }
+    if l2 == 0.0 || !best_d2.is_finite() {
+        return false;
+    }
+    // offsets within r + m: s in s0 ± δ
+    let reach = r + (best_d2 - g * g).max(0.0).sqrt();
+    let disc = reach * reach - lat0 * lat0;
+    if disc < 0.0 {
+        return false; // at the edge of round-off: keep the set
+    }
+    let delta = (disc / l2).sqrt() * (1.0 + 1e-9) + 1e-12;
+    let (s1, s2) = ((s0 - delta).max(0.0), (s0 + delta).min(1.0));
+    if s1 > s2 {
+        return false;
+    }
+    let (x1, x2) = (xa + (xb - xa) * s1, xa + (xb - xa) * s2);
+    let gi = gap(x1, x2);
+    gi * gi * SAFE > best_d2
 }
 
 /// A triangle mesh ready for distance queries.
@@ -224,6 +324,36 @@ impl TriMesh {
         }
     }
 
+    /// Lower bound of the squared distance of p to triangle t. With c the triangle's centroid,
+    /// r its circumradius about c and n its normal, every point z of the triangle has
+    /// n·(z − c) = 0 and |z − c| ≤ r, so |p − z|² = h² + |w − (z − c)|² ≥ h² + (|w| − r)₊²,
+    /// with h = n·(p − c) and w = (p − c) − n h (the in-plane offset). Much tighter than the
+    /// bounding sphere or the plane alone under a nearly parallel surface. Scaled down by
+    /// 1e-10 (relative) against round-off: it stays a lower bound.
+    #[inline]
+    fn point_lower2(&self, t: usize, p: &V3) -> f64 {
+        let (c, r) = &self.spheres[t];
+        let n = &self.face_normals[t];
+        let v = p - c;
+        let h = n.dot(&v);
+        let e = ((v - n * h).norm() - r).max(0.0);
+        (h * h + e * e) * (1.0 - 1e-10)
+    }
+
+    /// Whether segment [a, b] is farther than sqrt(best_d2) from triangle t: by
+    /// [`disk_excludes`] with the triangle's plane and its circumscribed disk about the
+    /// centroid (cheap, and tight under a nearly parallel surface).
+    #[inline]
+    fn segment_excluded(&self, t: usize, a: &V3, b: &V3, best_d2: f64) -> bool {
+        let (c, r) = &self.spheres[t];
+        let n = &self.face_normals[t];
+        let (u, w) = (a - c, b - c);
+        let (ha, hb) = (n.dot(&u), n.dot(&w));
+        let pu = u - n * ha;
+        let e = (w - n * hb) - pu;
+        disk_excludes(ha, hb, 0.0, 0.0, &pu, &e, *r, best_d2)
+    }
+
     /// Closest triangle to p within sqrt(best_d2): (triangle, closest point, squared distance).
     fn nearest_triangle(&self, p: &V3, mut best_d2: f64, hint: usize) -> Option<(usize, V3)> {
         let mut best = None;
@@ -247,16 +377,10 @@ impl TriMesh {
             if node.count > 0 {
                 let start = node.index as usize;
                 for t in start..start + node.count as usize {
-                    let (sc, sr) = &self.spheres[t];
-                    let ds = ((sc - p).norm() - sr).max(0.0);
-                    if ds * ds > best_d2 {
+                    if self.point_lower2(t, p) > best_d2 {
                         continue;
                     }
                     let [a, b, c] = &self.triangles[t];
-                    let h = self.face_normals[t].dot(&(p - a));
-                    if h * h > best_d2 {
-                        continue;
-                    }
                     let (cp, _) = point_triangle(p, a, b, c);
                     let d2 = (cp - p).norm_squared();
                     if d2 < best_d2 || (d2 == best_d2 && best.is_none()) {
@@ -295,30 +419,12 @@ impl TriMesh {
         let mid = (a + b) * 0.5;
         let half = (b - a).norm() * 0.5;
         let (lo, hi) = (a.inf(b), a.sup(b));
-        let lower2 = |n: &Node| {
-            let db = n.distance2_segment(a, b, &lo, &hi);
-            let dm = (n.distance2_point(&mid).sqrt() - half).max(0.0);
-            db.max(dm * dm)
-        };
+
         let check = |t: usize, best_d2: &mut f64, best: &mut Option<_>| {
-            // cheap lower bounds first: the triangle's bounding sphere, its plane
-            let (c, rad) = &self.spheres[t];
-            let (_, y) = point_segment(c, a, b);
-            let lb = ((c - y).norm() - rad).max(0.0);
-            if lb * lb > *best_d2 {
+            if self.segment_excluded(t, a, b, *best_d2) {
                 return;
             }
             let [p, q, r] = &self.triangles[t];
-            let n = &self.face_normals[t];
-            let (ha, hb) = (n.dot(&(a - p)), n.dot(&(b - p)));
-            let h = if ha * hb <= 0.0 {
-                0.0
-            } else {
-                ha.abs().min(hb.abs())
-            };
-            if h * h > *best_d2 {
-                return;
-            }
             let (s, x, y) = segment_triangle(a, b, p, q, r);
             let d2 = (x - y).norm_squared();
             if d2 < *best_d2 || (d2 == *best_d2 && best.is_none()) {
@@ -334,7 +440,7 @@ impl TriMesh {
         while top > 0 {
             top -= 1;
             let node = &self.nodes[stack[top] as usize];
-            if lower2(node) > best_d2 {
+            if node.excludes_segment(a, b, &lo, &hi, &mid, half, best_d2) {
                 continue;
             }
             if node.count > 0 {
@@ -441,9 +547,16 @@ struct BuildData<'a> {
 /// Subtrees up to this many triangles get a slab bound (the surface is nearly flat there).
 const SLAB_MAX: usize = 64;
 
-/// The slab of a node's triangles: axis = mean normal, and the range of axis·x over them.
-fn slab(items: &[(V3, u32)], d: &BuildData) -> (V3, f64, f64) {
-    let none = (V3::zeros(), f64::NEG_INFINITY, f64::INFINITY);
+/// The slab of a node's triangles (axis = mean normal, the range of axis·x over them) and a
+/// ball holding them (center, radius); axis zero and radius infinite when there is none.
+fn slab(items: &[(V3, u32)], d: &BuildData) -> (V3, f64, f64, V3, f64) {
+    let none = (
+        V3::zeros(),
+        f64::NEG_INFINITY,
+        f64::INFINITY,
+        V3::zeros(),
+        f64::INFINITY,
+    );
     if items.len() > SLAB_MAX {
         return none;
     }
@@ -454,16 +567,28 @@ fn slab(items: &[(V3, u32)], d: &BuildData) -> (V3, f64, f64) {
     }
     let axis = mean / len;
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    let (mut bmin, mut bmax) = (V3::repeat(f64::INFINITY), V3::repeat(f64::NEG_INFINITY));
     for (_, i) in items {
         for &k in &d.faces[*i as usize] {
-            let x = axis.dot(&d.vertices[k as usize]);
+            let v = &d.vertices[k as usize];
+            let x = axis.dot(v);
             lo = lo.min(x);
             hi = hi.max(x);
+            bmin = bmin.inf(v);
+            bmax = bmax.sup(v);
+        }
+    }
+    let center = (bmin + bmax) * 0.5;
+    let mut radius: f64 = 0.0;
+    for (_, i) in items {
+        for &k in &d.faces[*i as usize] {
+            radius = radius.max((d.vertices[k as usize] - center).norm());
         }
     }
     // widen by the round-off of the projections
     let pad = 1e-12 * (lo.abs() + hi.abs() + (hi - lo));
-    (axis, lo - pad, hi + pad)
+    let radius = radius * (1.0 + 1e-12) + 1e-12 * center.norm();
+    (axis, lo - pad, hi + pad, center, radius)
 }
 
 /// Builds the hierarchy over `items` (centroid, triangle), reordering them; `offset` is the
@@ -477,13 +602,15 @@ fn build(items: &mut [(V3, u32)], offset: usize, d: &BuildData) -> Vec<Node> {
             lo = lo.inf(&a);
             hi = hi.sup(&b);
         }
-        let (axis, slo, shi) = slab(items, d);
+        let (axis, slo, shi, center, radius) = slab(items, d);
         return vec![Node {
             min: lo,
             max: hi,
             axis,
             lo: slo,
             hi: shi,
+            center,
+            radius,
             index: offset as u32,
             count: items.len() as u32,
         }];
@@ -493,7 +620,7 @@ fn build(items: &mut [(V3, u32)], offset: usize, d: &BuildData) -> Vec<Node> {
         clo = clo.inf(c);
         chi = chi.sup(c);
     }
-    let (slab_axis, slab_lo, slab_hi) = slab(items, d);
+    let (slab_axis, slab_lo, slab_hi, center, radius) = slab(items, d);
     let axis = (chi - clo).imax();
     let mid = items.len() / 2;
     items.select_nth_unstable_by(mid, |x, y| x.0[axis].total_cmp(&y.0[axis]));
@@ -516,6 +643,8 @@ fn build(items: &mut [(V3, u32)], offset: usize, d: &BuildData) -> Vec<Node> {
         axis: slab_axis,
         lo: slab_lo,
         hi: slab_hi,
+        center,
+        radius,
         index: (1 + left.len()) as u32,
         count: 0,
     });
@@ -662,6 +791,69 @@ mod tests {
                 })
                 .fold(f64::INFINITY, f64::min);
             assert_eq!(s.distance, brute);
+        }
+    }
+
+    #[test]
+    fn disk_bounds_agree_with_brute_force_over_a_curved_surface() {
+        // a bumpy height field (the clearance benchmark's shape, 40 × 40 quads) and points and
+        // half-edge-like segments nearly parallel to it, where the slab/disk bounds of nodes
+        // and triangles are tightest: the hierarchy must give the brute-force minimum exactly
+        let h =
+            |x: f64, y: f64| 0.1 * (x * 6.0).sin() * (y * 9.0).cos() + 0.05 * ((x + y) * 3.0).sin();
+        let n = 40;
+        let mut v = vec![];
+        for i in 0..=n {
+            for j in 0..=n {
+                let (x, y) = (i as f64 / n as f64, j as f64 / n as f64);
+                v.push(V3::new(x, y, h(x, y)));
+            }
+        }
+        let mut f = vec![];
+        for i in 0..n {
+            for j in 0..n {
+                let a = (i * (n + 1) + j) as u32;
+                let (b, c, d) = (a + n as u32 + 1, a + 1, a + n as u32 + 2);
+                f.push([a, b, d]);
+                f.push([a, d, c]);
+            }
+        }
+        let m = TriMesh::new(&v, &f).unwrap();
+        let tri = |t: &[u32; 3]| [0, 1, 2].map(|k| v[t[k] as usize]);
+        for q in 0..300 {
+            let (x, y) = (
+                0.1 + (q as f64 * 0.377) % 0.8,
+                0.1 + (q as f64 * 0.613) % 0.8,
+            );
+            let lift = 0.01 + 0.002 * (q % 37) as f64;
+            let a = V3::new(x, y, h(x, y) + lift);
+            let dir = V3::new((q as f64).cos(), (q as f64).sin(), 0.0) * 0.03;
+            let b = V3::new(
+                a.x + dir.x,
+                a.y + dir.y,
+                h(a.x + dir.x, a.y + dir.y) + lift * 0.9,
+            );
+            let r = m.project_point(&a, f64::INFINITY, q).unwrap();
+            let brute = f
+                .iter()
+                .map(|t| {
+                    let [p, u, w] = tri(t);
+                    (point_triangle(&a, &p, &u, &w).0 - a).norm()
+                })
+                .fold(f64::INFINITY, f64::min);
+            assert_eq!(r.distance, brute);
+            for bound in [f64::INFINITY, brute * 1.01] {
+                let s = m.closest_to_segment(&a, &b, bound, usize::MAX).unwrap();
+                let brute = f
+                    .iter()
+                    .map(|t| {
+                        let [p, u, w] = tri(t);
+                        let (_, x, y) = segment_triangle(&a, &b, &p, &u, &w);
+                        (x - y).norm()
+                    })
+                    .fold(f64::INFINITY, f64::min);
+                assert_eq!(s.distance, brute, "query {q}");
+            }
         }
     }
 
