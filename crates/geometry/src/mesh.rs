@@ -45,26 +45,38 @@ struct Node {
 }
 
 impl Node {
-    /// Lower bound of the squared distance of p: the box's, and with a slab
-    /// h² + (|w| − radius)₊², h the gap to the slab and w the offset of p from the center
-    /// across the axis (every z of the node has axis·z in the slab and |z − center| ≤ radius,
-    /// so its offset across the axis is at most the radius too).
-    #[inline]
-    fn distance2_point(&self, p: &V3) -> f64 {
+    /// Squared distance of p to the box (a lower bound; cheap, to order the children).
+    #[inline(always)]
+    fn box_distance2(&self, p: &V3) -> f64 {
         let mut d2 = 0.0;
         for k in 0..3 {
             let e = (self.min[k] - p[k]).max(p[k] - self.max[k]).max(0.0);
             d2 += e * e;
         }
-        if self.radius.is_finite() {
-            let x = self.axis.dot(p);
-            let h = (self.lo - x).max(x - self.hi).max(0.0);
-            let v = p - self.center;
-            let w = v - self.axis * self.axis.dot(&v);
-            let lat = (w.norm() - self.radius).max(0.0);
-            d2 = d2.max((h * h + lat * lat) * (1.0 - 1e-10));
-        }
         d2
+    }
+
+    /// Whether p is farther than sqrt(best_d2) from the node: by the box, and with a slab by
+    /// h² + (|w| − radius)₊², h the gap to the slab and w the offset of p from the center
+    /// across the axis (every z of the node has axis·z in the slab and |z − center| ≤ radius,
+    /// so its offset across the axis is at most the radius too).
+    #[inline(always)]
+    fn excludes_point(&self, p: &V3, best_d2: f64) -> bool {
+        if self.box_distance2(p) > best_d2 {
+            return true;
+        }
+        if !self.radius.is_finite() {
+            return false;
+        }
+        let x = self.axis.dot(p);
+        let h = (self.lo - x).max(x - self.hi).max(0.0);
+        if h * h > best_d2 {
+            return true;
+        }
+        let v = p - self.center;
+        let w = v - self.axis * self.axis.dot(&v);
+        let lat = (w.norm() - self.radius).max(0.0);
+        (h * h + lat * lat) * (1.0 - 1e-10) > best_d2
     }
 
     /// Whether segment [a, b] (with box lo..hi, midpoint mid, half length half) is farther
@@ -123,7 +135,7 @@ impl Node {
 /// with the least gap and the least offset (taken apart), the set is out; else only the
 /// part of the segment with |q(s)| ≤ r + m, m² = best_d2 − (least gap)², can come nearer,
 /// and the set is out if the gap there exceeds the bound.
-#[inline]
+#[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn disk_excludes(
     xa: f64,
@@ -371,7 +383,7 @@ impl TriMesh {
         while top > 0 {
             top -= 1;
             let node = &self.nodes[stack[top] as usize];
-            if node.distance2_point(p) > best_d2 {
+            if node.excludes_point(p, best_d2) {
                 continue;
             }
             if node.count > 0 {
@@ -391,8 +403,8 @@ impl TriMesh {
             } else {
                 let left = stack[top] + 1;
                 let right = node.index;
-                let dl = self.nodes[left as usize].distance2_point(p);
-                let dr = self.nodes[right as usize].distance2_point(p);
+                let dl = self.nodes[left as usize].box_distance2(p);
+                let dr = self.nodes[right as usize].box_distance2(p);
                 // nearer child on top of the stack
                 let (near, far) = if dl <= dr {
                     (left, right)
@@ -405,6 +417,89 @@ impl TriMesh {
             }
         }
         best
+    }
+
+    /// Nearest of the segments [a, ends[j]] (a shared start, such as the two half-edges at a
+    /// cable node) to the mesh within `max_distance`, in one traversal: a node is skipped when
+    /// no segment can come nearer than the best found for any of them. Returns (distance,
+    /// index j, triangle); `hint` is a triangle to try first. The distance is the one
+    /// [`Surface::closest_to_segment`] gives for segment j.
+    pub fn nearest_of_segments(
+        &self,
+        a: &V3,
+        ends: &[V3],
+        max_distance: f64,
+        hint: usize,
+    ) -> Option<(f64, usize, usize)> {
+        const MAX_ENDS: usize = 4;
+        assert!(ends.len() <= MAX_ENDS, "at most {MAX_ENDS} segments");
+        let mut best_d2 = max_distance * max_distance;
+        let mut best: Option<(usize, usize)> = None;
+        // per segment: box, midpoint, half length
+        let mut seg = [(V3::zeros(), V3::zeros(), V3::zeros(), 0.0); MAX_ENDS];
+        let (mut vlo, mut vhi) = (*a, *a);
+        for (j, b) in ends.iter().enumerate() {
+            seg[j] = (a.inf(b), a.sup(b), (a + b) * 0.5, (b - a).norm() * 0.5);
+            vlo = vlo.inf(b);
+            vhi = vhi.sup(b);
+        }
+        let seg = &seg[..ends.len()];
+        let check = |t: usize, best_d2: &mut f64, best: &mut Option<(usize, usize)>| {
+            let [p, q, r] = &self.triangles[t];
+            for (j, b) in ends.iter().enumerate() {
+                if self.segment_excluded(t, a, b, *best_d2) {
+                    continue;
+                }
+                let (_, x, y) = segment_triangle(a, b, p, q, r);
+                let d2 = (x - y).norm_squared();
+                if d2 < *best_d2 || (d2 == *best_d2 && best.is_none()) {
+                    *best_d2 = d2;
+                    *best = Some((j, t));
+                }
+            }
+        };
+        if hint < self.triangles.len() {
+            check(hint, &mut best_d2, &mut best);
+        }
+        let mut stack = [0u32; 64];
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let node = &self.nodes[stack[top] as usize];
+            // the box of all segments first, then each segment
+            let mut d2 = 0.0;
+            for k in 0..3 {
+                let e = (node.min[k] - vhi[k]).max(vlo[k] - node.max[k]).max(0.0);
+                d2 += e * e;
+            }
+            if d2 > best_d2
+                || ends.iter().zip(seg).all(|(b, (lo, hi, mid, half))| {
+                    node.excludes_segment(a, b, lo, hi, mid, *half, best_d2)
+                })
+            {
+                continue;
+            }
+            if node.count > 0 {
+                let start = node.index as usize;
+                for t in start..start + node.count as usize {
+                    check(t, &mut best_d2, &mut best);
+                }
+            } else {
+                let left = stack[top] + 1;
+                let right = node.index;
+                let dl = self.nodes[left as usize].box_distance2(a);
+                let dr = self.nodes[right as usize].box_distance2(a);
+                let (near, far) = if dl <= dr {
+                    (left, right)
+                } else {
+                    (right, left)
+                };
+                stack[top] = far;
+                stack[top + 1] = near;
+                top += 2;
+            }
+        }
+        best.map(|(j, t)| (best_d2.sqrt(), j, t))
     }
 
     /// Closest triangle to segment [a, b] within sqrt(best_d2).
@@ -451,8 +546,8 @@ impl TriMesh {
             } else {
                 let left = stack[top] + 1;
                 let right = node.index;
-                let dl = self.nodes[left as usize].distance2_point(&mid);
-                let dr = self.nodes[right as usize].distance2_point(&mid);
+                let dl = self.nodes[left as usize].box_distance2(&mid);
+                let dr = self.nodes[right as usize].box_distance2(&mid);
                 let (near, far) = if dl <= dr {
                     (left, right)
                 } else {
@@ -853,6 +948,31 @@ mod tests {
                     })
                     .fold(f64::INFINITY, f64::min);
                 assert_eq!(s.distance, brute, "query {q}");
+            }
+            // both half-edges of a node at a (to b and to a point on the other side) at once
+            let c = V3::new(a.x - dir.y * 0.5, a.y + dir.x * 0.5, a.z - lift * 0.3);
+            let seg_brute = |e: &V3| {
+                f.iter()
+                    .map(|t| {
+                        let [p, u, w] = tri(t);
+                        let (_, x, y) = segment_triangle(&a, e, &p, &u, &w);
+                        (x - y).norm()
+                    })
+                    .fold(f64::INFINITY, f64::min)
+            };
+            let (db, dc) = (seg_brute(&b), seg_brute(&c));
+            let (d, j, t) = m
+                .nearest_of_segments(&a, &[b, c], f64::INFINITY, q)
+                .unwrap();
+            assert_eq!(d, db.min(dc), "query {q}");
+            assert_eq!(d, if j == 0 { db } else { dc });
+            let [p, u, w] = m.triangle(t);
+            let e = if j == 0 { b } else { c };
+            let (_, x, y) = segment_triangle(&a, &e, &p, &u, &w);
+            assert_eq!((x - y).norm(), d);
+            // nothing within a bound below the distance (d = 0: a half-edge crosses)
+            if d > 0.0 {
+                assert!(m.nearest_of_segments(&a, &[b, c], d * 0.99, t).is_none());
             }
         }
     }
