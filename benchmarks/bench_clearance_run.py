@@ -6,7 +6,8 @@ The scene: the hose of examples/surroundings/hose-near-engine.toml (100 segments
 millimetres, ~1.1 mm edges, 1–10 cm from the hose) moving with the engine. Printed: the wall
 time of the whole process (``cablelife run scene.toml -o result.h5 --quiet``, fresh
 subprocess), and the split of one in-process run: import, scene, mesh file read and checks
-(trimesh), hierarchy build, simulation, display decimation, clearance, result file.
+(trimesh), hierarchy build, simulation, display decimation, clearance, result file; wall and
+CPU time of all threads (on a shared machine the CPU time is the work itself).
 
     RAYON_NUM_THREADS=2 python benchmarks/bench_clearance_run.py [--repeat 3] [--duration 5]
 """
@@ -16,6 +17,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import resource
 import statistics
 import subprocess
 import sys
@@ -44,10 +46,12 @@ min_clearance = 0.02
 [[bodies]]
 name = "engine"
 origin = [0.6, 0.2, 0.0]
-motion = [
-  {{ channel = "z", frame = "global", signal = {{ type = "sine", amplitude = 0.005, frequency = 5.0, fade_in = 0.1 }} }},
-]
 geometry = [ {{ mesh = "torus.stl", scale = 0.001, name = "block" }} ]
+
+[[bodies.motion]]
+channel = "z"
+frame = "global"
+signal = {{ type = "sine", amplitude = 0.005, frequency = 5.0, fade_in = 0.1 }}
 
 [[cables]]
 name = "hose"
@@ -77,47 +81,56 @@ type = "fixed"
 # one in-process run, timed stage by stage by wrapping the functions simulate() calls
 SPLIT = r"""
 import json, sys, time
-t0 = time.perf_counter()
+clock = lambda: (time.perf_counter(), time.process_time())
+w0, c0 = clock()
 import cablelife.simulate
 from cablelife.scene import load_scene
 sim = sys.modules["cablelife.simulate"]
-t_import = time.perf_counter() - t0
-times = {"import cablelife": t_import}
+w, c = clock()
+times = {"import cablelife": [w - w0, c - c0]}
+
+def add(name, w0, c0):
+    w, c = clock()
+    old = times.get(name, [0.0, 0.0])
+    times[name] = [old[0] + w - w0, old[1] + c - c0]
 
 def timed(name, f):
     def g(*a, **k):
-        t = time.perf_counter()
+        w0, c0 = clock()
         try:
             return f(*a, **k)
         finally:
-            times[name] = times.get(name, 0.0) + time.perf_counter() - t
+            add(name, w0, c0)
     return g
 
 import cablelife.surroundings.meshes as meshes
 import cablelife.surroundings.clearance as clr
 from cablelife.surroundings.build import Surroundings
-t = time.perf_counter()
+w0, c0 = clock()
 import trimesh  # noqa: F401  (imported by the mesh reader on first use)
-times["import trimesh"] = time.perf_counter() - t
+add("import trimesh", w0, c0)
 meshes.load_mesh = timed("mesh read + checks (trimesh)", meshes.load_mesh)
 sim.load_surroundings = timed("surroundings total", sim.load_surroundings)
 Surroundings.display_meshes = timed("display decimation", Surroundings.display_meshes)
 clr.cable_clearance = timed("clearance", clr.cable_clearance)
-t = time.perf_counter()
+w0, c0 = clock()
 scene = load_scene(sys.argv[1])
-times["scene"] = time.perf_counter() - t
-t = time.perf_counter()
+add("scene", w0, c0)
+w0, c0 = clock()
 result = sim.simulate(scene)
-total = time.perf_counter() - t
-t = time.perf_counter()
+add("simulate total", w0, c0)
+w0, c0 = clock()
 result.save(sys.argv[2])
-times["result file"] = time.perf_counter() - t
-times["hierarchy build"] = times["surroundings total"] - times["mesh read + checks (trimesh)"]
-times["simulation"] = (
-    total - times.pop("surroundings total") - times["display decimation"] - times["clearance"]
-)
+add("result file", w0, c0)
+total = times.pop("simulate total")
+env = times.pop("surroundings total")
+read = times["mesh read + checks (trimesh)"]
+times["hierarchy build"] = [env[k] - read[k] for k in (0, 1)]
+times["simulation"] = [
+    total[k] - env[k] - times["display decimation"][k] - times["clearance"][k] for k in (0, 1)
+]
 c = next(iter(result.cables.values())).clearance
-times["clearance min (mm)"], times["clearance max (mm)"] = c.min() * 1e3, c.max() * 1e3
+times["clearance min, max (mm)"] = [c.min() * 1e3, c.max() * 1e3]
 print(json.dumps(times))
 """
 
@@ -155,15 +168,17 @@ def main() -> None:
             f"mesh {n:,} triangles ({(d / 'torus.stl').stat().st_size / 1e6:.0f} MB binary STL);"
             f" hose 100 segments, dynamic {args.duration:g} s at 1 ms; RAYON_NUM_THREADS={threads}"
         )
-        walls, splits = [], []
+        walls, cpus, splits = [], [], []
         for _ in range(args.repeat):
-            t0 = time.perf_counter()
+            t0, r0 = time.perf_counter(), resource.getrusage(resource.RUSAGE_CHILDREN)
             subprocess.run(
                 [*CLI, "run", str(scene), "-o", str(d / "run.h5"), "--quiet"],
                 check=True,
                 stdout=subprocess.DEVNULL,
             )
             walls.append(time.perf_counter() - t0)
+            r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+            cpus.append(r1.ru_utime + r1.ru_stime - r0.ru_utime - r0.ru_stime)
             out = subprocess.run(
                 [sys.executable, "-c", SPLIT, str(scene), str(d / "split.h5")],
                 capture_output=True,
@@ -172,11 +187,17 @@ def main() -> None:
             if out.returncode:
                 sys.exit(f"the in-process run failed:\n{out.stderr}")
             splits.append(json.loads(out.stdout.strip().splitlines()[-1]))
-        print(f"whole `cablelife run` (wall)       median {statistics.median(walls):7.2f} s")
-        print("split of one in-process run (medians):")
+        med = statistics.median
+        print(
+            f"whole `cablelife run`             wall {med(walls):7.2f} s   CPU {med(cpus):7.2f} s"
+        )
+        print("split of one in-process run (medians; CPU = all threads):")
         for key in splits[0]:
-            unit = "" if "(mm)" in key else " s"
-            print(f"  {key:32s} {statistics.median(s[key] for s in splits):7.2f}{unit}")
+            w, c = (med(s[key][k] for s in splits) for k in (0, 1))
+            if "(mm)" in key:
+                print(f"  {key:32s} {w:7.2f} … {c:.2f}")
+            else:
+                print(f"  {key:32s} wall {w:7.2f} s   CPU {c:7.2f} s")
         print(f"load average {os.getloadavg()[0]:.1f} (2 cores)")
 
 

@@ -25,23 +25,26 @@ impl fmt::Display for MeshError {
 
 impl std::error::Error for MeshError {}
 
+/// A hierarchy node, laid out so that the box test reads one cache line (box, links and the
+/// slab's range) and the slab-and-ball test the second.
 #[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
 struct Node {
     min: V3,
     max: V3,
-    /// Slab bound: the node's triangles lie in lo ≤ axis·x ≤ hi (axis zero: no slab). Tight
-    /// where the surface is nearly flat, which the box is not when the surface is inclined.
-    axis: V3,
-    lo: f64,
-    hi: f64,
-    /// With a slab: a ball (center, radius) holding the node's triangles (radius infinite
-    /// without a slab). Slab and ball together bound the distance like a thin disk.
-    center: V3,
-    radius: f64,
     /// Leaf: first triangle; inner node: index of the right child (the left one follows).
     index: u32,
     /// Leaf: number of triangles (> 0); inner node: 0.
     count: u32,
+    /// Slab bound: the node's triangles lie in lo ≤ axis·x ≤ hi (axis zero: no slab). Tight
+    /// where the surface is nearly flat, which the box is not when the surface is inclined.
+    lo: f64,
+    hi: f64,
+    axis: V3,
+    /// With a slab: a ball (center, radius) holding the node's triangles (radius infinite
+    /// without a slab). Slab and ball together bound the distance like a thin disk.
+    center: V3,
+    radius: f64,
 }
 
 impl Node {
