@@ -83,8 +83,8 @@ impl Node {
     }
 
     /// Whether segment [a, b] (with box lo..hi, midpoint mid, half length half) is farther
-    /// than sqrt(best_d2) from the node: by the boxes, by the box and the ball about mid,
-    /// and with a slab by [`disk_excludes`] (slab and ball).
+    /// than sqrt(best_d2) from the node: by the boxes, then with a slab by [`disk_excludes`]
+    /// (slab and ball, the tighter test), else by the box and the ball about mid.
     #[inline]
     #[allow(clippy::too_many_arguments)]
     fn excludes_segment(
@@ -98,34 +98,28 @@ impl Node {
         best_d2: f64,
     ) -> bool {
         let mut d2 = 0.0;
-        let mut dm = 0.0;
         for k in 0..3 {
             let e = (self.min[k] - hi[k]).max(lo[k] - self.max[k]).max(0.0);
             d2 += e * e;
-            let e = (self.min[k] - mid[k]).max(mid[k] - self.max[k]).max(0.0);
-            dm += e * e;
         }
-        let dm = (dm.sqrt() - half).max(0.0);
-        if d2.max(dm * dm) > best_d2 {
+        if d2 > best_d2 {
             return true;
         }
         if !self.radius.is_finite() {
-            return false;
+            // no slab: the box and the ball about mid
+            let dm = (self.box_distance2(mid).sqrt() - half).max(0.0);
+            return dm * dm > best_d2;
         }
         let n = &self.axis;
+        let (xa, xb) = (n.dot(a), n.dot(b));
+        let gap = (self.lo - xa.max(xb)).max(xa.min(xb) - self.hi).max(0.0);
+        if gap * gap * (1.0 - 1e-10) > best_d2 {
+            return true;
+        }
         let (u, w) = (a - self.center, b - self.center);
         let pu = u - n * n.dot(&u);
         let e = (w - n * n.dot(&w)) - pu;
-        disk_excludes(
-            n.dot(a),
-            n.dot(b),
-            self.lo,
-            self.hi,
-            &pu,
-            &e,
-            self.radius,
-            best_d2,
-        )
+        disk_excludes(xa, xb, self.lo, self.hi, &pu, &e, self.radius, best_d2)
     }
 }
 
@@ -364,6 +358,13 @@ impl TriMesh {
         let n = &self.face_normals[t];
         let (u, w) = (a - c, b - c);
         let (ha, hb) = (n.dot(&u), n.dot(&w));
+        if ha * hb > 0.0 {
+            // both ends on one side: the plane alone may exclude
+            let h = ha.abs().min(hb.abs());
+            if h * h * (1.0 - 1e-10) > best_d2 {
+                return true;
+            }
+        }
         let pu = u - n * ha;
         let e = (w - n * hb) - pu;
         disk_excludes(ha, hb, 0.0, 0.0, &pu, &e, *r, best_d2)
