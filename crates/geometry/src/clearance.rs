@@ -148,6 +148,10 @@ fn step(
                 let base = pt.body * n;
                 let x = &local[base + i];
                 let at = 3 * (i * n_parts + k);
+                // the half-edges that can come nearer than the best so far
+                let mut ends = [V3::zeros(); 2];
+                let mut sides = [0usize; 2];
+                let mut m = 0;
                 for (side, nb) in [i.wrapping_sub(1), i + 1].into_iter().enumerate() {
                     if nb >= n {
                         continue;
@@ -156,12 +160,36 @@ fn step(
                     if dist[k] - (mid - x).norm() >= best {
                         continue; // cannot come nearer than the best so far
                     }
+                    ends[m] = mid;
+                    sides[m] = side;
+                    m += 1;
+                }
+                if let Shape::Mesh(mesh) = &pt.shape {
+                    // both half-edges in one traversal; warm start: the triangle nearest to
+                    // them at the previous step, else the node's
+                    if m == 0 {
+                        continue;
+                    }
+                    let h = match hints[at + 1] {
+                        usize::MAX => hints[at],
+                        h => h,
+                    };
+                    if let Some((d, _, t)) = mesh.nearest_of_segments(x, &ends[..m], best, h) {
+                        hints[at + 1] = t;
+                        if d < best {
+                            best = d;
+                            nearest = k;
+                        }
+                    }
+                    continue;
+                }
+                for (mid, side) in ends[..m].iter().zip(&sides) {
                     // warm start: this half-edge's feature at the previous step, else the node's
                     let h = match hints[at + 1 + side] {
                         usize::MAX => hints[at],
                         h => h,
                     };
-                    if let Some(s) = pt.shape.closest_to_segment(x, &mid, best, h) {
+                    if let Some(s) = pt.shape.closest_to_segment(x, mid, best, h) {
                         hints[at + 1 + side] = s.feature;
                         if s.distance < best {
                             best = s.distance;

@@ -8,7 +8,7 @@
 //! point is.
 use std::fmt;
 
-use crate::closest::{point_segment, point_triangle, segment_triangle, Feature};
+use crate::closest::{point_triangle, segment_triangle, Feature};
 use crate::{PointProjection, SegmentProjection, Surface, V3};
 
 const LEAF_SIZE: usize = 4;
@@ -25,52 +25,161 @@ impl fmt::Display for MeshError {
 
 impl std::error::Error for MeshError {}
 
+/// A hierarchy node, laid out so that the box test reads one cache line (box, links and the
+/// slab's range) and the slab-and-ball test the second.
 #[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
 struct Node {
     min: V3,
     max: V3,
-    /// Slab bound: the node's triangles lie in lo ≤ axis·x ≤ hi (axis zero: no slab). Tight
-    /// where the surface is nearly flat, which the box is not when the surface is inclined.
-    axis: V3,
-    lo: f64,
-    hi: f64,
     /// Leaf: first triangle; inner node: index of the right child (the left one follows).
     index: u32,
     /// Leaf: number of triangles (> 0); inner node: 0.
     count: u32,
+    /// Slab bound: the node's triangles lie in lo ≤ axis·x ≤ hi (axis zero: no slab). Tight
+    /// where the surface is nearly flat, which the box is not when the surface is inclined.
+    lo: f64,
+    hi: f64,
+    axis: V3,
+    /// With a slab: a ball (center, radius) holding the node's triangles (radius infinite
+    /// without a slab). Slab and ball together bound the distance like a thin disk.
+    center: V3,
+    radius: f64,
 }
 
 impl Node {
-    #[inline]
-    fn distance2_point(&self, p: &V3) -> f64 {
+    /// Squared distance of p to the box (a lower bound; cheap, to order the children).
+    #[inline(always)]
+    fn box_distance2(&self, p: &V3) -> f64 {
         let mut d2 = 0.0;
         for k in 0..3 {
             let e = (self.min[k] - p[k]).max(p[k] - self.max[k]).max(0.0);
             d2 += e * e;
         }
+        d2
+    }
+
+    /// Whether p is farther than sqrt(best_d2) from the node: by the box, and with a slab by
+    /// h² + (|w| − radius)₊², h the gap to the slab and w the offset of p from the center
+    /// across the axis (every z of the node has axis·z in the slab and |z − center| ≤ radius,
+    /// so its offset across the axis is at most the radius too).
+    #[inline(always)]
+    fn excludes_point(&self, p: &V3, best_d2: f64) -> bool {
+        if self.box_distance2(p) > best_d2 {
+            return true;
+        }
+        if !self.radius.is_finite() {
+            return false;
+        }
         let x = self.axis.dot(p);
-        let e = (self.lo - x).max(x - self.hi).max(0.0);
-        d2.max(e * e)
+        let h = (self.lo - x).max(x - self.hi).max(0.0);
+        if h * h > best_d2 {
+            return true;
+        }
+        let v = p - self.center;
+        let w = v - self.axis * self.axis.dot(&v);
+        let lat = (w.norm() - self.radius).max(0.0);
+        (h * h + lat * lat) * (1.0 - 1e-10) > best_d2
     }
 
-    /// Lower bound of the squared distance of segment [a, b] (with box lo..hi).
+    /// Whether segment [a, b] (with box lo..hi, midpoint mid, half length half) is farther
+    /// than sqrt(best_d2) from the node: by the boxes, then with a slab by [`disk_excludes`]
+    /// (slab and ball, the tighter test), else by the box and the ball about mid.
     #[inline]
-    fn distance2_segment(&self, a: &V3, b: &V3, lo: &V3, hi: &V3) -> f64 {
-        let d2 = self.distance2_box(lo, hi);
-        let (xa, xb) = (self.axis.dot(a), self.axis.dot(b));
-        let e = (self.lo - xa.max(xb)).max(xa.min(xb) - self.hi).max(0.0);
-        d2.max(e * e)
-    }
-
-    #[inline]
-    fn distance2_box(&self, lo: &V3, hi: &V3) -> f64 {
+    #[allow(clippy::too_many_arguments)]
+    fn excludes_segment(
+        &self,
+        a: &V3,
+        b: &V3,
+        lo: &V3,
+        hi: &V3,
+        mid: &V3,
+        half: f64,
+        best_d2: f64,
+    ) -> bool {
         let mut d2 = 0.0;
         for k in 0..3 {
             let e = (self.min[k] - hi[k]).max(lo[k] - self.max[k]).max(0.0);
             d2 += e * e;
         }
-        d2
+        if d2 > best_d2 {
+            return true;
+        }
+        if !self.radius.is_finite() {
+            // no slab: the box and the ball about mid
+            let dm = (self.box_distance2(mid).sqrt() - half).max(0.0);
+            return dm * dm > best_d2;
+        }
+        let n = &self.axis;
+        let (xa, xb) = (n.dot(a), n.dot(b));
+        let gap = (self.lo - xa.max(xb)).max(xa.min(xb) - self.hi).max(0.0);
+        if gap * gap * (1.0 - 1e-10) > best_d2 {
+            return true;
+        }
+        let (u, w) = (a - self.center, b - self.center);
+        let pu = u - n * n.dot(&u);
+        let e = (w - n * n.dot(&w)) - pu;
+        disk_excludes(xa, xb, self.lo, self.hi, &pu, &e, self.radius, best_d2)
     }
+}
+
+/// Whether a thin disk-like set is farther than sqrt(best_d2) from a segment, exactly
+/// (round-off kept on the safe side). The set: points z with axial coordinate n·z in [lo, hi]
+/// and in-plane offset |P(z − c)| ≤ r from a center c (P the projection across the unit axis
+/// n). The segment: axial coordinates xa, xb of its ends, in-plane offsets pu (start) and
+/// pu + e (end) from c. For y(s) on the segment, |y − z|² ≥ gap(s)² + (|q(s)| − r)₊², gap the
+/// distance of the axial coordinate to [lo, hi] and q(s) = pu + s e. If this is above best
+/// with the least gap and the least offset (taken apart), the set is out; else only the
+/// part of the segment with |q(s)| ≤ r + m, m² = best_d2 − (least gap)², can come nearer,
+/// and the set is out if the gap there exceeds the bound.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn disk_excludes(
+    xa: f64,
+    xb: f64,
+    lo: f64,
+    hi: f64,
+    pu: &V3,
+    e: &V3,
+    r: f64,
+    best_d2: f64,
+) -> bool {
+    const SAFE: f64 = 1.0 - 1e-10;
+    let gap = |x1: f64, x2: f64| (lo - x1.max(x2)).max(x1.min(x2) - hi).max(0.0);
+    let g = gap(xa, xb);
+    let l2 = e.norm_squared();
+    let (s0, lat0) = if l2 > 0.0 {
+        let s0 = -pu.dot(e) / l2;
+        (s0, (pu + e * s0).norm())
+    } else {
+        (0.0, pu.norm())
+    };
+    let latc = if (0.0..=1.0).contains(&s0) {
+        lat0
+    } else {
+        (pu + e * s0.clamp(0.0, 1.0)).norm()
+    };
+    let out = (latc - r).max(0.0);
+    if (g * g + out * out) * SAFE > best_d2 {
+        return true;
+    }
+    if l2 == 0.0 || !best_d2.is_finite() {
+        return false;
+    }
+    // offsets within r + m: s in s0 ± δ
+    let reach = r + (best_d2 - g * g).max(0.0).sqrt();
+    let disc = reach * reach - lat0 * lat0;
+    if disc < 0.0 {
+        return false; // at the edge of round-off: keep the set
+    }
+    let delta = (disc / l2).sqrt() * (1.0 + 1e-9) + 1e-12;
+    let (s1, s2) = ((s0 - delta).max(0.0), (s0 + delta).min(1.0));
+    if s1 > s2 {
+        return false;
+    }
+    let (x1, x2) = (xa + (xb - xa) * s1, xa + (xb - xa) * s2);
+    let gi = gap(x1, x2);
+    gi * gi * SAFE > best_d2
 }
 
 /// A triangle mesh ready for distance queries.
@@ -224,6 +333,43 @@ impl TriMesh {
         }
     }
 
+    /// Lower bound of the squared distance of p to triangle t. With c the triangle's centroid,
+    /// r its circumradius about c and n its normal, every point z of the triangle has
+    /// n·(z − c) = 0 and |z − c| ≤ r, so |p − z|² = h² + |w − (z − c)|² ≥ h² + (|w| − r)₊²,
+    /// with h = n·(p − c) and w = (p − c) − n h (the in-plane offset). Much tighter than the
+    /// bounding sphere or the plane alone under a nearly parallel surface. Scaled down by
+    /// 1e-10 (relative) against round-off: it stays a lower bound.
+    #[inline]
+    fn point_lower2(&self, t: usize, p: &V3) -> f64 {
+        let (c, r) = &self.spheres[t];
+        let n = &self.face_normals[t];
+        let v = p - c;
+        let h = n.dot(&v);
+        let e = ((v - n * h).norm() - r).max(0.0);
+        (h * h + e * e) * (1.0 - 1e-10)
+    }
+
+    /// Whether segment [a, b] is farther than sqrt(best_d2) from triangle t: by
+    /// [`disk_excludes`] with the triangle's plane and its circumscribed disk about the
+    /// centroid (cheap, and tight under a nearly parallel surface).
+    #[inline]
+    fn segment_excluded(&self, t: usize, a: &V3, b: &V3, best_d2: f64) -> bool {
+        let (c, r) = &self.spheres[t];
+        let n = &self.face_normals[t];
+        let (u, w) = (a - c, b - c);
+        let (ha, hb) = (n.dot(&u), n.dot(&w));
+        if ha * hb > 0.0 {
+            // both ends on one side: the plane alone may exclude
+            let h = ha.abs().min(hb.abs());
+            if h * h * (1.0 - 1e-10) > best_d2 {
+                return true;
+            }
+        }
+        let pu = u - n * ha;
+        let e = (w - n * hb) - pu;
+        disk_excludes(ha, hb, 0.0, 0.0, &pu, &e, *r, best_d2)
+    }
+
     /// Closest triangle to p within sqrt(best_d2): (triangle, closest point, squared distance).
     fn nearest_triangle(&self, p: &V3, mut best_d2: f64, hint: usize) -> Option<(usize, V3)> {
         let mut best = None;
@@ -241,22 +387,16 @@ impl TriMesh {
         while top > 0 {
             top -= 1;
             let node = &self.nodes[stack[top] as usize];
-            if node.distance2_point(p) > best_d2 {
+            if node.excludes_point(p, best_d2) {
                 continue;
             }
             if node.count > 0 {
                 let start = node.index as usize;
                 for t in start..start + node.count as usize {
-                    let (sc, sr) = &self.spheres[t];
-                    let ds = ((sc - p).norm() - sr).max(0.0);
-                    if ds * ds > best_d2 {
+                    if self.point_lower2(t, p) > best_d2 {
                         continue;
                     }
                     let [a, b, c] = &self.triangles[t];
-                    let h = self.face_normals[t].dot(&(p - a));
-                    if h * h > best_d2 {
-                        continue;
-                    }
                     let (cp, _) = point_triangle(p, a, b, c);
                     let d2 = (cp - p).norm_squared();
                     if d2 < best_d2 || (d2 == best_d2 && best.is_none()) {
@@ -267,8 +407,8 @@ impl TriMesh {
             } else {
                 let left = stack[top] + 1;
                 let right = node.index;
-                let dl = self.nodes[left as usize].distance2_point(p);
-                let dr = self.nodes[right as usize].distance2_point(p);
+                let dl = self.nodes[left as usize].box_distance2(p);
+                let dr = self.nodes[right as usize].box_distance2(p);
                 // nearer child on top of the stack
                 let (near, far) = if dl <= dr {
                     (left, right)
@@ -283,6 +423,89 @@ impl TriMesh {
         best
     }
 
+    /// Nearest of the segments [a, ends[j]] (a shared start, such as the two half-edges at a
+    /// cable node) to the mesh within `max_distance`, in one traversal: a node is skipped when
+    /// no segment can come nearer than the best found for any of them. Returns (distance,
+    /// index j, triangle); `hint` is a triangle to try first. The distance is the one
+    /// [`Surface::closest_to_segment`] gives for segment j.
+    pub fn nearest_of_segments(
+        &self,
+        a: &V3,
+        ends: &[V3],
+        max_distance: f64,
+        hint: usize,
+    ) -> Option<(f64, usize, usize)> {
+        const MAX_ENDS: usize = 4;
+        assert!(ends.len() <= MAX_ENDS, "at most {MAX_ENDS} segments");
+        let mut best_d2 = max_distance * max_distance;
+        let mut best: Option<(usize, usize)> = None;
+        // per segment: box, midpoint, half length
+        let mut seg = [(V3::zeros(), V3::zeros(), V3::zeros(), 0.0); MAX_ENDS];
+        let (mut vlo, mut vhi) = (*a, *a);
+        for (j, b) in ends.iter().enumerate() {
+            seg[j] = (a.inf(b), a.sup(b), (a + b) * 0.5, (b - a).norm() * 0.5);
+            vlo = vlo.inf(b);
+            vhi = vhi.sup(b);
+        }
+        let seg = &seg[..ends.len()];
+        let check = |t: usize, best_d2: &mut f64, best: &mut Option<(usize, usize)>| {
+            let [p, q, r] = &self.triangles[t];
+            for (j, b) in ends.iter().enumerate() {
+                if self.segment_excluded(t, a, b, *best_d2) {
+                    continue;
+                }
+                let (_, x, y) = segment_triangle(a, b, p, q, r);
+                let d2 = (x - y).norm_squared();
+                if d2 < *best_d2 || (d2 == *best_d2 && best.is_none()) {
+                    *best_d2 = d2;
+                    *best = Some((j, t));
+                }
+            }
+        };
+        if hint < self.triangles.len() {
+            check(hint, &mut best_d2, &mut best);
+        }
+        let mut stack = [0u32; 64];
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let node = &self.nodes[stack[top] as usize];
+            // the box of all segments first, then each segment
+            let mut d2 = 0.0;
+            for k in 0..3 {
+                let e = (node.min[k] - vhi[k]).max(vlo[k] - node.max[k]).max(0.0);
+                d2 += e * e;
+            }
+            if d2 > best_d2
+                || ends.iter().zip(seg).all(|(b, (lo, hi, mid, half))| {
+                    node.excludes_segment(a, b, lo, hi, mid, *half, best_d2)
+                })
+            {
+                continue;
+            }
+            if node.count > 0 {
+                let start = node.index as usize;
+                for t in start..start + node.count as usize {
+                    check(t, &mut best_d2, &mut best);
+                }
+            } else {
+                let left = stack[top] + 1;
+                let right = node.index;
+                let dl = self.nodes[left as usize].box_distance2(a);
+                let dr = self.nodes[right as usize].box_distance2(a);
+                let (near, far) = if dl <= dr {
+                    (left, right)
+                } else {
+                    (right, left)
+                };
+                stack[top] = far;
+                stack[top + 1] = near;
+                top += 2;
+            }
+        }
+        best.map(|(j, t)| (best_d2.sqrt(), j, t))
+    }
+
     /// Closest triangle to segment [a, b] within sqrt(best_d2).
     fn nearest_to_segment(
         &self,
@@ -295,30 +518,12 @@ impl TriMesh {
         let mid = (a + b) * 0.5;
         let half = (b - a).norm() * 0.5;
         let (lo, hi) = (a.inf(b), a.sup(b));
-        let lower2 = |n: &Node| {
-            let db = n.distance2_segment(a, b, &lo, &hi);
-            let dm = (n.distance2_point(&mid).sqrt() - half).max(0.0);
-            db.max(dm * dm)
-        };
+
         let check = |t: usize, best_d2: &mut f64, best: &mut Option<_>| {
-            // cheap lower bounds first: the triangle's bounding sphere, its plane
-            let (c, rad) = &self.spheres[t];
-            let (_, y) = point_segment(c, a, b);
-            let lb = ((c - y).norm() - rad).max(0.0);
-            if lb * lb > *best_d2 {
+            if self.segment_excluded(t, a, b, *best_d2) {
                 return;
             }
             let [p, q, r] = &self.triangles[t];
-            let n = &self.face_normals[t];
-            let (ha, hb) = (n.dot(&(a - p)), n.dot(&(b - p)));
-            let h = if ha * hb <= 0.0 {
-                0.0
-            } else {
-                ha.abs().min(hb.abs())
-            };
-            if h * h > *best_d2 {
-                return;
-            }
             let (s, x, y) = segment_triangle(a, b, p, q, r);
             let d2 = (x - y).norm_squared();
             if d2 < *best_d2 || (d2 == *best_d2 && best.is_none()) {
@@ -334,7 +539,7 @@ impl TriMesh {
         while top > 0 {
             top -= 1;
             let node = &self.nodes[stack[top] as usize];
-            if lower2(node) > best_d2 {
+            if node.excludes_segment(a, b, &lo, &hi, &mid, half, best_d2) {
                 continue;
             }
             if node.count > 0 {
@@ -345,8 +550,8 @@ impl TriMesh {
             } else {
                 let left = stack[top] + 1;
                 let right = node.index;
-                let dl = self.nodes[left as usize].distance2_point(&mid);
-                let dr = self.nodes[right as usize].distance2_point(&mid);
+                let dl = self.nodes[left as usize].box_distance2(&mid);
+                let dr = self.nodes[right as usize].box_distance2(&mid);
                 let (near, far) = if dl <= dr {
                     (left, right)
                 } else {
@@ -441,9 +646,16 @@ struct BuildData<'a> {
 /// Subtrees up to this many triangles get a slab bound (the surface is nearly flat there).
 const SLAB_MAX: usize = 64;
 
-/// The slab of a node's triangles: axis = mean normal, and the range of axis·x over them.
-fn slab(items: &[(V3, u32)], d: &BuildData) -> (V3, f64, f64) {
-    let none = (V3::zeros(), f64::NEG_INFINITY, f64::INFINITY);
+/// The slab of a node's triangles (axis = mean normal, the range of axis·x over them) and a
+/// ball holding them (center, radius); axis zero and radius infinite when there is none.
+fn slab(items: &[(V3, u32)], d: &BuildData) -> (V3, f64, f64, V3, f64) {
+    let none = (
+        V3::zeros(),
+        f64::NEG_INFINITY,
+        f64::INFINITY,
+        V3::zeros(),
+        f64::INFINITY,
+    );
     if items.len() > SLAB_MAX {
         return none;
     }
@@ -454,16 +666,28 @@ fn slab(items: &[(V3, u32)], d: &BuildData) -> (V3, f64, f64) {
     }
     let axis = mean / len;
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    let (mut bmin, mut bmax) = (V3::repeat(f64::INFINITY), V3::repeat(f64::NEG_INFINITY));
     for (_, i) in items {
         for &k in &d.faces[*i as usize] {
-            let x = axis.dot(&d.vertices[k as usize]);
+            let v = &d.vertices[k as usize];
+            let x = axis.dot(v);
             lo = lo.min(x);
             hi = hi.max(x);
+            bmin = bmin.inf(v);
+            bmax = bmax.sup(v);
+        }
+    }
+    let center = (bmin + bmax) * 0.5;
+    let mut radius: f64 = 0.0;
+    for (_, i) in items {
+        for &k in &d.faces[*i as usize] {
+            radius = radius.max((d.vertices[k as usize] - center).norm());
         }
     }
     // widen by the round-off of the projections
     let pad = 1e-12 * (lo.abs() + hi.abs() + (hi - lo));
-    (axis, lo - pad, hi + pad)
+    let radius = radius * (1.0 + 1e-12) + 1e-12 * center.norm();
+    (axis, lo - pad, hi + pad, center, radius)
 }
 
 /// Builds the hierarchy over `items` (centroid, triangle), reordering them; `offset` is the
@@ -477,13 +701,15 @@ fn build(items: &mut [(V3, u32)], offset: usize, d: &BuildData) -> Vec<Node> {
             lo = lo.inf(&a);
             hi = hi.sup(&b);
         }
-        let (axis, slo, shi) = slab(items, d);
+        let (axis, slo, shi, center, radius) = slab(items, d);
         return vec![Node {
             min: lo,
             max: hi,
             axis,
             lo: slo,
             hi: shi,
+            center,
+            radius,
             index: offset as u32,
             count: items.len() as u32,
         }];
@@ -493,7 +719,7 @@ fn build(items: &mut [(V3, u32)], offset: usize, d: &BuildData) -> Vec<Node> {
         clo = clo.inf(c);
         chi = chi.sup(c);
     }
-    let (slab_axis, slab_lo, slab_hi) = slab(items, d);
+    let (slab_axis, slab_lo, slab_hi, center, radius) = slab(items, d);
     let axis = (chi - clo).imax();
     let mid = items.len() / 2;
     items.select_nth_unstable_by(mid, |x, y| x.0[axis].total_cmp(&y.0[axis]));
@@ -516,6 +742,8 @@ fn build(items: &mut [(V3, u32)], offset: usize, d: &BuildData) -> Vec<Node> {
         axis: slab_axis,
         lo: slab_lo,
         hi: slab_hi,
+        center,
+        radius,
         index: (1 + left.len()) as u32,
         count: 0,
     });
@@ -662,6 +890,94 @@ mod tests {
                 })
                 .fold(f64::INFINITY, f64::min);
             assert_eq!(s.distance, brute);
+        }
+    }
+
+    #[test]
+    fn disk_bounds_agree_with_brute_force_over_a_curved_surface() {
+        // a bumpy height field (the clearance benchmark's shape, 40 × 40 quads) and points and
+        // half-edge-like segments nearly parallel to it, where the slab/disk bounds of nodes
+        // and triangles are tightest: the hierarchy must give the brute-force minimum exactly
+        let h =
+            |x: f64, y: f64| 0.1 * (x * 6.0).sin() * (y * 9.0).cos() + 0.05 * ((x + y) * 3.0).sin();
+        let n = 40;
+        let mut v = vec![];
+        for i in 0..=n {
+            for j in 0..=n {
+                let (x, y) = (i as f64 / n as f64, j as f64 / n as f64);
+                v.push(V3::new(x, y, h(x, y)));
+            }
+        }
+        let mut f = vec![];
+        for i in 0..n {
+            for j in 0..n {
+                let a = (i * (n + 1) + j) as u32;
+                let (b, c, d) = (a + n as u32 + 1, a + 1, a + n as u32 + 2);
+                f.push([a, b, d]);
+                f.push([a, d, c]);
+            }
+        }
+        let m = TriMesh::new(&v, &f).unwrap();
+        let tri = |t: &[u32; 3]| [0, 1, 2].map(|k| v[t[k] as usize]);
+        for q in 0..300 {
+            let (x, y) = (
+                0.1 + (q as f64 * 0.377) % 0.8,
+                0.1 + (q as f64 * 0.613) % 0.8,
+            );
+            let lift = 0.01 + 0.002 * (q % 37) as f64;
+            let a = V3::new(x, y, h(x, y) + lift);
+            let dir = V3::new((q as f64).cos(), (q as f64).sin(), 0.0) * 0.03;
+            let b = V3::new(
+                a.x + dir.x,
+                a.y + dir.y,
+                h(a.x + dir.x, a.y + dir.y) + lift * 0.9,
+            );
+            let r = m.project_point(&a, f64::INFINITY, q).unwrap();
+            let brute = f
+                .iter()
+                .map(|t| {
+                    let [p, u, w] = tri(t);
+                    (point_triangle(&a, &p, &u, &w).0 - a).norm()
+                })
+                .fold(f64::INFINITY, f64::min);
+            assert_eq!(r.distance, brute);
+            for bound in [f64::INFINITY, brute * 1.01] {
+                let s = m.closest_to_segment(&a, &b, bound, usize::MAX).unwrap();
+                let brute = f
+                    .iter()
+                    .map(|t| {
+                        let [p, u, w] = tri(t);
+                        let (_, x, y) = segment_triangle(&a, &b, &p, &u, &w);
+                        (x - y).norm()
+                    })
+                    .fold(f64::INFINITY, f64::min);
+                assert_eq!(s.distance, brute, "query {q}");
+            }
+            // both half-edges of a node at a (to b and to a point on the other side) at once
+            let c = V3::new(a.x - dir.y * 0.5, a.y + dir.x * 0.5, a.z - lift * 0.3);
+            let seg_brute = |e: &V3| {
+                f.iter()
+                    .map(|t| {
+                        let [p, u, w] = tri(t);
+                        let (_, x, y) = segment_triangle(&a, e, &p, &u, &w);
+                        (x - y).norm()
+                    })
+                    .fold(f64::INFINITY, f64::min)
+            };
+            let (db, dc) = (seg_brute(&b), seg_brute(&c));
+            let (d, j, t) = m
+                .nearest_of_segments(&a, &[b, c], f64::INFINITY, q)
+                .unwrap();
+            assert_eq!(d, db.min(dc), "query {q}");
+            assert_eq!(d, if j == 0 { db } else { dc });
+            let [p, u, w] = m.triangle(t);
+            let e = if j == 0 { b } else { c };
+            let (_, x, y) = segment_triangle(&a, &e, &p, &u, &w);
+            assert_eq!((x - y).norm(), d);
+            // nothing within a bound below the distance (d = 0: a half-edge crosses)
+            if d > 0.0 {
+                assert!(m.nearest_of_segments(&a, &[b, c], d * 0.99, t).is_none());
+            }
         }
     }
 
