@@ -537,3 +537,133 @@ def test_panel_edit_and_undo_buttons(scene_copy):
     assert np.abs(np.array(n1) - np.array(n0)).max() > 1e-3
     assert n2 == n0
     assert "covers s = [1.7, 1.7] m, outside the cable [0, 1.0] m" in refused
+
+
+# ----------------------------------------------------------------------- harnesses, clip types
+
+HARNESS = ROOT / "examples" / "harness" / "scene.toml"
+BRACKET = np.array([0.8, 0.15, -0.05])  # the harness's engine-bracket clip (cable "engine")
+
+
+def harness_path(n: int = 50) -> np.ndarray:
+    """A drag path of the harness's engine bracket: 3 cm up and sideways along a quarter circle."""
+    a = np.linspace(0.0, np.pi / 2, n)
+    return BRACKET + 0.03 * np.column_stack([np.zeros(n), 1 - np.cos(a), np.sin(a)])
+
+
+@pytest.fixture
+def harness_copy(tmp_path):
+    target = tmp_path / "harness.toml"
+    shutil.copy(HARNESS, target)
+    return target
+
+
+def batch_harness(scene):
+    """A cold batch static solve of a harness scene with its bodies at rest: (cable nodes by
+    name, junction positions by name)."""
+    from cablelife.simulate import simulate
+    from cablelife.workbench.session import at_rest
+
+    r = simulate(at_rest(scene), mode="static")
+    return ({n: c.positions[0] for n, c in r.cables.items()},
+            {n: j.position[0] for n, j in r.junctions.items()})  # fmt: skip
+
+
+def test_harness_drag_moves_every_cable_and_the_junction(harness_copy, tmp_path):
+    """Dragging one clip of a harness re-solves the tree: every cable and the junction move,
+    the clip's node is at the clip, and the warm equilibrium equals a cold batch solve of the
+    saved scene."""
+    session = Session.open(harness_copy)
+    x0 = {n: c.state.positions.copy() for n, c in session.cables.items()}
+    j0 = np.array(session.state()["junctions"]["breakout"]["position"])
+    node = clip_node(session, "engine", "engine-bracket")
+    for p in harness_path(20):
+        errors = session.move_clips([{"cable": "engine", "clip": "engine-bracket",
+                                      "position": p.tolist()}])  # fmt: skip
+        assert errors == {"engine": ""}
+        np.testing.assert_allclose(session.cables["engine"].state.positions[node], p, atol=1e-12)
+    out = session.save(tmp_path / "saved.toml")
+    cables, junctions = batch_harness(load_scene(out))
+    for name, live in session.cables.items():
+        assert np.abs(live.state.positions - cables[name]).max() < 1e-9, name
+        assert np.abs(live.state.positions - x0[name]).max() > 1e-3, name  # it answered
+    j1 = np.array(session.state()["junctions"]["breakout"]["position"])
+    assert np.abs(j1 - junctions["breakout"]).max() < 1e-9
+    assert np.linalg.norm(j1 - j0) > 1e-3
+    # the clips of the other cables stay put, the joined ends sit on the junction
+    trunk = session.cables["trunk"].state.positions
+    np.testing.assert_allclose(trunk[0], [0.0, 0.0, 0.0], atol=1e-12)
+    np.testing.assert_allclose(trunk[-1], j1, atol=1e-12)
+    # undo goes back to the scene as loaded
+    for _ in range(20):
+        assert session.undo()
+    assert session.scene_text() == HARNESS.read_text()
+    np.testing.assert_allclose(session.cables["body"].state.positions, x0["body"], atol=1e-9)
+
+
+def test_harness_failed_solve_keeps_every_cable(harness_copy):
+    session = Session.open(harness_copy)
+    before = {n: c.state.positions.copy() for n, c in session.cables.items()}
+    text = session.scene_text()
+    errors = session.move_clips([{"cable": "engine", "clip": "engine-bracket",
+                                  "position": [5000.0, 0.0, 0.0]}])  # fmt: skip
+    assert "harness: no equilibrium at the new clip pose" in errors["engine"]
+    for n, live in session.cables.items():
+        assert np.array_equal(live.state.positions, before[n])
+    assert session.scene_text() == text
+    p = (BRACKET + [0.0, 0.005, 0.0]).tolist()
+    assert session.move_clips([{"cable": "engine", "clip": "engine-bracket", "position": p}]) \
+        == {"engine": ""}  # fmt: skip
+
+
+def test_harness_edits_rebuild_the_tree(harness_copy):
+    session = Session.open(harness_copy)
+    session.edit("gearbox", "gearbox-clip", "type", "hinge")
+    clip = session.cable_spec("gearbox").clips[0]
+    assert (clip.type, clip.axis, clip.length) == ("hinge", (0.0, 1.0, 0.0), 0.0)
+    session.edit("body", "", "length", 0.37)
+    cables, _ = batch_harness(edited_scene(session))
+    for name, live in session.cables.items():
+        assert np.abs(live.state.positions - cables[name]).max() < 1e-9, name
+    session.edit("gearbox", "gearbox-clip", "s", 0.3)  # off the end: a guide would fit
+    with pytest.raises(SceneError, match="sliding clip 'gearbox-clip' on a cable of a harness"):
+        session.edit("gearbox", "gearbox-clip", "type", "sliding")
+    assert session.cable_spec("gearbox").clips[0].type == "hinge"
+
+
+def test_hinge_and_sliding_clip_types(scene_copy):
+    """A clip turned into a hinge gets an axis (shown in global coordinates) that can be
+    edited; into a sliding guide a length, and the panel's slid length is the solver's."""
+    from cablelife.simulate import simulate
+    from cablelife.workbench.session import at_rest
+
+    session = Session.open(scene_copy)
+    session.edit("hose", "middle", "type", "hinge")
+    st = session.state()["cables"]["hose"]
+    frame = np.array(st["clipFrames"][1]).T  # columns d1, d2, d3
+    np.testing.assert_allclose(st["clipAxes"][1], frame[:, 1], atol=1e-12)
+    assert st["clipAxes"][0] is None and st["figures"]["clips"][1]["axis"] == [0.0, 1.0, 0.0]
+    session.edit("hose", "middle", "axis", [1.0, 0.0, 1.0])
+    st = session.state()["cables"]["hose"]
+    np.testing.assert_allclose(st["clipAxes"][1], (frame[:, 0] + frame[:, 2]) / np.sqrt(2),
+                               atol=1e-12)  # fmt: skip
+    ref = batch_equilibrium(edited_scene(session), "hose")
+    assert np.abs(session.cables["hose"].state.positions - ref).max() < 1e-9
+    with pytest.raises(WorkbenchError, match=r"axis = \[1, 'a'\]; give three numbers"):
+        session.edit("hose", "middle", "axis", [1, "a"])
+    with pytest.raises(WorkbenchError, match="axis given for a fixed clip"):
+        session.edit("hose", "engine-bracket", "axis", [1, 0, 0])
+    session.edit("hose", "middle", "type", "sliding")
+    clip = session.cable_spec("hose").clips[1]
+    assert clip.axis is None and clip.length == pytest.approx(4 * 1.0 / 50)  # four edges
+    for k in range(1, 11):  # the end clip pulled back 2 cm: the cable slides through
+        p = [0.75, 0.25 - 0.002 * k, 0.0]
+        assert session.move_clips([{"cable": "hose", "clip": CLIP, "position": p}]) \
+            == {"hose": ""}  # fmt: skip
+    slid = session.state()["cables"]["hose"]["figures"]["clips"][1]["slid"]
+    r = simulate(at_rest(edited_scene(session)), mode="static").cables["hose"]
+    assert slid == pytest.approx(float(r.clips["middle"].slid_length[0]), abs=1e-9)
+    assert abs(slid) > 1e-4
+    assert np.abs(session.cables["hose"].state.positions - r.positions[0]).max() < 1e-9
+    session.edit("hose", "middle", "type", "swivel")
+    assert session.state()["cables"]["hose"]["figures"]["clips"][1]["slid"] is None

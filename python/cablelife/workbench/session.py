@@ -76,6 +76,7 @@ class Equilibrium:
     reaction_moment: np.ndarray  # (C, 3)
     iterations: int
     solve_ms: float
+    slid: np.ndarray | None = None  # (C,) m: cable slid through each clip since its s
 
 
 @dataclass
@@ -107,6 +108,7 @@ class Session:
     lock: threading.RLock = field(default_factory=threading.RLock)
     pool: ThreadPoolExecutor | None = None
     solves: int = 0
+    harness: object = None  # harness_live.LiveHarness when the scene has [[junctions]]
 
     # ------------------------------------------------------------------ opening
     @classmethod
@@ -118,17 +120,11 @@ class Session:
 
         path = Path(path)
         scene = load_scene(path)
-        if getattr(scene, "junctions", None):  # harnesses (issue 16): not solved here yet
-            raise SceneError(
-                f"{str(path)!r} has [[junctions]] (a harness); the workbench solves single "
-                "cables only so far: run the harness with `cablelife run`"
-            )
         doc = tomlkit.parse(path.read_text(encoding="utf-8"))
         session = cls(path=path, scene=scene, doc=doc, bend_factor=bend_factor)
         session.env = load_surroundings(scene)
         session.pool = ThreadPoolExecutor(max_workers=max(1, min(len(scene.cables), 4)))
-        for cable in scene.cables:
-            session._rebuild(cable)
+        session._rebuild_all()
         failed = [c for c in session.cables.values() if c.state is None]
         if failed:
             raise SceneError(
@@ -140,11 +136,51 @@ class Session:
         if self.pool is not None:
             self.pool.shutdown(wait=False, cancel_futures=True)
 
+    def _rebuild_all(self) -> None:
+        """Fresh solvers for every cable (one harness solver for a harness), solved."""
+        if self.scene.junctions:
+            self._rebuild_harness()
+        else:
+            for cable in self.scene.cables:
+                self._rebuild(cable)
+
+    def _live_cable(self, cable: Cable, core, pos: np.ndarray, quat: np.ndarray) -> LiveCable:
+        props = cable.properties()
+        return LiveCable(
+            name=cable.name,
+            core=core,
+            arc_length=np.asarray(core.arc_length),
+            clip_positions=pos,
+            clip_quaternions=quat,
+            stiffness=np.array(
+                [props.bend_stiffness[0], props.bend_stiffness[1], props.bend_stiffness[2]]
+            ),  # fmt: skip
+            radius=float(props.outer_radius),
+        )
+
+    def _rebuild_harness(self) -> None:
+        """A fresh harness solver for the whole tree, solved from the routed shapes."""
+        from cablelife.workbench.harness_live import build_harness
+
+        self.harness, lives = build_harness(self.scene, self._live_cable)
+        self.cables.update(lives)
+        self._solve_harness({})
+
+    def _solve_harness(self, targets: dict) -> bool:
+        from cablelife.workbench.harness_live import solve_harness
+
+        ok = solve_harness(self.harness, self.cables, targets, _equilibrium)
+        self.solves += ok
+        return ok
+
     def _rebuild(self, cable: Cable) -> LiveCable:
         """A fresh solver for ``cable`` (its mesh follows the clips), solved from its route."""
         from cablelife.contact_settings import set_contact
         from cablelife.simulate import clip_poses
 
+        if self.scene.junctions:
+            self._rebuild_harness()
+            return self.cables[cable.name]
         core = build_cable(self.scene, cable)
         if self.scene.contact is not None and self.scene.contact.enabled:
             try:
@@ -152,18 +188,7 @@ class Session:
             except ValueError as err:
                 raise SceneError(f"cable '{cable.name}': {err}") from None
         pos, quat = clip_poses(self.scene, cable, np.array([0.0]), with_motion=False)
-        props = cable.properties()
-        live = LiveCable(
-            name=cable.name,
-            core=core,
-            arc_length=np.asarray(core.arc_length),
-            clip_positions=pos[0].copy(),
-            clip_quaternions=quat[0].copy(),
-            stiffness=np.array(
-                [props.bend_stiffness[0], props.bend_stiffness[1], props.bend_stiffness[2]]
-            ),  # fmt: skip
-            radius=float(props.outer_radius),
-        )
+        live = self._live_cable(cable, core, pos[0].copy(), quat[0].copy())
         self.cables[cable.name] = live
         self._solve(live, live.clip_positions, live.clip_quaternions)
         return live
@@ -199,20 +224,10 @@ class Session:
             live.message = f"cable '{live.name}': no equilibrium at the new clip pose ({err})"
             return False
         ms = (time.perf_counter() - start) * 1e3
-        x = out["positions"][0]
-        if not np.isfinite(x).all():
+        if not np.isfinite(out["positions"][0]).all():
             live.message = f"cable '{live.name}': the solve gave non-finite positions"
             return False
-        live.state = Equilibrium(
-            positions=x,
-            quaternions=out["quaternions"][0],
-            forces=out["forces"][0],
-            moments=out["moments"][0],
-            reaction_force=out["reaction_force"][0],
-            reaction_moment=out["reaction_moment"][0],
-            iterations=int(out["iterations"][0]),
-            solve_ms=ms,
-        )
+        live.state = _equilibrium(out, len(live.clip_positions), ms)
         live.clip_positions = np.array(positions, float)
         live.clip_quaternions = np.array(quaternions, float)
         live.message = ""
@@ -267,9 +282,13 @@ class Session:
             if mark:
                 self._push_undo()
             names = list(targets)
-            results = list(
-                self.pool.map(lambda n: self._solve(self.cables[n], *targets[n][:2]), names)
-            )
+            if self.harness is not None:  # one system: every cable of the tree answers
+                ok = self._solve_harness({n: targets[n][:2] for n in names})
+                results = [ok] * len(names)
+            else:
+                results = list(
+                    self.pool.map(lambda n: self._solve(self.cables[n], *targets[n][:2]), names)
+                )
             errors = {}
             for name, ok in zip(names, results, strict=True):
                 if ok:
@@ -300,14 +319,17 @@ class Session:
 
     # ------------------------------------------------------------------ edits
     def edit(self, cable: str, item: str, key: str, value) -> None:
-        """Sets a clip's ``s``, ``type`` or ``length`` (item = the clip's name) or the cable's
-        ``length`` (item = ""), validated as a scene; rebuilds and re-solves the cable. On an
-        invalid value or a failed solve nothing changes."""
+        """Sets a clip's ``s``, ``type``, ``length`` or hinge ``axis`` (item = the clip's name)
+        or the cable's ``length`` (item = ""), validated as a scene; rebuilds and re-solves the
+        cable (the whole harness on a harness). A new type brings what it needs: a hinge the
+        axis d2 ([0, 1, 0]) and a point, a sliding clip a guide of four edges when it held a
+        point; a type without them drops axis and friction. On an invalid value or a failed
+        solve nothing changes."""
         with self.lock:
             spec = self.cable_spec(cable)
             if item:
-                self.clip_index(spec, item)
-                allowed = ("s", "type", "length")
+                clip = spec.clips[self.clip_index(spec, item)]
+                allowed = ("s", "type", "length", "axis")
             else:
                 allowed = ("length",)
             if key not in allowed:
@@ -320,7 +342,24 @@ class Session:
                     f"cable '{cable}', clip '{item}': type = {value!r}; allowed: "
                     + ", ".join(CLIP_TYPES)
                 )
-            if key != "type":
+            if key == "axis":
+                ok = (
+                    isinstance(value, list | tuple)
+                    and len(value) == 3
+                    and all(isinstance(v, int | float) and not isinstance(v, bool) for v in value)
+                )
+                if not ok:
+                    raise WorkbenchError(
+                        f"cable '{cable}', clip '{item}': axis = {value!r}; give three numbers "
+                        "[a1, a2, a3] in the clip frame"
+                    )
+                if clip.type != "hinge":
+                    raise WorkbenchError(
+                        f"cable '{cable}', clip '{item}': axis given for a {clip.type} clip; "
+                        "only a hinge clip has an axis"
+                    )
+                value = [float(v) for v in value]
+            elif key != "type":
                 if isinstance(value, bool) or not isinstance(value, int | float):
                     raise WorkbenchError(
                         f"cable '{cable}'{f', clip {item!r}' if item else ''}: {key} = "
@@ -334,6 +373,8 @@ class Session:
             self.doc = tomlkit.parse(old_doc.as_string())
             entry = self._toml_clip(cable, item) if item else self._toml_cable(cable)
             entry[key] = value
+            if key == "type":
+                _type_needs(entry, value, spec)
             try:
                 self._reload(cable)
             except (SceneError, WorkbenchError):
@@ -350,15 +391,20 @@ class Session:
         )
         keep_scene, keep_cables = self.scene, dict(self.cables)
         # clip poses edited by dragging live in the document too: the new scene has them
+        keep_harness = self.harness
         self.scene = scene
         try:
+            if scene.junctions:
+                self._rebuild_harness()
+                if self.harness.message:
+                    raise SceneError(self.harness.message)
             for c in scene.cables:
-                if changed is None or c.name == changed:
+                if not scene.junctions and (changed is None or c.name == changed):
                     live = self._rebuild(c)
                     if live.state is None:
                         raise SceneError(live.message)
         except SceneError:
-            self.scene, self.cables = keep_scene, keep_cables
+            self.scene, self.cables, self.harness = keep_scene, keep_cables, keep_harness
             raise
 
     def undo(self) -> bool:
@@ -472,6 +518,8 @@ class Session:
                     "type": c.type,
                     "length": c.length,
                     "body": c.body,
+                    "axis": None if c.axis is None else list(c.axis),
+                    "slid": _slid(st, j) if c.type == "sliding" else None,
                     "force": st.reaction_force[j].tolist(),
                     "moment": st.reaction_moment[j].tolist(),
                 }
@@ -500,11 +548,23 @@ class Session:
                     "radius": live.radius,
                     "clipPositions": live.clip_positions.tolist(),
                     "clipFrames": [r.T.tolist() for r in frames],  # rows d1, d2, d3
+                    "clipAxes": [
+                        _hinge_axis(c, r)
+                        for c, r in zip(self.cable_spec(name).clips, frames, strict=True)
+                    ],  # fmt: skip
                     "values": self.node_values(live),
                     "figures": self.figures(live),
                     "message": live.message,
                 }
-            return {"cables": cables, "solves": self.solves, "undo": len(self.undo_stack)}
+            out = {"cables": cables, "solves": self.solves, "undo": len(self.undo_stack)}
+            h = self.harness
+            if h is not None and h.junction_positions is not None:
+                out["junctions"] = {
+                    name: {"position": h.junction_positions[k].tolist(),
+                           "frame": quat_matrix(h.junction_quaternions[k]).T.tolist()}
+                    for k, name in enumerate(h.junction_names)
+                }  # fmt: skip
+            return out
 
     def geometry(self) -> dict:
         """The bodies' meshes (global, at rest) and names, for the page (once)."""
@@ -544,6 +604,50 @@ def strain_warning(live: LiveCable) -> str:
                 "the cable"
             )
     return ""
+
+
+def _type_needs(entry, kind: str, cable: Cable) -> None:
+    """Completes a clip's TOML entry for its new type (see ``Session.edit``)."""
+    if kind != "hinge":
+        entry.pop("axis", None)
+    if kind != "sliding":
+        entry.pop("friction", None)
+    if kind in ("hinge", "ball"):
+        entry["length"] = 0.0
+    if kind == "hinge" and "axis" not in entry:
+        entry["axis"] = [0.0, 1.0, 0.0]
+    if kind == "sliding" and not entry.get("length"):
+        entry["length"] = _tidy(4 * cable.length / cable.n_segments)
+
+
+def _hinge_axis(clip: Clip, frame: np.ndarray) -> list[float] | None:
+    """A hinge clip's turning axis in global coordinates (unit), else None."""
+    if clip.type != "hinge" or clip.axis is None:
+        return None
+    a = frame @ np.asarray(clip.axis, float)
+    return (a / np.linalg.norm(a)).tolist()
+
+
+def _slid(st: Equilibrium, j: int) -> float | None:
+    if st.slid is None or not np.isfinite(st.slid[j]):
+        return None
+    return float(st.slid[j])
+
+
+def _equilibrium(out: dict, clips: int, ms: float) -> Equilibrium:
+    """The Equilibrium of a one-step solver record (the first ``clips`` clips: the user's)."""
+    slid = out.get("slid_length")
+    return Equilibrium(
+        positions=out["positions"][0],
+        quaternions=out["quaternions"][0],
+        forces=out["forces"][0],
+        moments=out["moments"][0],
+        reaction_force=out["reaction_force"][0][:clips],
+        reaction_moment=out["reaction_moment"][0][:clips],
+        iterations=int(np.asarray(out["iterations"]).reshape(-1)[0]),
+        solve_ms=ms,
+        slid=None if slid is None else np.asarray(slid)[0][:clips],
+    )
 
 
 def _tidy(v: float) -> float:

@@ -8,7 +8,7 @@
   var info = null, live = null, shown = null, playing = null;
   var quantity = "bending";
   var renderer, scene, camera, orbit, gizmo, dirty = true;
-  var tubes = {}, clipObjects = {}, bodyMeshes = {}, selected = null;
+  var tubes = {}, clipObjects = {}, bodyMeshes = {}, junctionObjects = {}, selected = null;
   var ws, nextId = 1, waiting = {}, inflight = false, pending = null, dragMark = false, idleWaiters = [];
   var updateTimes = [], frameTimes = [], lastSolveMs = 0;
   var statusText = "";
@@ -207,6 +207,39 @@
     return grp;
   }
 
+  // A hinge clip's turning axis: a grey rod through the clip (global axis, set per state).
+  function setHingeAxis(o, axis, size) {
+    if (!axis) { if (o.userData.axis) o.userData.axis.visible = false; return; }
+    if (!o.userData.axis) {
+      var rod = new THREE.Mesh(new THREE.CylinderBufferGeometry(size * 0.12, size * 0.12, size * 6, 8), new THREE.MeshLambertMaterial({color: 0x7f3fbf}));
+      rod.name = "hinge-axis";
+      scene.add(rod);
+      o.userData.axis = rod;
+    }
+    var rod = o.userData.axis;
+    rod.visible = o.visible;
+    rod.position.copy(o.position);
+    rod.quaternion.setFromUnitVectors(new THREE.Vector3(0, 1, 0), new THREE.Vector3(axis[0], axis[1], axis[2]));
+  }
+
+  // Junctions: a sphere with its frame (a harness's break-outs), posed per state.
+  function drawJunctions(junctions, size) {
+    Object.keys(junctions || {}).forEach(function (n) {
+      var j = junctions[n], o = junctionObjects[n];
+      if (!o) {
+        o = new THREE.Group();
+        o.add(new THREE.Mesh(new THREE.SphereBufferGeometry(size, 16, 12), new THREE.MeshLambertMaterial({color: 0xff9f1c})));
+        [[1, 0, 0, 0xd62728], [0, 1, 0, 0x2ca02c], [0, 0, 1, 0x1f77b4]].forEach(function (a) {
+          o.add(new THREE.ArrowHelper(new THREE.Vector3(a[0], a[1], a[2]), new THREE.Vector3(), size * 3, a[3], size * 0.8, size * 0.5));
+        });
+        o.name = "junction:" + n;
+        scene.add(o);
+        junctionObjects[n] = o;
+      }
+      setClipPose(o, j.position, j.frame);
+    });
+  }
+
   function setClipPose(o, p, rows) {
     o.position.set(p[0], p[1], p[2]);
     var m = new THREE.Matrix4().makeBasis(
@@ -238,9 +271,13 @@
         c.figures.clips.forEach(function (k, j) {
           var o = clipObjects[n][k.name];
           if (!(gizmo.dragging && selected && selected.cable === n && selected.clip === k.name)) setClipPose(o, c.clipPositions[j], c.clipFrames[j]);
+          if (c.clipAxes) setHingeAxis(o, c.clipAxes[j], Math.max(c.radius * 2.5, 0.004));
         });
       }
     });
+    var rmax = 0;
+    Object.keys(state.cables).forEach(function (n) { rmax = Math.max(rmax, state.cables[n].radius); });
+    if (withClips && state.junctions) drawJunctions(state.junctions, Math.max(rmax * 1.6, 0.004));
     drawColourBar(r);
     shown = state;
     dirty = true;
@@ -271,6 +308,7 @@
       if (f.minClearance !== undefined) html += '<tr><td>min clearance</td><td class="num' + (f.minClearance < 0 ? " bad" : "") + '">' + fmt(f.minClearance * 1e3, 3) + " mm at s = " + fmt(f.minClearanceS, 3) + " m</td></tr>";
       html += '<tr><td>last solve</td><td class="num">' + fmt(f.solveMs, 2) + " ms, " + f.iterations + " iterations</td></tr>";
       html += "</table><table><tr><th>clip</th><th>s [m]</th><th>type</th><th>length [m]</th><th>|F| [N]</th><th>|M| [N m]</th></tr>";
+      var extra = [];
       f.clips.forEach(function (k) {
         var sel = selected && selected.cable === n && selected.clip === k.name;
         var fn = Math.hypot.apply(null, k.force), mn = Math.hypot.apply(null, k.moment);
@@ -281,8 +319,12 @@
           "<td><select" + d + ' data-key="type">' + opts + "</select></td>" +
           '<td><input type="number" step="0.005"' + d + ' data-key="length" value="' + k.length + '" style="width:46px"></td>' +
           '<td class="num">' + fmt(fn, 3) + '</td><td class="num">' + fmt(mn, 3) + "</td></tr>";
+        if (k.type === "hinge" && k.axis) extra.push("<tr" + d + "><td>" + esc(k.name) + '</td><td>hinge axis (d1, d2, d3)</td><td class="num">' +
+          k.axis.map(function (a, i) { return '<input type="number" step="0.1" class="axis"' + d + ' data-key="axis" data-index="' + i + '" value="' + a + '" style="width:40px">'; }).join("") + "</td></tr>");
+        if (k.type === "sliding") extra.push("<tr" + d + "><td>" + esc(k.name) + '</td><td>slid through</td><td class="num slid">' + (k.slid === null ? "–" : fmt(k.slid * 1e3, 3) + " mm") + "</td></tr>");
       });
       html += "</table>";
+      if (extra.length) html += '<table class="clip-extra">' + extra.join("") + "</table>";
     });
     var box = $("cables");
     if (box.contains(document.activeElement) && document.activeElement.tagName === "INPUT") return; // typing
@@ -356,7 +398,12 @@
 
   // ---------------------------------------------------------------- result file
   function showClips(on) {
-    Object.keys(clipObjects).forEach(function (c) { Object.keys(clipObjects[c]).forEach(function (k) { clipObjects[c][k].visible = on; }); });
+    Object.keys(clipObjects).forEach(function (c) { Object.keys(clipObjects[c]).forEach(function (k) {
+      var o = clipObjects[c][k];
+      o.visible = on;
+      if (o.userData.axis && !on) o.userData.axis.visible = false;
+    }); });
+    Object.keys(junctionObjects).forEach(function (n) { junctionObjects[n].visible = on; });
     gizmo.visible = on && selected !== null;
     if (!on) gizmo.detach(); else if (selected) gizmo.attach(clipObjects[selected.cable][selected.clip]);
   }
@@ -436,6 +483,7 @@
         c.figures.clips.forEach(function (k) { clipObjects[n][k.name] = makeClip(n, k.name, size); });
       });
       fitCamera(st);
+      document.body.dataset.junctions = Object.keys(st.junctions || {}).length;
       applyLive(st);
       $("mode-translate").onclick = function () { setMode("translate"); };
       $("mode-rotate").onclick = function () { setMode("rotate"); };
@@ -445,6 +493,7 @@
         var t = e.target, key = t.dataset.key;
         if (!key) return;
         var value = key === "type" ? t.value : parseFloat(t.value);
+        if (key === "axis") value = Array.prototype.map.call(document.querySelectorAll('input.axis[data-cable="' + t.dataset.cable + '"][data-item="' + t.dataset.item + '"]'), function (e) { return parseFloat(e.value); });
         request({op: "edit", cable: t.dataset.cable, item: t.dataset.item, key: key, value: value}).catch(function (err) {
           showMessage(err.message, true); panel(live);
         });
@@ -492,7 +541,25 @@
       var out = {cables: {}};
       if (!live) return out;
       Object.keys(live.cables).forEach(function (n) { out.cables[n] = {positions: live.cables[n].positions}; });
+      if (live.junctions) {
+        out.junctions = {};
+        Object.keys(live.junctions).forEach(function (n) { out.junctions[n] = {position: live.junctions[n].position, drawn: junctionObjects[n].position.toArray()}; });
+      }
       return out;
+    },
+    // the side panel's text of a clip's extra rows (hinge axis, slid length), for tests
+    clipExtra: function (cable, clip) {
+      var rows = document.querySelectorAll('table.clip-extra tr[data-cable="' + cable + '"][data-item="' + clip + '"]');
+      return Array.prototype.map.call(rows, function (r) {
+        var axis = r.querySelectorAll("input.axis");
+        return axis.length ? {axis: Array.prototype.map.call(axis, function (e) { return parseFloat(e.value); })} : {slid: r.querySelector(".slid").textContent};
+      });
+    },
+    // a hinge clip's drawn axis (global unit vector) or null
+    hingeAxis: function (cable, clip) {
+      var a = clipObjects[cable][clip].userData.axis;
+      if (!a || !a.visible) return null;
+      return new THREE.Vector3(0, 1, 0).applyQuaternion(a.quaternion).toArray();
     },
     stats: function () {
       return {solvesPerSecond: rate(updateTimes), lastSolveMs: lastSolveMs, framesPerSecond: rate(frameTimes)};
