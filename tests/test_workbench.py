@@ -667,3 +667,103 @@ def test_hinge_and_sliding_clip_types(scene_copy):
     assert np.abs(session.cables["hose"].state.positions - r.positions[0]).max() < 1e-9
     session.edit("hose", "middle", "type", "swivel")
     assert session.state()["cables"]["hose"]["figures"]["clips"][1]["slid"] is None
+
+
+def test_page_follows_a_dragged_harness_clip(harness_copy, tmp_path):
+    """The harness example in the page: 50 moveClip calls on its engine bracket; after each
+    the clip's node is at the clip and the junction is drawn where the solver put it; the last
+    equilibrium of every cable equals a batch static solve of the saved scene."""
+    _browser()
+    import time
+
+    from cablelife.workbench.drive import run_page, workbench_process
+
+    points = harness_path(50)
+    shots = Path(os.environ.get("CABLELIFE_SCREENSHOTS", tmp_path))
+    session = Session.open(harness_copy)  # the node of the clip (s = 0.45, the cable's end)
+    node = clip_node(session, "engine", "engine-bracket")
+    session.close()
+
+    async def script(page):
+        first = await page.call("state()")
+        seen = []
+        t0 = time.perf_counter()
+        for p in points:
+            await page.call(f"moveClip('engine', 'engine-bracket', {p.tolist()})")
+            seen.append(await page.call("state()"))
+        wall = time.perf_counter() - t0
+        junctions = await page.cdp.evaluate("document.body.dataset.junctions")
+        await page.call("select('engine', 'engine-bracket')")
+        shot = await page.screenshot(shots / "workbench-harness.png")
+        saved = await page.call(f"save({str(tmp_path / 'saved.toml')!r})")
+        return first, seen, wall, junctions, shot, saved
+
+    with workbench_process(harness_copy) as (_, url):
+        first, seen, wall, junctions, shot, saved = run_page(url, script)
+    print(f"\nworkbench harness: 50 moveClip calls in {wall:.2f} s = {50 / wall:.1f} updates/s")
+    assert junctions == "1"
+    for p, st in zip(points, seen, strict=True):
+        np.testing.assert_allclose(st["cables"]["engine"]["positions"][node], p, atol=1e-12)
+        j = st["junctions"]["breakout"]
+        np.testing.assert_allclose(j["drawn"], j["position"], atol=1e-6)  # float32 on screen
+        np.testing.assert_allclose(st["cables"]["trunk"]["positions"][-1], j["position"],
+                                   atol=1e-12)  # fmt: skip
+    assert saved["ok"]
+    cables, junctions_ref = batch_harness(load_scene(tmp_path / "saved.toml"))
+    last = seen[-1]
+    for name, x in cables.items():
+        assert np.abs(np.array(last["cables"][name]["positions"]) - x).max() < 1e-9, name
+        moved = np.array(last["cables"][name]["positions"]) - first["cables"][name]["positions"]
+        assert np.abs(moved).max() > 1e-3, name  # every cable of the tree answered
+    assert np.abs(np.array(last["junctions"]["breakout"]["position"])
+                  - junctions_ref["breakout"]).max() < 1e-9  # fmt: skip
+    assert shot.stat().st_size > 20_000
+
+
+def test_page_hinge_axis_and_slid_length(scene_copy, tmp_path):
+    """Clip types in the page: a hinge's axis drawn along its global axis and shown in the
+    panel, a sliding clip's slid length in the panel."""
+    _browser()
+    from cablelife.workbench.drive import run_page, workbench_process
+
+    shots = Path(os.environ.get("CABLELIFE_SCREENSHOTS", tmp_path))
+    select = (
+        "(() => {{ const e = document.querySelector('select[data-item=\"middle\"]'); "
+        "e.value = '{0}'; e.dispatchEvent(new Event('change', {{bubbles: true}})); }})()"
+    )
+    options = "Array.from(document.querySelector('select[data-item=\"middle\"]').options)" \
+        ".map(o => o.value)"  # fmt: skip
+
+    async def script(page):
+        types = await page.cdp.evaluate(options)
+        await page.cdp.evaluate(select.format("hinge"))
+        await page.call("settled()")
+        axis = await page.call("hingeAxis('hose', 'middle')")
+        extra = await page.call("clipExtra('hose', 'middle')")
+        await page.call("select('hose', 'middle')")
+        shot = await page.screenshot(shots / "workbench-hinge.png")
+        await page.cdp.evaluate(select.format("sliding"))
+        await page.call("settled()")
+        gone = await page.call("hingeAxis('hose', 'middle')")
+        for k in range(1, 11):
+            await page.call(f"moveClip('hose', '{CLIP}', [0.75, {0.25 - 0.002 * k}, 0.0])")
+        slid = await page.call("clipExtra('hose', 'middle')")
+        return types, axis, extra, shot, gone, slid
+
+    with workbench_process(scene_copy) as (_, url):
+        types, axis, extra, shot, gone, slid = run_page(url, script)
+    assert types == ["fixed", "swivel", "ball", "hinge", "sliding"]
+    # hinge about d2 of the clip frame (direction [1, 0.3, 0], normal [0, 0, 1])
+    d3 = np.array([1.0, 0.3, 0.0]) / np.hypot(1.0, 0.3)
+    np.testing.assert_allclose(axis, np.cross(d3, [0.0, 0.0, 1.0]), atol=1e-6)
+    assert extra == [{"axis": [0, 1, 0]}]
+    assert gone is None
+    session = Session.open(scene_copy)  # the same edits and moves without the page
+    session.edit("hose", "middle", "type", "sliding")
+    for k in range(1, 11):
+        session.move_clips([{"cable": "hose", "clip": CLIP,
+                             "position": [0.75, 0.25 - 0.002 * k, 0.0]}])  # fmt: skip
+    value = session.state()["cables"]["hose"]["figures"]["clips"][1]["slid"]
+    assert len(slid) == 1 and slid[0]["slid"].endswith(" mm") and abs(value) > 1e-4
+    assert float(slid[0]["slid"].split()[0]) == pytest.approx(value * 1e3, rel=5e-3)  # 4 digits
+    assert shot.stat().st_size > 20_000

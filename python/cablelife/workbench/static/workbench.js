@@ -211,7 +211,7 @@
   function setHingeAxis(o, axis, size) {
     if (!axis) { if (o.userData.axis) o.userData.axis.visible = false; return; }
     if (!o.userData.axis) {
-      var rod = new THREE.Mesh(new THREE.CylinderBufferGeometry(size * 0.12, size * 0.12, size * 6, 8), new THREE.MeshLambertMaterial({color: 0x7f3fbf}));
+      var rod = new THREE.Mesh(new THREE.CylinderBufferGeometry(size * 0.15, size * 0.15, size * 10, 8), new THREE.MeshLambertMaterial({color: 0x7f3fbf}));
       rod.name = "hinge-axis";
       scene.add(rod);
       o.userData.axis = rod;
@@ -326,6 +326,14 @@
       html += "</table>";
       if (extra.length) html += '<table class="clip-extra">' + extra.join("") + "</table>";
     });
+    if (state.junctions) {
+      html += "<h2>junctions</h2><table>";
+      Object.keys(state.junctions).forEach(function (n) {
+        var p = state.junctions[n].position;
+        html += "<tr><td>" + esc(n) + '</td><td class="num">[' + p.map(function (v) { return fmt(v, 4); }).join(", ") + "] m</td></tr>";
+      });
+      html += "</table>";
+    }
     var box = $("cables");
     if (box.contains(document.activeElement) && document.activeElement.tagName === "INPUT") return; // typing
     box.innerHTML = html;
