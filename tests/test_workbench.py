@@ -490,8 +490,8 @@ def test_server_listens_on_loopback_and_refuses_foreign_pages(scene_copy):
     assert info["state"]["cables"]["hose"]["figures"]["clips"][2]["name"] == CLIP
     assert reply["id"] == 7 and reply["ok"] and reply["solveMs"] > 0
     assert reply["state"]["cables"]["hose"]["positions"][-1] == [0.75, 0.27, 0.01]
-    assert bad == {"id": 8, "ok": False,
-                   "error": "op = 'fly'; allowed: move, edit, undo, save, state"}  # fmt: skip
+    allowed = "move, moveBody, edit, undo, save, state"
+    assert bad == {"id": 8, "ok": False, "error": f"op = 'fly'; allowed: {allowed}"}
     assert bad_moves["ok"] is False
     assert bad_moves["error"] == "move: moves = [1]; give [{cable, clip, position}, ...]"
     assert not_json == {"ok": False, "error": "a request must be a JSON object"}
@@ -767,3 +767,92 @@ def test_page_hinge_axis_and_slid_length(scene_copy, tmp_path):
     assert len(slid) == 1 and slid[0]["slid"].endswith(" mm") and abs(value) > 1e-4
     assert float(slid[0]["slid"].split()[0]) == pytest.approx(value * 1e3, rel=5e-3)  # 4 digits
     assert shot.stat().st_size > 20_000
+
+
+# ----------------------------------------------------------------------- dragging bodies
+
+SHIFT = np.array([0.0, 0.02, 0.02])  # m: the powertrain's drag, translation
+TURN = (0.03, 0.02)  # rad: and rotation ry, rz about the global axes
+
+
+def body_pose_at(k: int, n: int = 10):
+    """The powertrain's origin and orientation quaternion at drag step k of n."""
+    from cablelife.rotations import euler_matrix, matrix_quaternions
+
+    f = k / n
+    r = euler_matrix([0.0, TURN[0] * f, TURN[1] * f])
+    return (np.array([0.8, 0.0, -0.1]) + f * SHIFT).tolist(), matrix_quaternions(r[None])[0]
+
+
+def test_dragging_a_body_moves_its_clips_and_saves_its_placement(harness_copy, tmp_path):
+    """The harness's powertrain dragged (moved and turned) in 10 steps: its two clips follow
+    rigidly, every cable answers, the saved scene has the body's new origin and orientation
+    and the clips' new global poses; the equilibrium equals the last step of a batch
+    quasistatic `simulate` that moves the body along the same poses (one static equilibrium
+    after the other: a cold static solve of such a pose finds another equilibrium of this
+    harness, 9–12 cm away)."""
+    from cablelife.rotations import euler_matrix
+    from cablelife.simulate import simulate
+
+    session = Session.open(harness_copy)
+    bracket0 = session.cables["engine"].clip_positions[0].copy()
+    for k in range(1, 11):
+        origin, q = body_pose_at(k)
+        errors = session.move_body("powertrain", origin, q.tolist(), mark=k == 1)
+        assert errors == {"engine": "", "gearbox": ""}
+    rot = euler_matrix([0.0, *TURN])
+    o0 = np.array([0.8, 0.0, -0.1])
+    expected = o0 + SHIFT + rot @ (bracket0 - o0)
+    np.testing.assert_allclose(session.cables["engine"].clip_positions[0], expected, atol=1e-12)
+    node = clip_node(session, "engine", "engine-bracket")
+    np.testing.assert_allclose(session.cables["engine"].state.positions[node], expected,
+                               atol=1e-12)  # fmt: skip
+    st = session.state()["bodies"]["powertrain"]
+    np.testing.assert_allclose(np.array(st["map"])[:, :3], rot, atol=1e-12)
+    out = session.save(tmp_path / "moved.toml")
+    saved = load_scene(out)
+    body = saved.body("powertrain")
+    np.testing.assert_allclose(body.origin, o0 + SHIFT, atol=1e-12)
+    np.testing.assert_allclose(body.orientation, [0.0, *TURN], atol=1e-12)
+    clip = saved.cables[1].clips[0]
+    np.testing.assert_allclose(clip.position, expected, atol=1e-12)
+    np.testing.assert_allclose(clip.direction, rot @ [1.0, 0.0, 0.0], atol=1e-12)
+    # the batch reference: the original scene, the body moved along the same 10 poses
+    ramp = lambda v: {"type": "table", "t": [0.0, 1.0], "value": [0.0, v]}  # noqa: E731
+    data = load_scene(HARNESS).model_dump(mode="json", exclude_none=True)
+    data["bodies"][0]["motion"] = [
+        {"channel": c, "signal": ramp(v)}
+        for c, v in (("y", SHIFT[1]), ("z", SHIFT[2]), ("ry", TURN[0]), ("rz", TURN[1]))
+    ]
+    data["simulation"].update(mode="quasistatic", duration=1.0, time_step=0.1)
+    ref = simulate(scene_from_dict(data, base_dir=HARNESS.parent), mode="quasistatic")
+    for name, live in session.cables.items():
+        assert np.abs(live.state.positions - ref.cables[name].positions[-1]).max() < 1e-9, name
+    # one undo step for the drag
+    assert session.undo() and not session.undo()
+    assert session.scene_text() == HARNESS.read_text()
+
+
+def test_body_drag_translation_equals_a_cold_batch_solve(harness_copy, tmp_path):
+    session = Session.open(harness_copy)
+    for k in range(1, 11):
+        origin = (np.array([0.8, 0.0, -0.1]) + k / 10 * SHIFT).tolist()
+        assert session.move_body("powertrain", origin) == {"engine": "", "gearbox": ""}
+    cables, junctions = batch_harness(load_scene(session.save(tmp_path / "moved.toml")))
+    for name, live in session.cables.items():
+        assert np.abs(live.state.positions - cables[name]).max() < 1e-9, name
+
+
+def test_bodies_that_cannot_be_dragged_say_why():
+    pytest.importorskip("trimesh")
+    scene = ROOT / "examples" / "surroundings" / "hose-near-engine.toml"
+    if not (scene.parent / "engine.stl").exists():
+        pytest.skip("example meshes not generated")
+    session = Session.open(scene)
+    st = session.state()["bodies"]
+    assert "global coordinates" in st["engine"]["refused"]
+    with pytest.raises(WorkbenchError, match="body 'engine' cannot be dragged: its geometry"):
+        session.move_body("engine", [0.0, 0.0, 0.0])
+    with pytest.raises(WorkbenchError, match="body 'motor' is not in the scene; allowed: "):
+        session.move_body("motor", [0.0, 0.0, 0.0])
+    assert session.undo_stack == []

@@ -109,6 +109,7 @@ class Session:
     pool: ThreadPoolExecutor | None = None
     solves: int = 0
     harness: object = None  # harness_live.LiveHarness when the scene has [[junctions]]
+    opened: Scene | None = None  # the scene as opened (bodies' rest poses of the geometry)
 
     # ------------------------------------------------------------------ opening
     @classmethod
@@ -121,7 +122,8 @@ class Session:
         path = Path(path)
         scene = load_scene(path)
         doc = tomlkit.parse(path.read_text(encoding="utf-8"))
-        session = cls(path=path, scene=scene, doc=doc, bend_factor=bend_factor)
+        session = cls(path=path, scene=scene, doc=doc, bend_factor=bend_factor,
+                      opened=scene.model_copy(deep=True))  # fmt: skip
         session.env = load_surroundings(scene)
         session.pool = ThreadPoolExecutor(max_workers=max(1, min(len(scene.cables), 4)))
         session._rebuild_all()
@@ -282,13 +284,7 @@ class Session:
             if mark:
                 self._push_undo()
             names = list(targets)
-            if self.harness is not None:  # one system: every cable of the tree answers
-                ok = self._solve_harness({n: targets[n][:2] for n in names})
-                results = [ok] * len(names)
-            else:
-                results = list(
-                    self.pool.map(lambda n: self._solve(self.cables[n], *targets[n][:2]), names)
-                )
+            results = self._solve_targets(targets)
             errors = {}
             for name, ok in zip(names, results, strict=True):
                 if ok:
@@ -298,6 +294,105 @@ class Session:
             if mark and not any(results):
                 self.undo_stack.pop()
             return errors
+
+    def _solve_targets(self, targets: dict) -> list[bool]:
+        """Solves the cables of ``targets`` ({cable: (clip positions, quaternions, …)}) at
+        their new clip poses: one harness solve, or the cables in parallel."""
+        names = list(targets)
+        if self.harness is not None:  # one system: every cable of the tree answers
+            ok = self._solve_harness({n: targets[n][:2] for n in names})
+            return [ok] * len(names)
+        return list(self.pool.map(lambda n: self._solve(self.cables[n], *targets[n][:2]), names))
+
+    def move_body(self, body: str, position, quaternion=None, mark: bool = True) -> dict:
+        """Moves a body at rest to a new ``origin`` (global [x, y, z] m) and, with
+        ``quaternion`` [w, x, y, z], a new orientation of its axes: its clips (in every cable)
+        and geometry follow rigidly, the cables concerned are re-solved. All or nothing: when a
+        cable has no equilibrium, the body, its clips and every cable stay as they were.
+        Returns {cable: error message or ""}; raises WorkbenchError for an unknown body or one
+        whose move could not be saved (geometry in global coordinates)."""
+        from cablelife.workbench.bodies import body_pose, matrix_euler, unsaveable_geometry
+
+        with self.lock:
+            spec = self.scene.body(str(body))
+            if spec is None:
+                raise WorkbenchError(
+                    f"body {body!r} is not in the scene; allowed: "
+                    + (", ".join(repr(b.name) for b in self.scene.bodies) or "none")
+                )
+            why = unsaveable_geometry(spec)
+            if why:
+                raise WorkbenchError(why)
+            o0, r0 = body_pose(spec)
+            o1 = self._check_point(f"body '{spec.name}' origin", position)
+            r1 = r0
+            if quaternion is not None:
+                q = np.asarray(quaternion, float).reshape(4)
+                if not np.isfinite(q).all() or np.linalg.norm(q) < 1e-9:
+                    raise WorkbenchError(
+                        f"body '{spec.name}' quaternion = {q.tolist()}: give a non-zero "
+                        "[w, x, y, z]"
+                    )
+                r1 = quat_matrix(q)
+            a = r1 @ r0.T
+            targets: dict[str, tuple] = {}
+            for cable in self.scene.cables:
+                live = self.cables[cable.name]
+                for j, clip in enumerate(cable.clips):
+                    if clip.body != spec.name:
+                        continue
+                    pos, quat, edits = targets.setdefault(
+                        cable.name,
+                        (live.clip_positions.copy(), live.clip_quaternions.copy(), []),
+                    )
+                    p = o1 + a @ (live.clip_positions[j] - o0)
+                    frame = a @ quat_matrix(live.clip_quaternions[j])
+                    pos[j] = p
+                    quat[j] = matrix_quaternions(frame[None])[0]
+                    edits.append((j, p, frame))
+            keep = {n: (c.state, c.clip_positions, c.clip_quaternions, c.message)
+                    for n, c in self.cables.items()}  # fmt: skip
+            keep_junctions = None
+            if self.harness is not None:
+                keep_junctions = (self.harness.junction_positions,
+                                  self.harness.junction_quaternions)  # fmt: skip
+            results = self._solve_targets(targets)
+            errors = {n: self.cables[n].message for n in targets}
+            if not all(results):
+                for n, (st, p, q, _) in keep.items():
+                    c = self.cables[n]
+                    c.state, c.clip_positions, c.clip_quaternions = st, p, q
+                if keep_junctions is not None:
+                    self.harness.junction_positions, self.harness.junction_quaternions = (
+                        keep_junctions
+                    )
+                return errors
+            if mark:
+                self._push_undo()
+            entry = self._toml_body(spec.name)
+            spec.origin = tuple(_tidy(v) for v in o1)
+            entry["origin"] = list(spec.origin)
+            if quaternion is not None:
+                spec.orientation = tuple(_tidy(v) for v in matrix_euler(r1))
+                entry["orientation"] = list(spec.orientation)
+            for name, (_, _, edits) in targets.items():
+                for j, p, frame in edits:
+                    self._set_clip_pose(self.cable_spec(name), j, p, frame)
+            return errors
+
+    def _toml_body(self, name: str):
+        for entry in self.doc.get("bodies", []):
+            if entry.get("name") == name:
+                return entry
+        raise WorkbenchError(f"body {name!r} is not in the scene file")
+
+    def body_map(self, name: str) -> np.ndarray:
+        """(3, 4) [A | b]: a point of body ``name`` at rest in the scene as opened goes to
+        A x + b now (identity until the body is dragged)."""
+        from cablelife.workbench.bodies import rigid_map
+
+        a, b = rigid_map(self.opened.body(name), self.scene.body(name))
+        return np.column_stack([a, b])
 
     def _set_clip_pose(self, cable: Cable, j: int, p: np.ndarray, frame) -> None:
         """Writes a clip's new global pose into the scene (and its TOML), in the clip's frame."""
@@ -481,7 +576,10 @@ class Session:
         if self.env is None:
             return None
         maps = np.zeros((len(self.env.bodies), 1, 3, 4))
-        maps[:, :, :, :3] = np.eye(3)
+        for k, name in enumerate(self.env.bodies):  # global → the body as opened: X = Aᵀ(x − b)
+            ab = self.body_map(name)
+            maps[k, 0, :, :3] = ab[:, :3].T
+            maps[k, 0, :, 3] = -ab[:, :3].T @ ab[:, 3]
         value, _ = self.env.core.clearance(
             np.ascontiguousarray(live.state.positions[None], float), live.radius, maps
         )
@@ -557,6 +655,7 @@ class Session:
                     "message": live.message,
                 }
             out = {"cables": cables, "solves": self.solves, "undo": len(self.undo_stack)}
+            out["bodies"] = {b.name: self._body_view(b) for b in self.scene.bodies}
             h = self.harness
             if h is not None and h.junction_positions is not None:
                 out["junctions"] = {
@@ -565,6 +664,19 @@ class Session:
                     for k, name in enumerate(h.junction_names)
                 }  # fmt: skip
             return out
+
+    def _body_view(self, body) -> dict:
+        from cablelife.workbench.bodies import body_pose, unsaveable_geometry
+
+        o, r = body_pose(body)
+        clips = sum(c.body == body.name for cable in self.scene.cables for c in cable.clips)
+        return {
+            "origin": o.tolist(),
+            "frame": r.T.tolist(),  # rows: the body's axes
+            "map": self.body_map(body.name).tolist(),
+            "clips": int(clips),
+            "refused": unsaveable_geometry(body),
+        }
 
     def geometry(self) -> dict:
         """The bodies' meshes (global, at rest) and names, for the page (once)."""
