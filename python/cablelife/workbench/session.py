@@ -510,8 +510,33 @@ class Session:
             if not self.undo_stack:
                 return False
             self.doc = tomlkit.parse(self.undo_stack.pop())
-            self._reload()
+            if not self._pose_back():
+                self._reload()
             return True
+
+    def _pose_back(self) -> bool:
+        """Undo of a drag: when the restored document differs from the live scene in clip and
+        body poses only, the cables are solved warm back to the restored poses (the branch of
+        equilibria the drag followed; a cold solve from the routed shapes may find another).
+        False (nothing changed) when more differs or the solve fails."""
+        from cablelife.simulate import clip_poses
+
+        scene = scene_from_dict(
+            self.doc.unwrap(), base_dir=self.path.parent.resolve(), source=str(self.path)
+        )
+        if _without_poses(scene) != _without_poses(self.scene):
+            return False
+        targets = {}
+        for cable in scene.cables:
+            pos, quat = clip_poses(scene, cable, np.array([0.0]), with_motion=False)
+            live = self.cables[cable.name]
+            if not (np.array_equal(pos[0], live.clip_positions)
+                    and np.array_equal(quat[0], live.clip_quaternions)):  # fmt: skip
+                targets[cable.name] = (pos[0], quat[0])
+        if not all(self._solve_targets(targets)):
+            return False
+        self.scene = scene
+        return True
 
     def _push_undo(self) -> None:
         self.undo_stack.append(self.doc.as_string())
@@ -716,6 +741,19 @@ def strain_warning(live: LiveCable) -> str:
                 "the cable"
             )
     return ""
+
+
+def _without_poses(scene: Scene) -> dict:
+    """The scene as data without the clips' and bodies' poses (what a drag changes)."""
+    data = scene.model_dump(mode="json")
+    for body in data.get("bodies", []):
+        body.pop("origin", None)
+        body.pop("orientation", None)
+    for cable in data.get("cables", []):
+        for clip in cable.get("clips", []):
+            for key in ("position", "direction", "normal"):
+                clip.pop(key, None)
+    return data
 
 
 def _type_needs(entry, kind: str, cable: Cable) -> None:

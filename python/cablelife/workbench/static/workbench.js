@@ -8,7 +8,7 @@
   var info = null, live = null, shown = null, playing = null;
   var quantity = "bending";
   var renderer, scene, camera, orbit, gizmo, dirty = true;
-  var tubes = {}, clipObjects = {}, bodyMeshes = {}, junctionObjects = {}, selected = null;
+  var tubes = {}, clipObjects = {}, bodyMeshes = {}, junctionObjects = {}, bodyObjects = {}, selected = null;
   var ws, nextId = 1, waiting = {}, inflight = false, pending = null, dragMark = false, idleWaiters = [];
   var updateTimes = [], frameTimes = [], lastSolveMs = 0;
   var statusText = "";
@@ -91,6 +91,13 @@
     });
     gizmo.addEventListener("objectChange", function () {
       if (!selected || !gizmo.dragging) return;
+      if (selected.body) {
+        var b = bodyObjects[selected.body];
+        var bm = {op: "moveBody", body: selected.body, position: [b.position.x, b.position.y, b.position.z]};
+        if (gizmo.getMode() === "rotate") bm.quaternion = [b.quaternion.w, b.quaternion.x, b.quaternion.y, b.quaternion.z];
+        queueMove(bm);
+        return;
+      }
       var o = clipObjects[selected.cable][selected.clip];
       var move = {cable: selected.cable, clip: selected.clip, position: [o.position.x, o.position.y, o.position.z]};
       if (gizmo.getMode() === "rotate") move.quaternion = [o.quaternion.w, o.quaternion.x, o.quaternion.y, o.quaternion.z];
@@ -111,8 +118,10 @@
       ray.setFromCamera({x: (e.clientX - r.left) / r.width * 2 - 1, y: -(e.clientY - r.top) / r.height * 2 + 1}, camera);
       var handles = [];
       Object.keys(clipObjects).forEach(function (c) { Object.keys(clipObjects[c]).forEach(function (k) { handles.push(clipObjects[c][k].userData.handle); }); });
+      Object.keys(bodyObjects).forEach(function (n) { handles.push(bodyObjects[n].userData.handle); });
       var hit = ray.intersectObjects(handles)[0];
-      if (hit) select(hit.object.userData.cable, hit.object.userData.clip);
+      if (hit && hit.object.userData.body) selectBody(hit.object.userData.body);
+      else if (hit) select(hit.object.userData.cable, hit.object.userData.clip);
     });
     window.addEventListener("keydown", function (e) {
       if (e.target.tagName === "INPUT" || e.target.tagName === "SELECT") return;
@@ -240,6 +249,21 @@
     });
   }
 
+  // A body's handle: a grey cube with the body's axes at its origin (drag it to move the body).
+  function makeBody(name, size) {
+    var grp = new THREE.Group();
+    var handle = new THREE.Mesh(new THREE.BoxBufferGeometry(size, size, size), new THREE.MeshLambertMaterial({color: 0x5a6470, transparent: true, opacity: 0.8}));
+    handle.userData = {body: name};
+    grp.add(handle);
+    grp.userData.handle = handle;
+    [[1, 0, 0, 0xd62728], [0, 1, 0, 0x2ca02c], [0, 0, 1, 0x1f77b4]].forEach(function (a) {
+      grp.add(new THREE.ArrowHelper(new THREE.Vector3(a[0], a[1], a[2]), new THREE.Vector3(), size * 2.5, a[3], size * 0.5, size * 0.3));
+    });
+    grp.name = "body-handle:" + name;
+    scene.add(grp);
+    return grp;
+  }
+
   function setClipPose(o, p, rows) {
     o.position.set(p[0], p[1], p[2]);
     var m = new THREE.Matrix4().makeBasis(
@@ -278,9 +302,22 @@
     var rmax = 0;
     Object.keys(state.cables).forEach(function (n) { rmax = Math.max(rmax, state.cables[n].radius); });
     if (withClips && state.junctions) drawJunctions(state.junctions, Math.max(rmax * 1.6, 0.004));
+    if (withClips && state.bodies) {
+      Object.keys(state.bodies).forEach(function (n) {
+        var b = state.bodies[n];
+        if (bodyObjects[n] && !(gizmo.dragging && selected && selected.body === n)) setClipPose(bodyObjects[n], b.origin, b.frame);
+      });
+      poseBodies(liveMaps(state));
+    }
     drawColourBar(r);
     shown = state;
     dirty = true;
+  }
+
+  function liveMaps(state) {
+    var maps = {};
+    Object.keys(state.bodies || {}).forEach(function (n) { maps[n] = state.bodies[n].map; });
+    return maps;
   }
 
   function applyLive(state) {
@@ -334,6 +371,17 @@
       });
       html += "</table>";
     }
+    var names = Object.keys(state.bodies || {});
+    if (names.length) {
+      html += '<h2>bodies</h2><table class="bodies">';
+      names.forEach(function (n) {
+        var b = state.bodies[n], sel = selected && selected.body === n;
+        html += '<tr class="body' + (sel ? " sel" : "") + '" data-body="' + esc(n) + '"><td>' + esc(n) + '</td><td class="num">origin [' +
+          b.origin.map(function (v) { return fmt(v, 4); }).join(", ") + "] m, " + b.clips + " clip(s)</td></tr>";
+        if (b.refused) html += '<tr><td colspan="2" class="bad">' + esc(b.refused) + "</td></tr>";
+      });
+      html += "</table>";
+    }
     var box = $("cables");
     if (box.contains(document.activeElement) && document.activeElement.tagName === "INPUT") return; // typing
     box.innerHTML = html;
@@ -381,7 +429,8 @@
   function sendMove(move) {
     inflight = true;
     var mark = dragMark; dragMark = false;
-    request({op: "move", moves: [move], mark: mark}).catch(function (e) { showMessage(e.message, true); }).then(function () {
+    var req = move.op === "moveBody" ? {op: "moveBody", body: move.body, position: move.position, quaternion: move.quaternion || null, mark: mark} : {op: "move", moves: [move], mark: mark};
+    request(req).catch(function (e) { showMessage(e.message, true); }).then(function () {
       inflight = false;
       if (pending) { var p = pending; pending = null; sendMove(p); return; }
       var done = idleWaiters; idleWaiters = [];
@@ -395,6 +444,19 @@
     panel(live);
     $("selected").innerHTML = "selected: cable <b>" + esc(cable) + "</b>, clip <b>" + esc(clip) + "</b> — drag the arrows (W: move, E: turn)";
     dirty = true;
+  }
+  function selectBody(name) {
+    var b = live.bodies[name];
+    if (b.refused) { showMessage(b.refused, true); return; }
+    selected = {body: name};
+    gizmo.attach(bodyObjects[name]);
+    panel(live);
+    $("selected").innerHTML = "selected: body <b>" + esc(name) + "</b> (" + b.clips + " clip(s)) — drag the arrows (W: move, E: turn)";
+    dirty = true;
+  }
+  function selectedObject() {
+    if (!selected) return null;
+    return selected.body ? bodyObjects[selected.body] : clipObjects[selected.cable][selected.clip];
   }
   function setMode(m) {
     gizmo.setMode(m);
@@ -412,8 +474,9 @@
       if (o.userData.axis && !on) o.userData.axis.visible = false;
     }); });
     Object.keys(junctionObjects).forEach(function (n) { junctionObjects[n].visible = on; });
+    Object.keys(bodyObjects).forEach(function (n) { bodyObjects[n].visible = on; });
     gizmo.visible = on && selected !== null;
-    if (!on) gizmo.detach(); else if (selected) gizmo.attach(clipObjects[selected.cable][selected.clip]);
+    if (!on) gizmo.detach(); else if (selected) gizmo.attach(selectedObject());
   }
   // Bodies at a saved step: x = R X + t, rows of [R | t] (at rest without).
   function poseBodies(poses) {
@@ -455,7 +518,7 @@
     });
     $("player-live").addEventListener("click", function () {
       if (timer) { clearInterval(timer); timer = null; $("player-play").textContent = "play"; }
-      playing = null; $("player-time").textContent = ""; showClips(true); poseBodies({}); draw(live, true);
+      playing = null; $("player-time").textContent = ""; showClips(true); poseBodies(liveMaps(live)); draw(live, true);
     });
     // test hook: show saved step k of the result; resolves when drawn, with its nodes
     window.cablelifeWorkbench.showResultStep = function (k) {
@@ -490,6 +553,9 @@
         var c = st.cables[n], size = Math.max(c.radius * 2.5, 0.004);
         c.figures.clips.forEach(function (k) { clipObjects[n][k.name] = makeClip(n, k.name, size); });
       });
+      Object.keys(st.bodies || {}).forEach(function (n) {
+        if (st.bodies[n].clips > 0 || bodyMeshes[n]) bodyObjects[n] = makeBody(n, 0.012);
+      });
       fitCamera(st);
       document.body.dataset.junctions = Object.keys(st.junctions || {}).length;
       applyLive(st);
@@ -507,6 +573,8 @@
         });
       });
       $("cables").addEventListener("click", function (e) {
+        var tb = e.target.closest("tr.body");
+        if (tb) { selectBody(tb.dataset.body); return; }
         var tr = e.target.closest("tr.clip");
         if (tr && e.target.tagName !== "INPUT" && e.target.tagName !== "SELECT") select(tr.dataset.cable, tr.dataset.item);
       });
@@ -554,6 +622,27 @@
         Object.keys(live.junctions).forEach(function (n) { out.junctions[n] = {position: live.junctions[n].position, drawn: junctionObjects[n].position.toArray()}; });
       }
       return out;
+    },
+    // moves a body to a new origin (and orientation, quaternion [w, x, y, z]); resolves when drawn
+    moveBody: function (body, xyz, quaternion) {
+      return request({op: "moveBody", body: body, position: xyz, quaternion: quaternion || null, mark: true}).then(function (msg) {
+        if (msg.ok === false) throw new Error(msg.error);
+        return {solveMs: msg.solveMs};
+      });
+    },
+    selectBody: selectBody,
+    // a body's handle and mesh as drawn: handle position, quaternion [w, x, y, z], mesh map rows (3 x 4)
+    bodyPose: function (body) {
+      var o = bodyObjects[body], m = bodyMeshes[body], e = m ? m.matrix.elements : null;
+      return {position: o.position.toArray(), quaternion: [o.quaternion.w, o.quaternion.x, o.quaternion.y, o.quaternion.z],
+        map: e ? [[e[0], e[4], e[8], e[12]], [e[1], e[5], e[9], e[13]], [e[2], e[6], e[10], e[14]]] : null};
+    },
+    // the handle axis under the mouse ("X", "Y", "Z", "E", "XYZE", … or null), to find the rings in tests
+    gizmoAxis: function () { return gizmo.axis; },
+    setMode: setMode,
+    bodyOnScreen: function (body) {
+      var v = bodyObjects[body].position.clone().project(camera), r = renderer.domElement.getBoundingClientRect();
+      return [r.left + (v.x + 1) / 2 * r.width, r.top + (1 - v.y) / 2 * r.height];
     },
     // the side panel's text of a clip's extra rows (hinge axis, slid length), for tests
     clipExtra: function (cable, clip) {
