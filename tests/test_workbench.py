@@ -970,3 +970,30 @@ def test_turning_a_clip_with_the_mouse(scene_copy, tmp_path):
     q = quat[0, 2]
     assert min(np.abs(q - q1).max(), np.abs(q + q1).max()) < 1e-6  # saved as drawn
     assert np.abs(np.array(shown) - batch_equilibrium(scene, "hose")).max() < 1e-9
+
+
+def test_dragged_body_carries_its_geometry_for_clearance(tmp_path):
+    """A body with geometry in its own frame can be dragged: the clearance after the drag is
+    the batch clearance of the saved scene (the geometry moved with the body)."""
+    pytest.importorskip("trimesh")
+    from cablelife.simulate import simulate
+    from cablelife.workbench.session import at_rest
+
+    text = EXAMPLE.read_text().replace(
+        "origin = [0.6, 0.2, 0.0]",
+        'origin = [0.6, 0.2, 0.0]\ngeometry = [{ shape = "sphere", center = [0.0, -0.1, 0.05], '
+        'radius = 0.03, frame = "body" }]',
+    )
+    path = tmp_path / "sphere.toml"
+    path.write_text(text)
+    session = Session.open(path)
+    before = np.array(session.state()["cables"]["hose"]["values"]["clearance"])
+    for k in range(1, 6):
+        assert session.move_body("engine", [0.6, 0.2 - 0.004 * k, 0.002 * k]) == {"hose": ""}
+    after = np.array(session.state()["cables"]["hose"]["values"]["clearance"]) / 1e3
+    scene = load_scene(session.save(tmp_path / "moved.toml"))
+    assert scene.body("engine").origin == (0.6, 0.18, 0.01)
+    ref = simulate(at_rest(scene), mode="static").cables["hose"]
+    np.testing.assert_allclose(after, ref.clearance[0], atol=1e-9)
+    assert np.abs(after - before / 1e3).max() > 1e-3  # the sphere moved (and the cable)
+    assert np.abs(session.cables["hose"].state.positions - ref.positions[0]).max() < 1e-9
