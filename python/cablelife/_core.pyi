@@ -130,7 +130,7 @@ class Harness:
         branch outputs."""
         ...
     def run_sequence(
-        self, positions, quaternions, progress=None, progress_every=50, stop=None
+        self, positions, quaternions, progress=None, progress_every=50, stop=None, warm=False
     ) -> Any:
         """Runs a sequence of equilibria through the clip poses of each cable, `positions[c]`
         (T, C_c, 3) and `quaternions[c]` (T, C_c, 4) (the entries of joined ends are ignored).
@@ -139,7 +139,9 @@ class Harness:
         (T, J, 4, scalar first), `branch_force` and `branch_moment` (T, E, 3: what each joined
         end's cable applies to its junction, global, moment about the junction point),
         `iterations`, `substeps`, `residual`, `steps` and `error` (None, or why it stopped: the
-        steps before are kept).
+        steps before are kept). `warm`: step 0 starts from the last equilibrium of the previous
+        warm run (the first from the routed shapes), and a complete run's last equilibrium is
+        kept for the next; a failed one keeps the previous (the workbench's drags).
         """
         ...
 

@@ -18,6 +18,8 @@ type JunctionTuple = (String, f64, Vec<f64>, Vec<(usize, usize)>);
 pub struct Harness {
     tree: Tree,
     solver: HarnessStatics,
+    /// The last equilibrium of a `warm` run (the workbench's warm start).
+    state: Option<HarnessState>,
 }
 
 #[pymethods]
@@ -56,7 +58,11 @@ impl Harness {
             ..Default::default()
         };
         let solver = HarnessStatics::new(&tree, opts);
-        Ok(Harness { tree, solver })
+        Ok(Harness {
+            tree,
+            solver,
+            state: None,
+        })
     }
 
     /// (cable index, clip index, junction index) of every joined end, in the order of the
@@ -77,8 +83,12 @@ impl Harness {
     /// (T, J, 4, scalar first), `branch_force` and `branch_moment` (T, E, 3: what each joined
     /// end's cable applies to its junction, global, moment about the junction point),
     /// `iterations`, `substeps`, `residual`, `steps` and `error` (None, or why it stopped: the
-    /// steps before are kept).
-    #[pyo3(signature = (positions, quaternions, progress=None, progress_every=50, stop=None))]
+    /// steps before are kept). `warm`: step 0 starts from the last equilibrium of the previous
+    /// warm run (the first from the routed shapes), and a complete run's last equilibrium is
+    /// kept for the next; a failed one keeps the previous (the workbench's drags).
+    #[pyo3(signature = (positions, quaternions, progress=None, progress_every=50, stop=None,
+        warm=false))]
+    #[allow(clippy::too_many_arguments)]
     fn run_sequence<'py>(
         &mut self,
         py: Python<'py>,
@@ -87,6 +97,7 @@ impl Harness {
         progress: Option<Py<PyAny>>,
         progress_every: usize,
         stop: Option<Bound<'py, StopFlag>>,
+        warm: bool,
     ) -> PyResult<Bound<'py, PyDict>> {
         let nc = self.tree.cables.len();
         if positions.len() != nc || quaternions.len() != nc {
@@ -121,18 +132,26 @@ impl Harness {
         }
         let t = steps.unwrap_or(0);
         let tree = &self.tree;
-        let mut initial = HarnessState {
-            cables: Vec::with_capacity(nc),
-            junctions: tree.reference.clone(),
+        let previous = if warm { self.state.clone() } else { None };
+        let from_previous = previous.is_some();
+        let initial = match previous {
+            Some(p) => p,
+            None => {
+                let mut initial = HarnessState {
+                    cables: Vec::with_capacity(nc),
+                    junctions: tree.reference.clone(),
+                };
+                for (c, rod) in tree.cables.iter().enumerate() {
+                    let first: Option<Vec<Pose>> = (t > 0).then(|| poses[c][0].clone());
+                    initial
+                        .cables
+                        .push(route(rod, first.as_deref()).map_err(|e| {
+                            PyValueError::new_err(format!("cable '{}': {}", tree.names[c], e.0))
+                        })?);
+                }
+                initial
+            }
         };
-        for (c, rod) in tree.cables.iter().enumerate() {
-            let first: Option<Vec<Pose>> = (t > 0).then(|| poses[c][0].clone());
-            initial
-                .cables
-                .push(route(rod, first.as_deref()).map_err(|e| {
-                    PyValueError::new_err(format!("cable '{}': {}", tree.names[c], e.0))
-                })?);
-        }
         let solver = &mut self.solver;
         let mut poller = Poller::new(stop.as_ref(), progress, progress_every, t);
         let (nj, ne) = (tree.junctions.len(), tree.ends.len());
@@ -147,7 +166,7 @@ impl Harness {
             residual: Vec<f64>,
             steps: usize,
         }
-        let (out, error) = py.detach(move || {
+        let (out, error, last) = py.detach(move || {
             let mut out = Out {
                 records: (0..nc).map(|_| Record::default()).collect(),
                 jpos: Vec::with_capacity(t * nj * 3),
@@ -165,7 +184,7 @@ impl Harness {
                 for (tc, pc) in target.iter_mut().zip(&poses) {
                     tc.clone_from(&pc[k]);
                 }
-                let result = if k == 0 {
+                let result = if k == 0 && !from_previous {
                     st.set_clip_poses(tree, &target);
                     solver.solve_static(tree, &mut st)
                 } else {
@@ -173,10 +192,10 @@ impl Harness {
                 };
                 let stats = match result {
                     Ok(s) => s,
-                    Err(e) => return (out, Some(format!("step {k}: {e}"))),
+                    Err(e) => return (out, Some(format!("step {k}: {e}")), None),
                 };
                 if let Err(e) = solver.assemble(tree, &st, 1.0, false) {
-                    return (out, Some(format!("step {k}: {e}")));
+                    return (out, Some(format!("step {k}: {e}")), None);
                 }
                 for (c, rod) in tree.cables.iter().enumerate() {
                     out.records[c].push(rod, &st.cables[c], &solver.ws[c], &stats);
@@ -197,11 +216,14 @@ impl Harness {
                 out.residual.push(stats.residual);
                 out.steps += 1;
                 if let Some(why) = poller.poll(k + 1) {
-                    return (out, Some(why));
+                    return (out, Some(why), None);
                 }
             }
-            (out, None)
+            (out, None, Some(st))
         });
+        if warm && last.is_some() {
+            self.state = last;
+        }
         let d = PyDict::new(py);
         let cables = PyList::empty(py);
         for (c, rec) in out.records.into_iter().enumerate() {

@@ -129,6 +129,13 @@ class SocketHandler(tornado.websocket.WebSocketHandler):
             ms = (time.perf_counter() - start) * 1e3
             failed = "; ".join(e for e in errors.values() if e)
             return {"ok": not failed, "error": failed, "state": s.state(), "solveMs": ms}
+        if op == "moveBody":
+            start = time.perf_counter()
+            errors = s.move_body(req.get("body"), req.get("position"), req.get("quaternion"),
+                                 mark=bool(req.get("mark", True)))  # fmt: skip
+            ms = (time.perf_counter() - start) * 1e3
+            failed = "; ".join(e for e in errors.values() if e)
+            return {"ok": not failed, "error": failed, "state": s.state(), "solveMs": ms}
         if op == "edit":
             s.edit(str(req.get("cable")), str(req.get("item") or ""), str(req.get("key")),
                    req.get("value"))  # fmt: skip
@@ -141,7 +148,7 @@ class SocketHandler(tornado.websocket.WebSocketHandler):
             return {"ok": True, "saved": str(path), "state": s.state()}
         if op == "state":
             return {"ok": True, "state": s.state()}
-        raise WorkbenchError(f"op = {op!r}; allowed: move, edit, undo, save, state")
+        raise WorkbenchError(f"op = {op!r}; allowed: move, moveBody, edit, undo, save, state")
 
 
 def make_app(session: Session, player=None) -> tornado.web.Application:

@@ -76,6 +76,7 @@ class Equilibrium:
     reaction_moment: np.ndarray  # (C, 3)
     iterations: int
     solve_ms: float
+    slid: np.ndarray | None = None  # (C,) m: cable slid through each clip since its s
 
 
 @dataclass
@@ -107,6 +108,8 @@ class Session:
     lock: threading.RLock = field(default_factory=threading.RLock)
     pool: ThreadPoolExecutor | None = None
     solves: int = 0
+    harness: object = None  # harness_live.LiveHarness when the scene has [[junctions]]
+    opened: Scene | None = None  # the scene as opened (bodies' rest poses of the geometry)
 
     # ------------------------------------------------------------------ opening
     @classmethod
@@ -118,17 +121,12 @@ class Session:
 
         path = Path(path)
         scene = load_scene(path)
-        if getattr(scene, "junctions", None):  # harnesses (issue 16): not solved here yet
-            raise SceneError(
-                f"{str(path)!r} has [[junctions]] (a harness); the workbench solves single "
-                "cables only so far: run the harness with `cablelife run`"
-            )
         doc = tomlkit.parse(path.read_text(encoding="utf-8"))
-        session = cls(path=path, scene=scene, doc=doc, bend_factor=bend_factor)
+        session = cls(path=path, scene=scene, doc=doc, bend_factor=bend_factor,
+                      opened=scene.model_copy(deep=True))  # fmt: skip
         session.env = load_surroundings(scene)
         session.pool = ThreadPoolExecutor(max_workers=max(1, min(len(scene.cables), 4)))
-        for cable in scene.cables:
-            session._rebuild(cable)
+        session._rebuild_all()
         failed = [c for c in session.cables.values() if c.state is None]
         if failed:
             raise SceneError(
@@ -140,11 +138,51 @@ class Session:
         if self.pool is not None:
             self.pool.shutdown(wait=False, cancel_futures=True)
 
+    def _rebuild_all(self) -> None:
+        """Fresh solvers for every cable (one harness solver for a harness), solved."""
+        if self.scene.junctions:
+            self._rebuild_harness()
+        else:
+            for cable in self.scene.cables:
+                self._rebuild(cable)
+
+    def _live_cable(self, cable: Cable, core, pos: np.ndarray, quat: np.ndarray) -> LiveCable:
+        props = cable.properties()
+        return LiveCable(
+            name=cable.name,
+            core=core,
+            arc_length=np.asarray(core.arc_length),
+            clip_positions=pos,
+            clip_quaternions=quat,
+            stiffness=np.array(
+                [props.bend_stiffness[0], props.bend_stiffness[1], props.bend_stiffness[2]]
+            ),  # fmt: skip
+            radius=float(props.outer_radius),
+        )
+
+    def _rebuild_harness(self) -> None:
+        """A fresh harness solver for the whole tree, solved from the routed shapes."""
+        from cablelife.workbench.harness_live import build_harness
+
+        self.harness, lives = build_harness(self.scene, self._live_cable)
+        self.cables.update(lives)
+        self._solve_harness({})
+
+    def _solve_harness(self, targets: dict) -> bool:
+        from cablelife.workbench.harness_live import solve_harness
+
+        ok = solve_harness(self.harness, self.cables, targets, _equilibrium)
+        self.solves += ok
+        return ok
+
     def _rebuild(self, cable: Cable) -> LiveCable:
         """A fresh solver for ``cable`` (its mesh follows the clips), solved from its route."""
         from cablelife.contact_settings import set_contact
         from cablelife.simulate import clip_poses
 
+        if self.scene.junctions:
+            self._rebuild_harness()
+            return self.cables[cable.name]
         core = build_cable(self.scene, cable)
         if self.scene.contact is not None and self.scene.contact.enabled:
             try:
@@ -152,18 +190,7 @@ class Session:
             except ValueError as err:
                 raise SceneError(f"cable '{cable.name}': {err}") from None
         pos, quat = clip_poses(self.scene, cable, np.array([0.0]), with_motion=False)
-        props = cable.properties()
-        live = LiveCable(
-            name=cable.name,
-            core=core,
-            arc_length=np.asarray(core.arc_length),
-            clip_positions=pos[0].copy(),
-            clip_quaternions=quat[0].copy(),
-            stiffness=np.array(
-                [props.bend_stiffness[0], props.bend_stiffness[1], props.bend_stiffness[2]]
-            ),  # fmt: skip
-            radius=float(props.outer_radius),
-        )
+        live = self._live_cable(cable, core, pos[0].copy(), quat[0].copy())
         self.cables[cable.name] = live
         self._solve(live, live.clip_positions, live.clip_quaternions)
         return live
@@ -199,20 +226,10 @@ class Session:
             live.message = f"cable '{live.name}': no equilibrium at the new clip pose ({err})"
             return False
         ms = (time.perf_counter() - start) * 1e3
-        x = out["positions"][0]
-        if not np.isfinite(x).all():
+        if not np.isfinite(out["positions"][0]).all():
             live.message = f"cable '{live.name}': the solve gave non-finite positions"
             return False
-        live.state = Equilibrium(
-            positions=x,
-            quaternions=out["quaternions"][0],
-            forces=out["forces"][0],
-            moments=out["moments"][0],
-            reaction_force=out["reaction_force"][0],
-            reaction_moment=out["reaction_moment"][0],
-            iterations=int(out["iterations"][0]),
-            solve_ms=ms,
-        )
+        live.state = _equilibrium(out, len(live.clip_positions), ms)
         live.clip_positions = np.array(positions, float)
         live.clip_quaternions = np.array(quaternions, float)
         live.message = ""
@@ -267,9 +284,7 @@ class Session:
             if mark:
                 self._push_undo()
             names = list(targets)
-            results = list(
-                self.pool.map(lambda n: self._solve(self.cables[n], *targets[n][:2]), names)
-            )
+            results = self._solve_targets(targets)
             errors = {}
             for name, ok in zip(names, results, strict=True):
                 if ok:
@@ -279,6 +294,105 @@ class Session:
             if mark and not any(results):
                 self.undo_stack.pop()
             return errors
+
+    def _solve_targets(self, targets: dict) -> list[bool]:
+        """Solves the cables of ``targets`` ({cable: (clip positions, quaternions, …)}) at
+        their new clip poses: one harness solve, or the cables in parallel."""
+        names = list(targets)
+        if self.harness is not None:  # one system: every cable of the tree answers
+            ok = self._solve_harness({n: targets[n][:2] for n in names})
+            return [ok] * len(names)
+        return list(self.pool.map(lambda n: self._solve(self.cables[n], *targets[n][:2]), names))
+
+    def move_body(self, body: str, position, quaternion=None, mark: bool = True) -> dict:
+        """Moves a body at rest to a new ``origin`` (global [x, y, z] m) and, with
+        ``quaternion`` [w, x, y, z], a new orientation of its axes: its clips (in every cable)
+        and geometry follow rigidly, the cables concerned are re-solved. All or nothing: when a
+        cable has no equilibrium, the body, its clips and every cable stay as they were.
+        Returns {cable: error message or ""}; raises WorkbenchError for an unknown body or one
+        whose move could not be saved (geometry in global coordinates)."""
+        from cablelife.workbench.bodies import body_pose, matrix_euler, unsaveable_geometry
+
+        with self.lock:
+            spec = self.scene.body(str(body))
+            if spec is None:
+                raise WorkbenchError(
+                    f"body {body!r} is not in the scene; allowed: "
+                    + (", ".join(repr(b.name) for b in self.scene.bodies) or "none")
+                )
+            why = unsaveable_geometry(spec)
+            if why:
+                raise WorkbenchError(why)
+            o0, r0 = body_pose(spec)
+            o1 = self._check_point(f"body '{spec.name}' origin", position)
+            r1 = r0
+            if quaternion is not None:
+                q = np.asarray(quaternion, float).reshape(4)
+                if not np.isfinite(q).all() or np.linalg.norm(q) < 1e-9:
+                    raise WorkbenchError(
+                        f"body '{spec.name}' quaternion = {q.tolist()}: give a non-zero "
+                        "[w, x, y, z]"
+                    )
+                r1 = quat_matrix(q)
+            a = r1 @ r0.T
+            targets: dict[str, tuple] = {}
+            for cable in self.scene.cables:
+                live = self.cables[cable.name]
+                for j, clip in enumerate(cable.clips):
+                    if clip.body != spec.name:
+                        continue
+                    pos, quat, edits = targets.setdefault(
+                        cable.name,
+                        (live.clip_positions.copy(), live.clip_quaternions.copy(), []),
+                    )
+                    p = o1 + a @ (live.clip_positions[j] - o0)
+                    frame = a @ quat_matrix(live.clip_quaternions[j])
+                    pos[j] = p
+                    quat[j] = matrix_quaternions(frame[None])[0]
+                    edits.append((j, p, frame))
+            keep = {n: (c.state, c.clip_positions, c.clip_quaternions, c.message)
+                    for n, c in self.cables.items()}  # fmt: skip
+            keep_junctions = None
+            if self.harness is not None:
+                keep_junctions = (self.harness.junction_positions,
+                                  self.harness.junction_quaternions)  # fmt: skip
+            results = self._solve_targets(targets)
+            errors = {n: self.cables[n].message for n in targets}
+            if not all(results):
+                for n, (st, p, q, _) in keep.items():
+                    c = self.cables[n]
+                    c.state, c.clip_positions, c.clip_quaternions = st, p, q
+                if keep_junctions is not None:
+                    self.harness.junction_positions, self.harness.junction_quaternions = (
+                        keep_junctions
+                    )
+                return errors
+            if mark:
+                self._push_undo()
+            entry = self._toml_body(spec.name)
+            spec.origin = tuple(_tidy(v) for v in o1)
+            entry["origin"] = list(spec.origin)
+            if quaternion is not None:
+                spec.orientation = tuple(_tidy(v) for v in matrix_euler(r1))
+                entry["orientation"] = list(spec.orientation)
+            for name, (_, _, edits) in targets.items():
+                for j, p, frame in edits:
+                    self._set_clip_pose(self.cable_spec(name), j, p, frame)
+            return errors
+
+    def _toml_body(self, name: str):
+        for entry in self.doc.get("bodies", []):
+            if entry.get("name") == name:
+                return entry
+        raise WorkbenchError(f"body {name!r} is not in the scene file")
+
+    def body_map(self, name: str) -> np.ndarray:
+        """(3, 4) [A | b]: a point of body ``name`` at rest in the scene as opened goes to
+        A x + b now (identity until the body is dragged)."""
+        from cablelife.workbench.bodies import rigid_map
+
+        a, b = rigid_map(self.opened.body(name), self.scene.body(name))
+        return np.column_stack([a, b])
 
     def _set_clip_pose(self, cable: Cable, j: int, p: np.ndarray, frame) -> None:
         """Writes a clip's new global pose into the scene (and its TOML), in the clip's frame."""
@@ -300,14 +414,17 @@ class Session:
 
     # ------------------------------------------------------------------ edits
     def edit(self, cable: str, item: str, key: str, value) -> None:
-        """Sets a clip's ``s``, ``type`` or ``length`` (item = the clip's name) or the cable's
-        ``length`` (item = ""), validated as a scene; rebuilds and re-solves the cable. On an
-        invalid value or a failed solve nothing changes."""
+        """Sets a clip's ``s``, ``type``, ``length`` or hinge ``axis`` (item = the clip's name)
+        or the cable's ``length`` (item = ""), validated as a scene; rebuilds and re-solves the
+        cable (the whole harness on a harness). A new type brings what it needs: a hinge the
+        axis d2 ([0, 1, 0]) and a point, a sliding clip a guide of four edges when it held a
+        point; a type without them drops axis and friction. On an invalid value or a failed
+        solve nothing changes."""
         with self.lock:
             spec = self.cable_spec(cable)
             if item:
-                self.clip_index(spec, item)
-                allowed = ("s", "type", "length")
+                clip = spec.clips[self.clip_index(spec, item)]
+                allowed = ("s", "type", "length", "axis")
             else:
                 allowed = ("length",)
             if key not in allowed:
@@ -320,7 +437,24 @@ class Session:
                     f"cable '{cable}', clip '{item}': type = {value!r}; allowed: "
                     + ", ".join(CLIP_TYPES)
                 )
-            if key != "type":
+            if key == "axis":
+                ok = (
+                    isinstance(value, list | tuple)
+                    and len(value) == 3
+                    and all(isinstance(v, int | float) and not isinstance(v, bool) for v in value)
+                )
+                if not ok:
+                    raise WorkbenchError(
+                        f"cable '{cable}', clip '{item}': axis = {value!r}; give three numbers "
+                        "[a1, a2, a3] in the clip frame"
+                    )
+                if clip.type != "hinge":
+                    raise WorkbenchError(
+                        f"cable '{cable}', clip '{item}': axis given for a {clip.type} clip; "
+                        "only a hinge clip has an axis"
+                    )
+                value = [float(v) for v in value]
+            elif key != "type":
                 if isinstance(value, bool) or not isinstance(value, int | float):
                     raise WorkbenchError(
                         f"cable '{cable}'{f', clip {item!r}' if item else ''}: {key} = "
@@ -334,6 +468,8 @@ class Session:
             self.doc = tomlkit.parse(old_doc.as_string())
             entry = self._toml_clip(cable, item) if item else self._toml_cable(cable)
             entry[key] = value
+            if key == "type":
+                _type_needs(entry, value, spec)
             try:
                 self._reload(cable)
             except (SceneError, WorkbenchError):
@@ -350,15 +486,20 @@ class Session:
         )
         keep_scene, keep_cables = self.scene, dict(self.cables)
         # clip poses edited by dragging live in the document too: the new scene has them
+        keep_harness = self.harness
         self.scene = scene
         try:
+            if scene.junctions:
+                self._rebuild_harness()
+                if self.harness.message:
+                    raise SceneError(self.harness.message)
             for c in scene.cables:
-                if changed is None or c.name == changed:
+                if not scene.junctions and (changed is None or c.name == changed):
                     live = self._rebuild(c)
                     if live.state is None:
                         raise SceneError(live.message)
         except SceneError:
-            self.scene, self.cables = keep_scene, keep_cables
+            self.scene, self.cables, self.harness = keep_scene, keep_cables, keep_harness
             raise
 
     def undo(self) -> bool:
@@ -369,8 +510,33 @@ class Session:
             if not self.undo_stack:
                 return False
             self.doc = tomlkit.parse(self.undo_stack.pop())
-            self._reload()
+            if not self._pose_back():
+                self._reload()
             return True
+
+    def _pose_back(self) -> bool:
+        """Undo of a drag: when the restored document differs from the live scene in clip and
+        body poses only, the cables are solved warm back to the restored poses (the branch of
+        equilibria the drag followed; a cold solve from the routed shapes may find another).
+        False (nothing changed) when more differs or the solve fails."""
+        from cablelife.simulate import clip_poses
+
+        scene = scene_from_dict(
+            self.doc.unwrap(), base_dir=self.path.parent.resolve(), source=str(self.path)
+        )
+        if _without_poses(scene) != _without_poses(self.scene):
+            return False
+        targets = {}
+        for cable in scene.cables:
+            pos, quat = clip_poses(scene, cable, np.array([0.0]), with_motion=False)
+            live = self.cables[cable.name]
+            if not (np.array_equal(pos[0], live.clip_positions)
+                    and np.array_equal(quat[0], live.clip_quaternions)):  # fmt: skip
+                targets[cable.name] = (pos[0], quat[0])
+        if not all(self._solve_targets(targets)):
+            return False
+        self.scene = scene
+        return True
 
     def _push_undo(self) -> None:
         self.undo_stack.append(self.doc.as_string())
@@ -435,7 +601,10 @@ class Session:
         if self.env is None:
             return None
         maps = np.zeros((len(self.env.bodies), 1, 3, 4))
-        maps[:, :, :, :3] = np.eye(3)
+        for k, name in enumerate(self.env.bodies):  # global → the body as opened: X = Aᵀ(x − b)
+            ab = self.body_map(name)
+            maps[k, 0, :, :3] = ab[:, :3].T
+            maps[k, 0, :, 3] = -ab[:, :3].T @ ab[:, 3]
         value, _ = self.env.core.clearance(
             np.ascontiguousarray(live.state.positions[None], float), live.radius, maps
         )
@@ -472,6 +641,8 @@ class Session:
                     "type": c.type,
                     "length": c.length,
                     "body": c.body,
+                    "axis": None if c.axis is None else list(c.axis),
+                    "slid": _slid(st, j) if c.type == "sliding" else None,
                     "force": st.reaction_force[j].tolist(),
                     "moment": st.reaction_moment[j].tolist(),
                 }
@@ -500,11 +671,37 @@ class Session:
                     "radius": live.radius,
                     "clipPositions": live.clip_positions.tolist(),
                     "clipFrames": [r.T.tolist() for r in frames],  # rows d1, d2, d3
+                    "clipAxes": [
+                        _hinge_axis(c, r)
+                        for c, r in zip(self.cable_spec(name).clips, frames, strict=True)
+                    ],  # fmt: skip
                     "values": self.node_values(live),
                     "figures": self.figures(live),
                     "message": live.message,
                 }
-            return {"cables": cables, "solves": self.solves, "undo": len(self.undo_stack)}
+            out = {"cables": cables, "solves": self.solves, "undo": len(self.undo_stack)}
+            out["bodies"] = {b.name: self._body_view(b) for b in self.scene.bodies}
+            h = self.harness
+            if h is not None and h.junction_positions is not None:
+                out["junctions"] = {
+                    name: {"position": h.junction_positions[k].tolist(),
+                           "frame": quat_matrix(h.junction_quaternions[k]).T.tolist()}
+                    for k, name in enumerate(h.junction_names)
+                }  # fmt: skip
+            return out
+
+    def _body_view(self, body) -> dict:
+        from cablelife.workbench.bodies import body_pose, unsaveable_geometry
+
+        o, r = body_pose(body)
+        clips = sum(c.body == body.name for cable in self.scene.cables for c in cable.clips)
+        return {
+            "origin": o.tolist(),
+            "frame": r.T.tolist(),  # rows: the body's axes
+            "map": self.body_map(body.name).tolist(),
+            "clips": int(clips),
+            "refused": unsaveable_geometry(body),
+        }
 
     def geometry(self) -> dict:
         """The bodies' meshes (global, at rest) and names, for the page (once)."""
@@ -544,6 +741,63 @@ def strain_warning(live: LiveCable) -> str:
                 "the cable"
             )
     return ""
+
+
+def _without_poses(scene: Scene) -> dict:
+    """The scene as data without the clips' and bodies' poses (what a drag changes)."""
+    data = scene.model_dump(mode="json")
+    for body in data.get("bodies", []):
+        body.pop("origin", None)
+        body.pop("orientation", None)
+    for cable in data.get("cables", []):
+        for clip in cable.get("clips", []):
+            for key in ("position", "direction", "normal"):
+                clip.pop(key, None)
+    return data
+
+
+def _type_needs(entry, kind: str, cable: Cable) -> None:
+    """Completes a clip's TOML entry for its new type (see ``Session.edit``)."""
+    if kind != "hinge":
+        entry.pop("axis", None)
+    if kind != "sliding":
+        entry.pop("friction", None)
+    if kind in ("hinge", "ball"):
+        entry["length"] = 0.0
+    if kind == "hinge" and "axis" not in entry:
+        entry["axis"] = [0.0, 1.0, 0.0]
+    if kind == "sliding" and not entry.get("length"):
+        entry["length"] = _tidy(4 * cable.length / cable.n_segments)
+
+
+def _hinge_axis(clip: Clip, frame: np.ndarray) -> list[float] | None:
+    """A hinge clip's turning axis in global coordinates (unit), else None."""
+    if clip.type != "hinge" or clip.axis is None:
+        return None
+    a = frame @ np.asarray(clip.axis, float)
+    return (a / np.linalg.norm(a)).tolist()
+
+
+def _slid(st: Equilibrium, j: int) -> float | None:
+    if st.slid is None or not np.isfinite(st.slid[j]):
+        return None
+    return float(st.slid[j])
+
+
+def _equilibrium(out: dict, clips: int, ms: float) -> Equilibrium:
+    """The Equilibrium of a one-step solver record (the first ``clips`` clips: the user's)."""
+    slid = out.get("slid_length")
+    return Equilibrium(
+        positions=out["positions"][0],
+        quaternions=out["quaternions"][0],
+        forces=out["forces"][0],
+        moments=out["moments"][0],
+        reaction_force=out["reaction_force"][0][:clips],
+        reaction_moment=out["reaction_moment"][0][:clips],
+        iterations=int(np.asarray(out["iterations"]).reshape(-1)[0]),
+        solve_ms=ms,
+        slid=None if slid is None else np.asarray(slid)[0][:clips],
+    )
 
 
 def _tidy(v: float) -> float:

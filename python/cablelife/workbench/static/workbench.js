@@ -8,7 +8,7 @@
   var info = null, live = null, shown = null, playing = null;
   var quantity = "bending";
   var renderer, scene, camera, orbit, gizmo, dirty = true;
-  var tubes = {}, clipObjects = {}, bodyMeshes = {}, selected = null;
+  var tubes = {}, clipObjects = {}, bodyMeshes = {}, junctionObjects = {}, bodyObjects = {}, selected = null;
   var ws, nextId = 1, waiting = {}, inflight = false, pending = null, dragMark = false, idleWaiters = [];
   var updateTimes = [], frameTimes = [], lastSolveMs = 0;
   var statusText = "";
@@ -91,6 +91,13 @@
     });
     gizmo.addEventListener("objectChange", function () {
       if (!selected || !gizmo.dragging) return;
+      if (selected.body) {
+        var b = bodyObjects[selected.body];
+        var bm = {op: "moveBody", body: selected.body, position: [b.position.x, b.position.y, b.position.z]};
+        if (gizmo.getMode() === "rotate") bm.quaternion = [b.quaternion.w, b.quaternion.x, b.quaternion.y, b.quaternion.z];
+        queueMove(bm);
+        return;
+      }
       var o = clipObjects[selected.cable][selected.clip];
       var move = {cable: selected.cable, clip: selected.clip, position: [o.position.x, o.position.y, o.position.z]};
       if (gizmo.getMode() === "rotate") move.quaternion = [o.quaternion.w, o.quaternion.x, o.quaternion.y, o.quaternion.z];
@@ -111,8 +118,10 @@
       ray.setFromCamera({x: (e.clientX - r.left) / r.width * 2 - 1, y: -(e.clientY - r.top) / r.height * 2 + 1}, camera);
       var handles = [];
       Object.keys(clipObjects).forEach(function (c) { Object.keys(clipObjects[c]).forEach(function (k) { handles.push(clipObjects[c][k].userData.handle); }); });
+      Object.keys(bodyObjects).forEach(function (n) { handles.push(bodyObjects[n].userData.handle); });
       var hit = ray.intersectObjects(handles)[0];
-      if (hit) select(hit.object.userData.cable, hit.object.userData.clip);
+      if (hit && hit.object.userData.body) selectBody(hit.object.userData.body);
+      else if (hit) select(hit.object.userData.cable, hit.object.userData.clip);
     });
     window.addEventListener("keydown", function (e) {
       if (e.target.tagName === "INPUT" || e.target.tagName === "SELECT") return;
@@ -207,6 +216,54 @@
     return grp;
   }
 
+  // A hinge clip's turning axis: a grey rod through the clip (global axis, set per state).
+  function setHingeAxis(o, axis, size) {
+    if (!axis) { if (o.userData.axis) o.userData.axis.visible = false; return; }
+    if (!o.userData.axis) {
+      var rod = new THREE.Mesh(new THREE.CylinderBufferGeometry(size * 0.15, size * 0.15, size * 10, 8), new THREE.MeshLambertMaterial({color: 0x7f3fbf}));
+      rod.name = "hinge-axis";
+      scene.add(rod);
+      o.userData.axis = rod;
+    }
+    var rod = o.userData.axis;
+    rod.visible = o.visible;
+    rod.position.copy(o.position);
+    rod.quaternion.setFromUnitVectors(new THREE.Vector3(0, 1, 0), new THREE.Vector3(axis[0], axis[1], axis[2]));
+  }
+
+  // Junctions: a sphere with its frame (a harness's break-outs), posed per state.
+  function drawJunctions(junctions, size) {
+    Object.keys(junctions || {}).forEach(function (n) {
+      var j = junctions[n], o = junctionObjects[n];
+      if (!o) {
+        o = new THREE.Group();
+        o.add(new THREE.Mesh(new THREE.SphereBufferGeometry(size, 16, 12), new THREE.MeshLambertMaterial({color: 0xff9f1c})));
+        [[1, 0, 0, 0xd62728], [0, 1, 0, 0x2ca02c], [0, 0, 1, 0x1f77b4]].forEach(function (a) {
+          o.add(new THREE.ArrowHelper(new THREE.Vector3(a[0], a[1], a[2]), new THREE.Vector3(), size * 3, a[3], size * 0.8, size * 0.5));
+        });
+        o.name = "junction:" + n;
+        scene.add(o);
+        junctionObjects[n] = o;
+      }
+      setClipPose(o, j.position, j.frame);
+    });
+  }
+
+  // A body's handle: a grey cube with the body's axes at its origin (drag it to move the body).
+  function makeBody(name, size) {
+    var grp = new THREE.Group();
+    var handle = new THREE.Mesh(new THREE.BoxBufferGeometry(size, size, size), new THREE.MeshLambertMaterial({color: 0x5a6470, transparent: true, opacity: 0.8}));
+    handle.userData = {body: name};
+    grp.add(handle);
+    grp.userData.handle = handle;
+    [[1, 0, 0, 0xd62728], [0, 1, 0, 0x2ca02c], [0, 0, 1, 0x1f77b4]].forEach(function (a) {
+      grp.add(new THREE.ArrowHelper(new THREE.Vector3(a[0], a[1], a[2]), new THREE.Vector3(), size * 2.5, a[3], size * 0.5, size * 0.3));
+    });
+    grp.name = "body-handle:" + name;
+    scene.add(grp);
+    return grp;
+  }
+
   function setClipPose(o, p, rows) {
     o.position.set(p[0], p[1], p[2]);
     var m = new THREE.Matrix4().makeBasis(
@@ -238,12 +295,29 @@
         c.figures.clips.forEach(function (k, j) {
           var o = clipObjects[n][k.name];
           if (!(gizmo.dragging && selected && selected.cable === n && selected.clip === k.name)) setClipPose(o, c.clipPositions[j], c.clipFrames[j]);
+          if (c.clipAxes) setHingeAxis(o, c.clipAxes[j], Math.max(c.radius * 2.5, 0.004));
         });
       }
     });
+    var rmax = 0;
+    Object.keys(state.cables).forEach(function (n) { rmax = Math.max(rmax, state.cables[n].radius); });
+    if (withClips && state.junctions) drawJunctions(state.junctions, Math.max(rmax * 1.6, 0.004));
+    if (withClips && state.bodies) {
+      Object.keys(state.bodies).forEach(function (n) {
+        var b = state.bodies[n];
+        if (bodyObjects[n] && !(gizmo.dragging && selected && selected.body === n)) setClipPose(bodyObjects[n], b.origin, b.frame);
+      });
+      poseBodies(liveMaps(state));
+    }
     drawColourBar(r);
     shown = state;
     dirty = true;
+  }
+
+  function liveMaps(state) {
+    var maps = {};
+    Object.keys(state.bodies || {}).forEach(function (n) { maps[n] = state.bodies[n].map; });
+    return maps;
   }
 
   function applyLive(state) {
@@ -271,6 +345,7 @@
       if (f.minClearance !== undefined) html += '<tr><td>min clearance</td><td class="num' + (f.minClearance < 0 ? " bad" : "") + '">' + fmt(f.minClearance * 1e3, 3) + " mm at s = " + fmt(f.minClearanceS, 3) + " m</td></tr>";
       html += '<tr><td>last solve</td><td class="num">' + fmt(f.solveMs, 2) + " ms, " + f.iterations + " iterations</td></tr>";
       html += "</table><table><tr><th>clip</th><th>s [m]</th><th>type</th><th>length [m]</th><th>|F| [N]</th><th>|M| [N m]</th></tr>";
+      var extra = [];
       f.clips.forEach(function (k) {
         var sel = selected && selected.cable === n && selected.clip === k.name;
         var fn = Math.hypot.apply(null, k.force), mn = Math.hypot.apply(null, k.moment);
@@ -281,9 +356,32 @@
           "<td><select" + d + ' data-key="type">' + opts + "</select></td>" +
           '<td><input type="number" step="0.005"' + d + ' data-key="length" value="' + k.length + '" style="width:46px"></td>' +
           '<td class="num">' + fmt(fn, 3) + '</td><td class="num">' + fmt(mn, 3) + "</td></tr>";
+        if (k.type === "hinge" && k.axis) extra.push("<tr" + d + "><td>" + esc(k.name) + '</td><td>hinge axis (d1, d2, d3)</td><td class="num">' +
+          k.axis.map(function (a, i) { return '<input type="number" step="0.1" class="axis"' + d + ' data-key="axis" data-index="' + i + '" value="' + a + '" style="width:40px">'; }).join("") + "</td></tr>");
+        if (k.type === "sliding") extra.push("<tr" + d + "><td>" + esc(k.name) + '</td><td>slid through</td><td class="num slid">' + (k.slid === null ? "–" : fmt(k.slid * 1e3, 3) + " mm") + "</td></tr>");
       });
       html += "</table>";
+      if (extra.length) html += '<table class="clip-extra">' + extra.join("") + "</table>";
     });
+    if (state.junctions) {
+      html += "<h2>junctions</h2><table>";
+      Object.keys(state.junctions).forEach(function (n) {
+        var p = state.junctions[n].position;
+        html += "<tr><td>" + esc(n) + '</td><td class="num">[' + p.map(function (v) { return fmt(v, 4); }).join(", ") + "] m</td></tr>";
+      });
+      html += "</table>";
+    }
+    var names = Object.keys(state.bodies || {});
+    if (names.length) {
+      html += '<h2>bodies</h2><table class="bodies">';
+      names.forEach(function (n) {
+        var b = state.bodies[n], sel = selected && selected.body === n;
+        html += '<tr class="body' + (sel ? " sel" : "") + '" data-body="' + esc(n) + '"><td>' + esc(n) + '</td><td class="num">origin [' +
+          b.origin.map(function (v) { return fmt(v, 4); }).join(", ") + "] m, " + b.clips + " clip(s)</td></tr>";
+        if (b.refused) html += '<tr><td colspan="2" class="bad">' + esc(b.refused) + "</td></tr>";
+      });
+      html += "</table>";
+    }
     var box = $("cables");
     if (box.contains(document.activeElement) && document.activeElement.tagName === "INPUT") return; // typing
     box.innerHTML = html;
@@ -331,7 +429,8 @@
   function sendMove(move) {
     inflight = true;
     var mark = dragMark; dragMark = false;
-    request({op: "move", moves: [move], mark: mark}).catch(function (e) { showMessage(e.message, true); }).then(function () {
+    var req = move.op === "moveBody" ? {op: "moveBody", body: move.body, position: move.position, quaternion: move.quaternion || null, mark: mark} : {op: "move", moves: [move], mark: mark};
+    request(req).catch(function (e) { showMessage(e.message, true); }).then(function () {
       inflight = false;
       if (pending) { var p = pending; pending = null; sendMove(p); return; }
       var done = idleWaiters; idleWaiters = [];
@@ -346,6 +445,19 @@
     $("selected").innerHTML = "selected: cable <b>" + esc(cable) + "</b>, clip <b>" + esc(clip) + "</b> — drag the arrows (W: move, E: turn)";
     dirty = true;
   }
+  function selectBody(name) {
+    var b = live.bodies[name];
+    if (b.refused) { showMessage(b.refused, true); return; }
+    selected = {body: name};
+    gizmo.attach(bodyObjects[name]);
+    panel(live);
+    $("selected").innerHTML = "selected: body <b>" + esc(name) + "</b> (" + b.clips + " clip(s)) — drag the arrows (W: move, E: turn)";
+    dirty = true;
+  }
+  function selectedObject() {
+    if (!selected) return null;
+    return selected.body ? bodyObjects[selected.body] : clipObjects[selected.cable][selected.clip];
+  }
   function setMode(m) {
     gizmo.setMode(m);
     $("mode-translate").className = m === "translate" ? "on" : "";
@@ -356,9 +468,15 @@
 
   // ---------------------------------------------------------------- result file
   function showClips(on) {
-    Object.keys(clipObjects).forEach(function (c) { Object.keys(clipObjects[c]).forEach(function (k) { clipObjects[c][k].visible = on; }); });
+    Object.keys(clipObjects).forEach(function (c) { Object.keys(clipObjects[c]).forEach(function (k) {
+      var o = clipObjects[c][k];
+      o.visible = on;
+      if (o.userData.axis && !on) o.userData.axis.visible = false;
+    }); });
+    Object.keys(junctionObjects).forEach(function (n) { junctionObjects[n].visible = on; });
+    Object.keys(bodyObjects).forEach(function (n) { bodyObjects[n].visible = on; });
     gizmo.visible = on && selected !== null;
-    if (!on) gizmo.detach(); else if (selected) gizmo.attach(clipObjects[selected.cable][selected.clip]);
+    if (!on) gizmo.detach(); else if (selected) gizmo.attach(selectedObject());
   }
   // Bodies at a saved step: x = R X + t, rows of [R | t] (at rest without).
   function poseBodies(poses) {
@@ -400,7 +518,7 @@
     });
     $("player-live").addEventListener("click", function () {
       if (timer) { clearInterval(timer); timer = null; $("player-play").textContent = "play"; }
-      playing = null; $("player-time").textContent = ""; showClips(true); poseBodies({}); draw(live, true);
+      playing = null; $("player-time").textContent = ""; showClips(true); poseBodies(liveMaps(live)); draw(live, true);
     });
     // test hook: show saved step k of the result; resolves when drawn, with its nodes
     window.cablelifeWorkbench.showResultStep = function (k) {
@@ -435,7 +553,11 @@
         var c = st.cables[n], size = Math.max(c.radius * 2.5, 0.004);
         c.figures.clips.forEach(function (k) { clipObjects[n][k.name] = makeClip(n, k.name, size); });
       });
+      Object.keys(st.bodies || {}).forEach(function (n) {
+        if (st.bodies[n].clips > 0 || bodyMeshes[n]) bodyObjects[n] = makeBody(n, 0.012);
+      });
       fitCamera(st);
+      document.body.dataset.junctions = Object.keys(st.junctions || {}).length;
       applyLive(st);
       $("mode-translate").onclick = function () { setMode("translate"); };
       $("mode-rotate").onclick = function () { setMode("rotate"); };
@@ -445,11 +567,14 @@
         var t = e.target, key = t.dataset.key;
         if (!key) return;
         var value = key === "type" ? t.value : parseFloat(t.value);
+        if (key === "axis") value = Array.prototype.map.call(document.querySelectorAll('input.axis[data-cable="' + t.dataset.cable + '"][data-item="' + t.dataset.item + '"]'), function (e) { return parseFloat(e.value); });
         request({op: "edit", cable: t.dataset.cable, item: t.dataset.item, key: key, value: value}).catch(function (err) {
           showMessage(err.message, true); panel(live);
         });
       });
       $("cables").addEventListener("click", function (e) {
+        var tb = e.target.closest("tr.body");
+        if (tb) { selectBody(tb.dataset.body); return; }
         var tr = e.target.closest("tr.clip");
         if (tr && e.target.tagName !== "INPUT" && e.target.tagName !== "SELECT") select(tr.dataset.cable, tr.dataset.item);
       });
@@ -492,7 +617,46 @@
       var out = {cables: {}};
       if (!live) return out;
       Object.keys(live.cables).forEach(function (n) { out.cables[n] = {positions: live.cables[n].positions}; });
+      if (live.junctions) {
+        out.junctions = {};
+        Object.keys(live.junctions).forEach(function (n) { out.junctions[n] = {position: live.junctions[n].position, drawn: junctionObjects[n].position.toArray()}; });
+      }
       return out;
+    },
+    // moves a body to a new origin (and orientation, quaternion [w, x, y, z]); resolves when drawn
+    moveBody: function (body, xyz, quaternion) {
+      return request({op: "moveBody", body: body, position: xyz, quaternion: quaternion || null, mark: true}).then(function (msg) {
+        if (msg.ok === false) throw new Error(msg.error);
+        return {solveMs: msg.solveMs};
+      });
+    },
+    selectBody: selectBody,
+    // a body's handle and mesh as drawn: handle position, quaternion [w, x, y, z], mesh map rows (3 x 4)
+    bodyPose: function (body) {
+      var o = bodyObjects[body], m = bodyMeshes[body], e = m ? m.matrix.elements : null;
+      return {position: o.position.toArray(), quaternion: [o.quaternion.w, o.quaternion.x, o.quaternion.y, o.quaternion.z],
+        map: e ? [[e[0], e[4], e[8], e[12]], [e[1], e[5], e[9], e[13]], [e[2], e[6], e[10], e[14]]] : null};
+    },
+    // the handle axis under the mouse ("X", "Y", "Z", "E", "XYZE", … or null), to find the rings in tests
+    gizmoAxis: function () { return gizmo.axis; },
+    setMode: setMode,
+    bodyOnScreen: function (body) {
+      var v = bodyObjects[body].position.clone().project(camera), r = renderer.domElement.getBoundingClientRect();
+      return [r.left + (v.x + 1) / 2 * r.width, r.top + (1 - v.y) / 2 * r.height];
+    },
+    // the side panel's text of a clip's extra rows (hinge axis, slid length), for tests
+    clipExtra: function (cable, clip) {
+      var rows = document.querySelectorAll('table.clip-extra tr[data-cable="' + cable + '"][data-item="' + clip + '"]');
+      return Array.prototype.map.call(rows, function (r) {
+        var axis = r.querySelectorAll("input.axis");
+        return axis.length ? {axis: Array.prototype.map.call(axis, function (e) { return parseFloat(e.value); })} : {slid: r.querySelector(".slid").textContent};
+      });
+    },
+    // a hinge clip's drawn axis (global unit vector) or null
+    hingeAxis: function (cable, clip) {
+      var a = clipObjects[cable][clip].userData.axis;
+      if (!a || !a.visible) return null;
+      return new THREE.Vector3(0, 1, 0).applyQuaternion(a.quaternion).toArray();
     },
     stats: function () {
       return {solvesPerSecond: rate(updateTimes), lastSolveMs: lastSolveMs, framesPerSecond: rate(frameTimes)};
