@@ -458,6 +458,38 @@ pub struct Contact {
     /// start inside the geometry being resolved: a point deeper inside a mesh than the
     /// barrier's reach reads as far otherwise).
     deep: Vec<bool>,
+    /// Samples along a Newton correction (`line_search`): κ·weight, gap, approach.
+    line: Vec<(f64, f64, f64)>,
+    /// The queries of the last assembly, per obstacle k and edge e (index k · edges + e): the
+    /// edge's end points, the exact distance at its midpoint (∞: not queried), the obstacle's
+    /// position and rotation, and per sample (stride `max_samples` + 1) distance and normal.
+    /// `step_bound` and `line_search` at the same positions reuse them instead of querying
+    /// the geometry again.
+    cache_edges: Vec<CachedEdge>,
+    cache_samples: Vec<(f64, Vector3<f64>)>,
+}
+
+/// An edge's queries of the last assembly against one obstacle (`Contact::edge_samples`).
+#[derive(Clone, Debug)]
+struct CachedEdge {
+    a: Vector3<f64>,
+    b: Vector3<f64>,
+    /// Exact distance at the midpoint; ∞: not queried.
+    d_mid: f64,
+    position: Vector3<f64>,
+    rotation: Matrix3<f64>,
+}
+
+impl Default for CachedEdge {
+    fn default() -> Self {
+        CachedEdge {
+            a: Vector3::zeros(),
+            b: Vector3::zeros(),
+            d_mid: f64::INFINITY,
+            position: Vector3::zeros(),
+            rotation: Matrix3::zeros(),
+        }
+    }
 }
 
 /// A node of the cable inside an obstacle deeper than the allowed penetration.
@@ -552,6 +584,7 @@ impl Contact {
             .collect();
         let n = rod.arc.len();
         let n_obstacles = obstacles.len();
+        let opts_samples = opts.max_samples.max(1);
         Ok(Contact {
             obstacles,
             kappa,
@@ -567,6 +600,12 @@ impl Contact {
             min_gap: f64::INFINITY,
             active: 0,
             deep: vec![false; n_obstacles * n.saturating_sub(1)],
+            line: Vec::new(),
+            cache_edges: vec![CachedEdge::default(); n_obstacles * n.saturating_sub(1)],
+            cache_samples: vec![
+                (0.0, Vector3::zeros());
+                n_obstacles * n.saturating_sub(1) * (opts_samples + 1)
+            ],
         })
     }
 
@@ -609,30 +648,153 @@ impl Contact {
         edges: impl Iterator<Item = usize> + Clone,
     ) -> f64 {
         let mut alpha = 1.0f64;
-        let r = self.opts.radius;
-        for (k, o) in self.obstacles.iter().enumerate() {
-            let kk = self.samples[k];
+        for k in 0..self.obstacles.len() {
             for e in edges.clone() {
-                let (a, b) = (x[e], x[e + 1]);
                 let (da, db) = (dx(e), dx(e + 1));
                 let motion = da.norm().max(db.norm());
-                let mid = 0.5 * (a + b);
-                let half = 0.5 * (b - a).norm();
-                if o.distance_within(&mid, half + r + motion) - half - r > motion {
-                    continue;
-                }
-                for i in 0..=kk {
-                    let t = i as f64 / kk as f64;
-                    let q = o.query(&(a + t * (b - a)));
-                    let g = q.distance - r;
-                    let approach = -q.normal.dot(&(da + t * (db - da)));
+                self.edge_samples(x, k, e, motion, |t, g, normal| {
+                    let approach = -normal.dot(&(da + t * (db - da)));
                     if g > 0.0 && approach * alpha > 0.9 * g {
                         alpha = 0.9 * g / approach;
                     }
-                }
+                });
             }
         }
         alpha
+    }
+
+    /// Calls `f(t, gap, normal)` for the samples of edge e against obstacle k at the positions
+    /// `x`, unless the edge's capsule is farther than `margin` from the obstacle: from the last
+    /// assembly's queries if it was at these positions and this pose, else by new queries.
+    fn edge_samples(
+        &self,
+        x: &[Vector3<f64>],
+        k: usize,
+        e: usize,
+        margin: f64,
+        mut f: impl FnMut(f64, f64, &Vector3<f64>),
+    ) {
+        let o = &self.obstacles[k];
+        let r = self.opts.radius;
+        let kk = self.samples[k];
+        let (a, b) = (x[e], x[e + 1]);
+        let half = 0.5 * (b - a).norm();
+        let slot = k * (x.len() - 1) + e;
+        let c = &self.cache_edges[slot];
+        if c.d_mid.is_finite()
+            && c.a == a
+            && c.b == b
+            && c.position == o.position
+            && c.rotation == o.rotation
+        {
+            if c.d_mid - half - r > margin {
+                return;
+            }
+            let stride = self.opts.max_samples.max(1) + 1;
+            for (i, (d, n)) in self.cache_samples[slot * stride..][..=kk]
+                .iter()
+                .enumerate()
+            {
+                f(i as f64 / kk as f64, d - r, n);
+            }
+            return;
+        }
+        let mid = 0.5 * (a + b);
+        if o.distance_within(&mid, half + r + margin) - half - r > margin {
+            return;
+        }
+        for i in 0..=kk {
+            let t = i as f64 / kk as f64;
+            let q = o.query(&(a + t * (b - a)));
+            f(t, q.distance - r, &q.normal);
+        }
+    }
+
+    /// The step α ∈ (0, 1] along a Newton correction `dx(n)` of the nodes from `x` (edges
+    /// `edges`, lengths `ds`): a line search on a model of the barrier-augmented merit,
+    ///
+    ///   ψ(α) = −α (R + C₀) + ½ α² max(R − S, 0) + Σ κ w [b(g − α a) − b(g)],
+    ///
+    /// the rest of the system quadratic (its slope −R − C₀ and curvature R − S from the Newton
+    /// decrement R = −Δxᵀ r, in the position unit: `decrement`), the barrier exact along the
+    /// linearised gap g − α a of each sample (a its approach along the normal; C₀ = Σ κ w b'(g)(−a)
+    /// and S = Σ κ w b''(g) a² the barrier's own slope and curvature). The full step is taken
+    /// when it decreases ψ sufficiently (Armijo, 1e-4) and keeps every gap above a tenth of its
+    /// value (the feasible bound, `step_bound`'s); otherwise the minimiser of ψ within that
+    /// bound. With R ≤ 0 (a reused matrix giving no descent): the feasible bound alone.
+    pub fn line_search(
+        &mut self,
+        x: &[Vector3<f64>],
+        dx: impl Fn(usize) -> Vector3<f64>,
+        edges: impl Iterator<Item = usize> + Clone,
+        ds: &[f64],
+        decrement: f64,
+    ) -> f64 {
+        let mut feasible = 1.0f64;
+        let dhat = self.opts.distance;
+        self.line.clear();
+        let mut line = std::mem::take(&mut self.line);
+        for k in 0..self.obstacles.len() {
+            let kk = self.samples[k];
+            for e in edges.clone() {
+                let (da, db) = (dx(e), dx(e + 1));
+                let motion = da.norm().max(db.norm());
+                let w_end = 0.5 * ds[e] / kk as f64;
+                self.edge_samples(x, k, e, motion + dhat, |t, g, normal| {
+                    let approach = -normal.dot(&(da + t * (db - da)));
+                    if g > 0.0 && approach * feasible > 0.9 * g {
+                        feasible = 0.9 * g / approach;
+                    }
+                    if g - approach.max(0.0) < dhat {
+                        let w = if t == 0.0 || t == 1.0 {
+                            w_end
+                        } else {
+                            2.0 * w_end
+                        };
+                        line.push((self.kappa * w, g, approach));
+                    }
+                });
+            }
+        }
+        self.line = line;
+        if decrement <= 0.0 || self.line.is_empty() {
+            return feasible;
+        }
+        let (mut c0, mut s) = (0.0, 0.0);
+        for &(kw, g, a) in &self.line {
+            let (_, b1, b2) = barrier(g, dhat);
+            c0 -= kw * b1 * a;
+            s += kw * b2 * a * a;
+        }
+        let slope = -decrement - c0;
+        let curv = (decrement - s).max(0.0);
+        let dmerit = |al: f64| {
+            let mut v = slope + al * curv;
+            for &(kw, g, a) in &self.line {
+                v -= kw * barrier(g - al * a, dhat).1 * a;
+            }
+            v
+        };
+        // ψ is convex (b is): the minimiser within the feasible bound, by bisection on ψ'.
+        if dmerit(feasible) <= 0.0 {
+            return feasible;
+        }
+        let (mut lo, mut hi) = (0.0, feasible);
+        for _ in 0..40 {
+            let mid = 0.5 * (lo + hi);
+            if dmerit(mid) > 0.0 {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+            if hi - lo < 1e-3 * feasible {
+                break;
+            }
+        }
+        if feasible == 1.0 && lo > 0.95 {
+            return 1.0; // Newton's own step (near convergence ψ' vanishes near 1)
+        }
+        lo.max(1e-3 * feasible)
     }
 
     /// Whether a trial state is acceptable after one with the smallest gap `before`: its
@@ -757,16 +919,27 @@ impl Contact {
         let mid = 0.5 * (a + b);
         let half = 0.5 * (b - a).norm();
         let far = o.shape.bounding_radius();
+        let slot = k * rod.n_edges() + e;
+        self.cache_edges[slot].d_mid = f64::INFINITY;
         if far.is_finite() && (mid - o.position).norm() - half - far > reach {
             return;
         }
         let mut d_mid = o.distance_within(&mid, half + reach);
-        if self.deep[k * rod.n_edges() + e] && d_mid >= half + reach {
+        if self.deep[slot] && d_mid >= half + reach {
             d_mid = o.distance(&mid); // deeper inside than the bound, or far
         }
         if d_mid - half >= reach {
             return;
         }
+        // Exact here (within the bound): kept with the samples' queries below.
+        self.cache_edges[slot] = CachedEdge {
+            a,
+            b,
+            d_mid,
+            position: o.position,
+            rotation: o.rotation,
+        };
+        let stride = self.opts.max_samples.max(1) + 1;
         let kk = self.samples[k];
         let (ra, rb) = (self.reference[e], self.reference[e + 1]);
         let a_free = rod.node_kind[e] == NodeKind::Free;
@@ -776,6 +949,7 @@ impl Contact {
             let w = if i == 0 || i == kk { 0.5 } else { 1.0 } * ds / kk as f64;
             let x = a + t * (b - a);
             let q = o.query(&x);
+            self.cache_samples[slot * stride + i] = (q.distance, q.normal);
             if outputs {
                 self.min_gap = self.min_gap.min(q.distance - self.opts.radius);
             }

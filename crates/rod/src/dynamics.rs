@@ -113,6 +113,14 @@ pub struct DynamicOptions {
     /// `contact_tolerance` is reached in fewer iterations with a fresh matrix than by the slow
     /// contraction of a reused one (bench_contact: 7.8 → 6.3 iterations per step, 30 % faster).
     pub contact_refactor_rate: f64,
+    /// With contact: shorten a Newton correction by a line search on a model of the
+    /// barrier-augmented merit (`Contact::line_search`) instead of the fixed rule "close at
+    /// most 90 % of a gap" (`Contact::step_bound`, still the feasible bound), and refactor
+    /// after a shortened correction. Off by default: 7.4 → 5.9 iterations per step on
+    /// bench_contact, but
+    /// the drop test then gains energy in a sub-step the step guard accepts unchecked
+    /// (docs/contact.md).
+    pub contact_line_search: bool,
 }
 
 impl Default for DynamicOptions {
@@ -129,6 +137,7 @@ impl Default for DynamicOptions {
             energy_tolerance: 1e-3,
             contact_tolerance: 1e-5,
             contact_refactor_rate: 0.2,
+            contact_line_search: false,
         }
     }
 }
@@ -639,7 +648,7 @@ impl Dynamics {
                 last_fresh_norm = norm;
             }
             // Contact: no dive through the barrier (the correction is shortened).
-            let alpha = match &self.contact {
+            let alpha = match &mut self.contact {
                 Some(c) => {
                     let kx = h * self.k_dq * c_mass;
                     let (delta, half) = (&self.delta, &self.inertial_half);
@@ -650,7 +659,25 @@ impl Dynamics {
                             Vector3::zeros()
                         }
                     };
-                    c.step_bound(&st.x, dx, seg.edges.iter().cloned())
+                    if self.opts.contact_line_search {
+                        // The Newton decrement −Δxᵀ r in the position unit (J δ = −r, Δx = kx δ).
+                        let rhs = &self.ws.rhs;
+                        let decrement = -kx
+                            * seg
+                                .blocks
+                                .clone()
+                                .map(|b| rhs[b].dot(&delta[b]))
+                                .sum::<f64>();
+                        c.line_search(
+                            &st.x,
+                            dx,
+                            seg.edges.iter().cloned(),
+                            &rod.ds_edge,
+                            decrement,
+                        )
+                    } else {
+                        c.step_bound(&st.x, dx, seg.edges.iter().cloned())
+                    }
                 }
                 None => 1.0,
             };
@@ -700,6 +727,11 @@ impl Dynamics {
             } else {
                 self.opts.refactor_rate
             };
+            // With the line search: a correction the contact shortened has the barrier far
+            // from its linearisation; the next iterate gets a fresh matrix.
+            if alpha < 1.0 && self.opts.contact_line_search {
+                self.factors[k].valid = false;
+            }
             if norm > rate * last_norm && !refactor {
                 self.factors[k].valid = false;
             }

@@ -729,3 +729,130 @@ fn a_cable_held_inside_a_mesh_is_an_error_naming_node_and_geometry() {
         other => panic!("expected a penetration error, got {other:?}"),
     }
 }
+
+/// The step bound of a Newton correction from the last assembly's queries (kept per edge with
+/// its end points and the obstacle's pose) equals the one from fresh queries, on a plane and a
+/// cylinder (8 samples per edge), also after the obstacle moved (the kept queries then unused).
+#[test]
+fn step_bound_from_the_assembly_queries_equals_fresh_queries() {
+    let (r, l, n) = (0.003, 0.3, 30);
+    let spec = CableSpec {
+        length: l,
+        segments: n,
+        section: circle(r, 5e7, 0.45, 1500.0),
+        natural_curvature: Vector3::zeros(),
+        clips: vec![],
+        loads: vec![],
+        gravity: Vector3::new(0.0, 0.0, -9.81),
+    };
+    let rod = Rod::new(spec).unwrap();
+    let dhat = ContactOptions::for_radius(r).distance;
+    // Over a cylinder (axis y, radius 2 cm, top at z = 0) and a plane at z = −0.05: the middle
+    // nodes within the barrier of the cylinder, the ends near the plane.
+    let x: Vec<_> = rod
+        .arc
+        .iter()
+        .map(|&s| {
+            let u = s - 0.5 * l;
+            Vector3::new(u, 0.0, r + 0.5 * dhat + 40.0 * u * u * u.abs().min(0.02))
+        })
+        .collect();
+    let st = state_through(&rod, x, Vector3::z());
+    let cylinder = Pose {
+        position: Vector3::new(0.0, 0.0, -0.02),
+        orientation: frame_quaternion(&Vector3::y(), &Vector3::z()).unwrap(),
+    };
+    let plane = at(Vector3::new(0.0, 0.0, -0.05), Vector3::z());
+    let obstacles = |pose: &Pose| {
+        vec![
+            Obstacle::new(
+                "pipe",
+                0,
+                Box::new(Cylinder {
+                    radius: 0.02,
+                    length: 0.4,
+                }),
+                0.3,
+                pose,
+            ),
+            Obstacle::new("floor", 0, Box::new(Plane), 0.0, &plane),
+        ]
+    };
+    let mut dy = Dynamics::new(&rod, &st, &[], DynamicOptions::default());
+    dy.contact = Some(contact(&rod, obstacles(&cylinder), r));
+    dy.start(&rod, &st).unwrap(); // assembles the whole cable: the queries are kept
+    let assembled = dy.contact.as_mut().unwrap();
+    assert!(assembled.active > 0, "no sample inside the barrier");
+    // Down by up to 2 d̂, twisted along the cable.
+    let dx = |k: usize| {
+        let u = k as f64 / n as f64;
+        Vector3::new(1e-4 * u, 2e-4 * (1.0 - u), -2.0 * dhat * (0.3 + u))
+    };
+    let fresh = contact(&rod, obstacles(&cylinder), r);
+    let alpha = assembled.step_bound(&st.x, dx, 0..n);
+    assert!(alpha < 0.9, "the bound does not act: {alpha}");
+    assert_eq!(alpha, fresh.step_bound(&st.x, dx, 0..n));
+    // Per edge too (the bound of each edge alone).
+    for e in 0..n {
+        assert_eq!(
+            assembled.step_bound(&st.x, dx, e..e + 1),
+            fresh.step_bound(&st.x, dx, e..e + 1),
+            "edge {e}"
+        );
+    }
+    // The pipe moved 0.4 d̂ up since the assembly: the kept queries are stale.
+    let mut moved = cylinder;
+    moved.position.z += 0.4 * dhat;
+    assembled.set_obstacle_poses(&[moved, plane]);
+    let fresh = contact(&rod, obstacles(&moved), r);
+    let alpha_moved = assembled.step_bound(&st.x, dx, 0..n);
+    assert_eq!(alpha_moved, fresh.step_bound(&st.x, dx, 0..n));
+    assert!(alpha_moved < alpha, "{alpha_moved} vs {alpha}");
+}
+
+/// The line search (`DynamicOptions::contact_line_search`, off by default) on a straight edge
+/// above a plane moved straight down by its whole gap g₀ (Newton towards zero gap): with the
+/// rest of the system flat (decrement R below the barrier's own curvature S), the step stops
+/// where the barrier's force has grown by R/(κ ds a) — the minimiser of the merit along the
+/// line — well short of the feasible bound 0.9; moving away, the full step.
+#[test]
+fn line_search_stops_where_the_barrier_balances_the_decrement() {
+    let (r, l, n) = (0.003, 0.3, 30);
+    let spec = CableSpec {
+        length: l,
+        segments: n,
+        section: circle(r, 5e7, 0.45, 1500.0),
+        natural_curvature: Vector3::zeros(),
+        clips: vec![],
+        loads: vec![],
+        gravity: Vector3::new(0.0, 0.0, -9.81),
+    };
+    let rod = Rod::new(spec).unwrap();
+    let dhat = ContactOptions::for_radius(r).distance;
+    let g0 = 0.5 * dhat;
+    let x: Vec<_> = rod
+        .arc
+        .iter()
+        .map(|&s| Vector3::new(s, 0.0, r + g0))
+        .collect();
+    let floor = Obstacle::new("floor", 0, Box::new(Plane), 0.0, &origin());
+    let mut c = contact(&rod, vec![floor], r);
+    let down = |_: usize| Vector3::new(0.0, 0.0, -g0);
+    let (_, b1, b2) = rod::contact::barrier(g0, dhat);
+    let (kds, a) = (c.kappa * rod.ds_edge[0], g0);
+    let s = kds * b2 * a * a;
+    let decrement = 0.5 * s;
+    let alpha = c.line_search(&x, down, 0..1, &rod.ds_edge, decrement);
+    assert!(alpha > 0.0 && alpha < 0.85, "{alpha}");
+    // −b'(g₀(1 − α)) = −b'(g₀) + R/(κ ds a), to the search's resolution (1e-3 of the bound).
+    let target = -b1 + decrement / (kds * a);
+    let force = |al: f64| -rod::contact::barrier(g0 * (1.0 - al), dhat).1;
+    assert!(
+        force(alpha - 1e-3) <= target && target <= force(alpha + 1e-3),
+        "α = {alpha}: {} .. {} vs {target}",
+        force(alpha - 1e-3),
+        force(alpha + 1e-3)
+    );
+    let up = |_: usize| Vector3::new(0.0, 0.0, g0);
+    assert_eq!(c.line_search(&x, up, 0..1, &rod.ds_edge, decrement), 1.0);
+}
