@@ -85,9 +85,7 @@ def check_junctions(scene: Scene) -> None:
     clipped: dict[str, bool] = {}
     for j in scene.junctions:
         r = find(j.name)
-        held_here = j.clip is not None or any(
-            cables[j.end(i)[0]].clips for i in range(len(j.ends))
-        )
+        held_here = j.clip is not None or any(cables[j.end(i)[0]].clips for i in range(len(j.ends)))
         clipped[r] = clipped.get(r, False) or held_here
     for j in scene.junctions:
         if not clipped[find(j.name)]:
@@ -241,9 +239,7 @@ def run_harness(scene: Scene, times: np.ndarray, mode: str, progress, stop):
             quaternion=out["junction_quaternions"][:, jj].copy(),
             branch_force={k: v[0] for k, v in branches.items()},
             branch_moment={k: v[1] for k, v in branches.items()},
-            reaction_force=None
-            if j.clip is None
-            else out["junction_reaction_force"][:, jj].copy(),
+            reaction_force=None if j.clip is None else out["junction_reaction_force"][:, jj].copy(),
             reaction_moment=None
             if j.clip is None
             else out["junction_reaction_moment"][:, jj].copy(),
