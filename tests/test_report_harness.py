@@ -75,8 +75,8 @@ def test_example_has_every_clip_type_and_its_results(example):
 
 
 def test_harness_view_draws_every_cable_and_the_junctions(example):
-    from cablelife.report.html import ReportRun
     from cablelife.report.harness_view import harness_figure
+    from cablelife.report.html import ReportRun
     from cablelife.results import load_result
 
     res = load_result(example / "h.h5")
