@@ -547,3 +547,20 @@ fn junction_held_by_a_clip_follows_it_and_the_reactions_balance() {
     assert!(f_j.norm() < 1e-9 * scale, "{f_j:?}");
     assert!(m_j.norm() < 1e-9 * scale, "{m_j:?}");
 }
+
+#[test]
+fn a_branch_that_runs_out_of_its_guide_is_named() {
+    let h = y_with_guide(20);
+    let mut st = initial(&h);
+    let mut solver = HarnessStatics::new(&h, NewtonOptions::default());
+    solver.solve_static(&h, &mut st).unwrap();
+    // The guide moves along its line beyond the branch's far end.
+    let (c, s) = (30f64.to_radians().cos(), 30f64.to_radians().sin());
+    let mut target: Vec<Vec<Pose>> = st.cables.iter().map(|x| x.clip_pose.clone()).collect();
+    target[1][2].position += 0.25 * Vector3::new(c, s, 0.0);
+    let e = solver.step_to(&h, &mut st, &target).unwrap_err();
+    assert!(
+        e.0.contains("cable 'c1'") && e.0.contains("ran out of sliding clip 'guide'"),
+        "{e}"
+    );
+}
