@@ -120,9 +120,11 @@ class Cable:
 DEFAULT_NEWTON_TOLERANCE: float
 
 class Harness:
-    """A harness: cables (each given with a fixed point clip at every joined end) and junctions."""
+    """A harness: cables (each given with a fixed point clip at every joined end) and junctions;
+    `held`: indices of the junctions held by a clip (their pose follows the clip poses given
+    for their first end)."""
     def __init__(
-        self, cables, names, junctions, max_iterations=40, step_tolerance=1e-9
+        self, cables, names, junctions, max_iterations=40, step_tolerance=1e-9, held=...
     ) -> None: ...
     @property
     def ends(self) -> Any:
@@ -138,10 +140,12 @@ class Harness:
         as `Cable.run_sequence`), `junction_positions` (T, J, 3), `junction_quaternions`
         (T, J, 4, scalar first), `branch_force` and `branch_moment` (T, E, 3: what each joined
         end's cable applies to its junction, global, moment about the junction point),
-        `iterations`, `substeps`, `residual`, `steps` and `error` (None, or why it stopped: the
-        steps before are kept). `warm`: step 0 starts from the last equilibrium of the previous
-        warm run (the first from the routed shapes), and a complete run's last equilibrium is
-        kept for the next; a failed one keeps the previous (the workbench's drags).
+        `junction_reaction_force` and `junction_reaction_moment` (T, J, 3: of the clip on each
+        junction in `held`, zero for the others), `iterations`, `substeps`, `residual`, `steps`
+        and `error` (None, or why it stopped: the steps before are kept). `warm`: step 0 starts
+        from the last equilibrium of the previous warm run (the first from the routed shapes),
+        and a complete run's last equilibrium is kept for the next; a failed one keeps the
+        previous (the workbench's drags).
         """
         ...
 

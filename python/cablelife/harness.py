@@ -56,13 +56,6 @@ def check_junctions(scene: Scene) -> None:
                     )
     held = {cable for cable, _ in used}
     for i, c in enumerate(scene.cables):
-        sliding = [clip.name for clip in c.clips if clip.type == "sliding"]
-        if c.name in held and sliding:
-            _fail(
-                f"cables[{i}] ('{c.name}'): sliding clip '{sliding[0]}' on a cable of a harness "
-                "is not supported yet; use a fixed, swivel or hinge clip there"
-            )
-    for i, c in enumerate(scene.cables):
         if not c.clips and c.name not in held:
             _fail(
                 f"cables[{i}] ('{c.name}') has no clips and no junction joins it; give at "
@@ -92,14 +85,14 @@ def check_junctions(scene: Scene) -> None:
     clipped: dict[str, bool] = {}
     for j in scene.junctions:
         r = find(j.name)
-        held_here = any(cables[j.end(i)[0]].clips for i in range(len(j.ends)))
+        held_here = j.clip is not None or any(cables[j.end(i)[0]].clips for i in range(len(j.ends)))
         clipped[r] = clipped.get(r, False) or held_here
     for j in scene.junctions:
         if not clipped[find(j.name)]:
             group = sorted(k.name for k in scene.junctions if find(k.name) == find(j.name))
             _fail(
                 f"the harness through junctions {group} is held by no clip: it could move as "
-                "a rigid body; give at least one of its cables a clip"
+                "a rigid body; give at least one of its cables or junctions a clip"
             )
 
 
@@ -109,8 +102,9 @@ def end_clip_name(junction: Junction) -> str:
 
 
 def harness_cables(scene: Scene) -> tuple[list[Cable], list[tuple]]:
-    """The scene's cables with a fixed point clip at every joined end, and the junctions as
-    (name, mass, rotary inertia [3], ends as (cable index, clip index))."""
+    """The scene's cables with a fixed point clip at every joined end (on the body of the
+    junction's clip, if it has one), and the junctions as (name, mass, rotary inertia [3],
+    ends as (cable index, clip index))."""
     from cablelife.scene import Clip
 
     index = {c.name: k for k, c in enumerate(scene.cables)}
@@ -130,6 +124,9 @@ def harness_cables(scene: Scene) -> tuple[list[Cable], list[tuple]]:
                 direction=tuple(float(v) for v in tangent),
                 normal=None if j.normals is None else j.normals[i],
                 type="fixed",
+                # A junction held by a clip: its ends' clips move with the clip's body (the
+                # solver takes the junction's pose from its first end's clip).
+                body="world" if j.clip is None else j.clip.body,
             )
             ends.append((index[cable], len(c.clips) + len(extra[cable])))
             extra[cable].append(clip)
@@ -166,6 +163,7 @@ def run_harness(scene: Scene, times: np.ndarray, mode: str, progress, stop):
             [c.name for c in cables],
             specs,
             max_iterations=scene.simulation.max_iterations,
+            held=[k for k, j in enumerate(scene.junctions) if j.clip is not None],
         )
     except ValueError as err:
         raise SceneError(f"harness: {err}") from None
@@ -194,6 +192,7 @@ def run_harness(scene: Scene, times: np.ndarray, mode: str, progress, stop):
                 clip.s,
                 o["reaction_force"][:, j].copy(),
                 o["reaction_moment"][:, j].copy(),
+                o["slid_length"][:, j].copy() if clip.type == "sliding" else None,
             )
             for j, clip in enumerate(c.clips[:n_own])
         }
@@ -240,6 +239,10 @@ def run_harness(scene: Scene, times: np.ndarray, mode: str, progress, stop):
             quaternion=out["junction_quaternions"][:, jj].copy(),
             branch_force={k: v[0] for k, v in branches.items()},
             branch_moment={k: v[1] for k, v in branches.items()},
+            reaction_force=None if j.clip is None else out["junction_reaction_force"][:, jj].copy(),
+            reaction_moment=None
+            if j.clip is None
+            else out["junction_reaction_moment"][:, jj].copy(),
         )
     return results, junctions, out["error"]
 

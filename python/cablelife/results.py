@@ -21,6 +21,8 @@ HDF5 layout (every dataset carries a ``unit`` attribute)::
     /junctions/<name>/time, position (T, 3) m, quaternion (T, 4) 1   harnesses (docs/harness.md)
     /junctions/<name>/branches/<cable:end>/force, moment  (T, 3) N, N m: what that branch
                                  applies to the junction (global, about the junction point)
+    /junctions/<name>/clip/force, moment  (T, 3) N, N m: a junction held by a clip: the clip's
+                                 force and moment on it (global, about the junction point)
 
 Datasets are chunked and compressed (gzip level 1 with the shuffle filter: lossless, readable by
 any HDF5 tool); the histories (positions … clip reactions) are float64, or float32 when the
@@ -234,6 +236,10 @@ class JunctionResult:
     quaternion: np.ndarray  # (T, 4)
     branch_force: dict[str, np.ndarray] = field(default_factory=dict)  # (T, 3) N
     branch_moment: dict[str, np.ndarray] = field(default_factory=dict)  # (T, 3) N m
+    # A junction held by a clip: the clip's force and moment on it (global, about the
+    # junction point); None for a free junction.
+    reaction_force: np.ndarray | None = None  # (T, 3) N
+    reaction_moment: np.ndarray | None = None  # (T, 3) N m
 
     def __repr__(self) -> str:
         return f"JunctionResult({self.name!r}, branches {list(self.branch_force)})"
@@ -357,6 +363,10 @@ def _write_junctions(f, junctions: dict[str, JunctionResult], hist: str | None) 
             b = branches.create_group(end)
             _put(b, "force", force, "N", hist)
             _put(b, "moment", j.branch_moment[end], "N m", hist)
+        if j.reaction_force is not None:
+            clip = g.create_group("clip")
+            _put(clip, "force", j.reaction_force, "N", hist)
+            _put(clip, "moment", j.reaction_moment, "N m", hist)
 
 
 def _read_junctions(f) -> dict[str, JunctionResult]:
@@ -376,6 +386,8 @@ def _read_junctions(f) -> dict[str, JunctionResult]:
             quaternion=get(g["quaternion"]),
             branch_force={e: get(b["force"]) for e, b in br.items()},
             branch_moment={e: get(b["moment"]) for e, b in br.items()},
+            reaction_force=get(g["clip/force"]) if "clip" in g else None,
+            reaction_moment=get(g["clip/moment"]) if "clip" in g else None,
         )
     return out
 

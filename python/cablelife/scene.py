@@ -409,6 +409,14 @@ def read_pose_table(path: Path, what: str) -> dict[str, np.ndarray]:
     return table
 
 
+class JunctionClip(_Model):
+    """A clip that holds a junction (docs/harness.md): the junction is clamped to ``body``
+    ("world": fixed) at its position and orientation; the solver prescribes its pose."""
+
+    name: Name = "clip"
+    body: Annotated[str, Strict()] = "world"
+
+
 class Junction(_Model):
     """A junction of a harness (docs/harness.md): joins cable ends rigidly at ``position``.
     ``ends`` name "cable:start" or "cable:end"; ``directions`` give each end's stress-free
@@ -424,6 +432,7 @@ class Junction(_Model):
     normals: list[Direction] | None = None
     mass: NonNegativeFloat = 0.0  # kg
     rotary_inertia: NonNegativeFloat = 0.0  # kg m², about each axis
+    clip: JunctionClip | None = None  # a clip holding the junction (default: free)
 
     @model_validator(mode="after")
     def _ends(self):
@@ -522,6 +531,12 @@ class Scene(_Model):
                         f"cables[{i}].clips[{j}].body = '{clip.body}' is not a body of the scene; "
                         f"allowed: {allowed}"
                     )
+        for i, junction in enumerate(self.junctions):
+            if junction.clip is not None and junction.clip.body not in allowed:
+                raise ValueError(
+                    f"junctions[{i}].clip.body = '{junction.clip.body}' is not a body of the "
+                    f"scene; allowed: {allowed}"
+                )
         from cablelife.harness import check_junctions
 
         check_junctions(self)

@@ -13,7 +13,9 @@ use rod::{NewtonOptions, Pose};
 /// (name, mass, rotary inertia [3], ends as (cable index, clip index)).
 type JunctionTuple = (String, f64, Vec<f64>, Vec<(usize, usize)>);
 
-/// A harness: cables (each given with a fixed point clip at every joined end) and junctions.
+/// A harness: cables (each given with a fixed point clip at every joined end) and junctions;
+/// `held`: indices of the junctions held by a clip (their pose follows the clip poses given
+/// for their first end).
 #[pyclass(module = "cablelife._core")]
 pub struct Harness {
     tree: Tree,
@@ -25,13 +27,14 @@ pub struct Harness {
 #[pymethods]
 impl Harness {
     #[new]
-    #[pyo3(signature = (cables, names, junctions, max_iterations=40, step_tolerance=1e-9))]
+    #[pyo3(signature = (cables, names, junctions, max_iterations=40, step_tolerance=1e-9, held=vec![]))]
     fn new(
         cables: Vec<PyRef<'_, Cable>>,
         names: Vec<String>,
         junctions: Vec<JunctionTuple>,
         max_iterations: usize,
         step_tolerance: f64,
+        held: Vec<usize>,
     ) -> PyResult<Self> {
         if names.len() != cables.len() {
             return Err(PyValueError::new_err(format!(
@@ -51,7 +54,11 @@ impl Harness {
             });
         }
         let rods = cables.iter().map(|c| c.rod.clone()).collect();
-        let tree = Tree::new(names, rods, specs).map_err(|e| PyValueError::new_err(e.0))?;
+        let mut tree = Tree::new(names, rods, specs).map_err(|e| PyValueError::new_err(e.0))?;
+        for j in held {
+            tree.hold_junction(j)
+                .map_err(|e| PyValueError::new_err(e.0))?;
+        }
         let opts = NewtonOptions {
             max_iterations,
             step_tolerance,
@@ -82,10 +89,12 @@ impl Harness {
     /// as `Cable.run_sequence`), `junction_positions` (T, J, 3), `junction_quaternions`
     /// (T, J, 4, scalar first), `branch_force` and `branch_moment` (T, E, 3: what each joined
     /// end's cable applies to its junction, global, moment about the junction point),
-    /// `iterations`, `substeps`, `residual`, `steps` and `error` (None, or why it stopped: the
-    /// steps before are kept). `warm`: step 0 starts from the last equilibrium of the previous
-    /// warm run (the first from the routed shapes), and a complete run's last equilibrium is
-    /// kept for the next; a failed one keeps the previous (the workbench's drags).
+    /// `junction_reaction_force` and `junction_reaction_moment` (T, J, 3: of the clip on each
+    /// junction in `held`, zero for the others), `iterations`, `substeps`, `residual`, `steps`
+    /// and `error` (None, or why it stopped: the steps before are kept). `warm`: step 0 starts
+    /// from the last equilibrium of the previous warm run (the first from the routed shapes),
+    /// and a complete run's last equilibrium is kept for the next; a failed one keeps the
+    /// previous (the workbench's drags).
     #[pyo3(signature = (positions, quaternions, progress=None, progress_every=50, stop=None,
         warm=false))]
     #[allow(clippy::too_many_arguments)]
@@ -161,6 +170,8 @@ impl Harness {
             jquat: Vec<f64>,
             force: Vec<f64>,
             moment: Vec<f64>,
+            reaction_force: Vec<f64>,
+            reaction_moment: Vec<f64>,
             iterations: Vec<i64>,
             substeps: Vec<i64>,
             residual: Vec<f64>,
@@ -173,6 +184,8 @@ impl Harness {
                 jquat: Vec::with_capacity(t * nj * 4),
                 force: Vec::with_capacity(t * ne * 3),
                 moment: Vec::with_capacity(t * ne * 3),
+                reaction_force: Vec::with_capacity(t * nj * 3),
+                reaction_moment: Vec::with_capacity(t * nj * 3),
                 iterations: Vec::with_capacity(t),
                 substeps: Vec::with_capacity(t),
                 residual: Vec::with_capacity(t),
@@ -199,8 +212,7 @@ impl Harness {
                 }
                 for (c, rod) in tree.cables.iter().enumerate() {
                     out.records[c].push(rod, &st.cables[c], &solver.ws[c], &stats);
-                    // sliding clips are refused on harness cables (harness.py)
-                    out.records[c].push_sliding(rod, None);
+                    out.records[c].push_sliding(rod, solver.sliding[c].as_ref());
                 }
                 for pose in &st.junctions {
                     out.jpos.extend_from_slice(pose.position.as_slice());
@@ -210,6 +222,10 @@ impl Harness {
                 for (f, m) in solver.branch_loads(tree, &st) {
                     out.force.extend_from_slice(f.as_slice());
                     out.moment.extend_from_slice(m.as_slice());
+                }
+                for (f, m) in solver.junction_reactions(tree, &st) {
+                    out.reaction_force.extend_from_slice(f.as_slice());
+                    out.reaction_moment.extend_from_slice(m.as_slice());
                 }
                 out.iterations.push(stats.iterations as i64);
                 out.substeps.push(stats.substeps as i64);
@@ -240,6 +256,14 @@ impl Harness {
         d.set_item("junction_quaternions", shaped(out.jquat, &[n, nj, 4])?)?;
         d.set_item("branch_force", shaped(out.force, &[n, ne, 3])?)?;
         d.set_item("branch_moment", shaped(out.moment, &[n, ne, 3])?)?;
+        d.set_item(
+            "junction_reaction_force",
+            shaped(out.reaction_force, &[n, nj, 3])?,
+        )?;
+        d.set_item(
+            "junction_reaction_moment",
+            shaped(out.reaction_moment, &[n, nj, 3])?,
+        )?;
         d.set_item("iterations", PyArray1::from_vec(py, out.iterations))?;
         d.set_item("substeps", PyArray1::from_vec(py, out.substeps))?;
         d.set_item("residual", PyArray1::from_vec(py, out.residual))?;

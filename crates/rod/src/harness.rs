@@ -81,6 +81,8 @@ pub struct Harness {
     pub(crate) order: Vec<usize>,
     pub(crate) parent: Vec<Option<(usize, usize)>>,
     pub gravity: Vector3<f64>,
+    /// Junctions held by a clip (`hold_junction`): their pose is prescribed, not solved for.
+    pub held: Vec<bool>,
 }
 
 fn err(s: String) -> SpecError {
@@ -286,7 +288,32 @@ impl Harness {
             order,
             parent,
             gravity,
+            held: vec![false; n],
         })
+    }
+
+    /// Holds junction `j` by a clip (docs/harness.md, "Clips holding a junction"): its pose
+    /// follows the target poses given for its first end's clip (`set_clip_poses`, the entries
+    /// otherwise ignored), times the inverse of that end's relative rotation; the solver
+    /// prescribes it and reports the clip's reaction (`HarnessStatics::junction_reactions`).
+    pub fn hold_junction(&mut self, j: usize) -> Result<(), SpecError> {
+        if j >= self.junctions.len() {
+            return Err(err(format!(
+                "junction index {j} out of range: the harness has {} junctions",
+                self.junctions.len()
+            )));
+        }
+        self.held[j] = true;
+        Ok(())
+    }
+
+    /// The pose of junction j that puts the clip of its first end at `end_pose`.
+    pub fn junction_pose_from_end(&self, j: usize, end_pose: &Pose) -> Pose {
+        let e = &self.ends[self.junction_ends[j][0]];
+        Pose {
+            position: end_pose.position,
+            orientation: end_pose.orientation * e.relative.conjugate(),
+        }
     }
 
     /// The coupling terms of each cable (one `EndBlocks` per held end).
@@ -366,13 +393,25 @@ impl HarnessState {
     }
 
     /// Sets the poses of the clips that hold cables (not the junction ends) to `poses[c]`
-    /// (all clips of cable c; the entries of junction ends are ignored). `buffer` is scratch.
+    /// (all clips of cable c; the entries of junction ends are ignored, but for a held
+    /// junction's first end, which gives the junction's pose). `buffer` is scratch.
     pub fn set_clip_poses_with(
         &mut self,
         h: &Harness,
         poses: &[Vec<Pose>],
         buffer: &mut Vec<Pose>,
     ) {
+        let mut moved = false;
+        for (j, held) in h.held.iter().enumerate() {
+            if *held {
+                let e = &h.ends[h.junction_ends[j][0]];
+                self.junctions[j] = h.junction_pose_from_end(j, &poses[e.cable][e.topo.clip]);
+                moved = true;
+            }
+        }
+        if moved {
+            self.sync_ends(h);
+        }
         for (c, rod) in h.cables.iter().enumerate() {
             let st = &mut self.cables[c];
             buffer.clone_from(&poses[c]);

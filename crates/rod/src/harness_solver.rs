@@ -7,6 +7,7 @@ use crate::harness::{Harness, HarnessError, HarnessState};
 use crate::junction::HeldEnds;
 use crate::model::{Pose, Rod};
 use crate::rotation::slerp;
+use crate::sliding::SlidingClips;
 use crate::statics::{NewtonOptions, SolveError, SolveStats};
 use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 
@@ -49,6 +50,8 @@ fn invert(m: &Matrix6<f64>) -> Option<Matrix6<f64>> {
 pub struct HarnessStatics {
     pub ws: Vec<Workspace>,
     pub held: Vec<HeldEnds>,
+    /// Per cable: the sliding clips' term (None without sliding clips).
+    pub sliding: Vec<Option<SlidingClips>>,
     pub opts: NewtonOptions,
     delta: Vec<Vec<Vector6<f64>>>,
     trial: Vec<Vec<Vector6<f64>>>,
@@ -57,6 +60,7 @@ pub struct HarnessStatics {
     trial_j: Vec<Vector6<f64>>,
     /// Junction residuals (∂V/∂(X, Θ)).
     pub junction_residual: Vec<Vector6<f64>>,
+    held_junction: Vec<bool>,
     /// Per end: A⁻¹ B_k, six block-vector columns over its cable.
     z: Vec<[Vec<Vector6<f64>>; 6]>,
     /// Junction pivots (after the tree elimination) and their inverses.
@@ -112,6 +116,7 @@ impl HarnessStatics {
         HarnessStatics {
             ws: h.cables.iter().map(Workspace::new).collect(),
             held: h.held_ends(),
+            sliding: h.cables.iter().map(SlidingClips::of).collect(),
             opts,
             delta: per_cable(),
             trial: per_cable(),
@@ -119,6 +124,7 @@ impl HarnessStatics {
             dj: vec![Vector6::zeros(); nj],
             trial_j: vec![Vector6::zeros(); nj],
             junction_residual: vec![Vector6::zeros(); nj],
+            held_junction: h.held.clone(),
             z: h.ends
                 .iter()
                 .map(|e| std::array::from_fn(|_| blocks(e.cable)))
@@ -156,9 +162,16 @@ impl HarnessStatics {
         lf: f64,
         want_jac: bool,
     ) -> Result<(), HarnessError> {
+        self.held_junction.clone_from(&h.held);
         for (c, rod) in h.cables.iter().enumerate() {
             self.ws[c]
-                .assemble_terms(rod, &st.cables[c], lf, want_jac, &mut [&mut self.held[c]])
+                .assemble_terms(
+                    rod,
+                    &st.cables[c],
+                    lf,
+                    want_jac,
+                    &mut [&mut self.held[c], &mut self.sliding[c]],
+                )
                 .map_err(|k| {
                     Self::cable_err(
                         h,
@@ -200,7 +213,12 @@ impl HarnessStatics {
             inf = inf.max(i);
             two += t * t;
         }
-        for r in &self.junction_residual {
+        for (r, _) in self
+            .junction_residual
+            .iter()
+            .zip(&self.held_junction)
+            .filter(|(_, &held)| !held)
+        {
             for k in 0..6 {
                 let v = if k < 3 { r[k] } else { r[k] / self.h };
                 inf = inf.max(v.abs());
@@ -292,6 +310,11 @@ impl HarnessStatics {
         }
         // The junction tree, leaves first.
         for &j in h.order.iter().rev() {
+            if h.held[j] {
+                // A prescribed junction: no increment, no coupling to its parent.
+                self.pivot_inv[j] = Matrix6::zeros();
+                continue;
+            }
             let inv = invert(&self.pivot[j]).ok_or_else(|| {
                 HarnessError(format!(
                     "the stiffness matrix is singular at junction '{}': the harness is not held \
@@ -655,6 +678,42 @@ impl HarnessStatics {
     ) -> Result<SolveStats, HarnessError> {
         st.sync_ends(h);
         self.has_prev = false; // a new sequence starts here
+        self.begin_step(h, st); // friction acts against the motion from the start
+        let result = self.solve_static_inner(h, st);
+        result.and_then(|s| self.check_sliding(h, st).map(|_| s))
+    }
+
+    /// Starts a step of the sliding clips' friction from `st`.
+    fn begin_step(&mut self, h: &Harness, st: &HarnessState) {
+        for (c, rod) in h.cables.iter().enumerate() {
+            if let Some(s) = &mut self.sliding[c] {
+                s.begin_step(rod, &st.cables[c], None);
+            }
+        }
+    }
+
+    /// Fails naming the cable and the clip if a sliding clip's guide reaches beyond a cable
+    /// end at `st`.
+    pub fn check_sliding(&mut self, h: &Harness, st: &HarnessState) -> Result<(), HarnessError> {
+        for (c, rod) in h.cables.iter().enumerate() {
+            if let Some(Err(k)) = self.sliding[c]
+                .as_mut()
+                .map(|s| s.check(rod, &st.cables[c]))
+            {
+                let e = SolveError::SlidOff {
+                    clip: rod.spec.clips[k].name.clone(),
+                };
+                return Err(Self::cable_err(h, c, e));
+            }
+        }
+        Ok(())
+    }
+
+    fn solve_static_inner(
+        &mut self,
+        h: &Harness,
+        st: &mut HarnessState,
+    ) -> Result<SolveStats, HarnessError> {
         let start = st.clone();
         let full = self.opts.max_iterations;
         self.opts.max_iterations = full.min(15);
@@ -726,11 +785,32 @@ impl HarnessStatics {
         st: &mut HarnessState,
         target: &[Vec<Pose>],
     ) -> Result<SolveStats, HarnessError> {
+        self.begin_step(h, st); // the guides' friction acts from the last equilibrium
+        self.step_from_reference(h, st, target)
+    }
+
+    /// `step_to` with the friction reference already set.
+    fn step_from_reference(
+        &mut self,
+        h: &Harness,
+        st: &mut HarnessState,
+        target: &[Vec<Pose>],
+    ) -> Result<SolveStats, HarnessError> {
         self.start_poses.resize(st.cables.len(), Vec::new());
         for (sp, c) in self.start_poses.iter_mut().zip(&st.cables) {
             sp.clone_from(&c.clip_pose);
         }
         self.saved.clone_from(st);
+        let result = self.step_to_inner(h, st, target);
+        result.and_then(|s| self.check_sliding(h, st).map(|_| s))
+    }
+
+    fn step_to_inner(
+        &mut self,
+        h: &Harness,
+        st: &mut HarnessState,
+        target: &[Vec<Pose>],
+    ) -> Result<SolveStats, HarnessError> {
         st.set_clip_poses_with(h, target, &mut self.pose_buffer);
         match self.newton(h, st, 1.0, false) {
             Ok(s) => return Ok(s),
@@ -795,6 +875,7 @@ impl HarnessStatics {
         target: &[Vec<Pose>],
     ) -> Result<SolveStats, HarnessError> {
         self.last.clone_from(st);
+        self.begin_step(h, st); // the guides' friction acts from the last equilibrium
         if self.has_prev {
             for (c, rod) in h.cables.iter().enumerate() {
                 st.cables[c].extrapolate_free(rod, &self.prev.cables[c], &self.last.cables[c]);
@@ -807,16 +888,39 @@ impl HarnessStatics {
             }
             st.sync_ends(h);
         }
-        let result = match self.step_to(h, st, target) {
+        let result = match self.step_from_reference(h, st, target) {
             Ok(s) => Ok(s),
             Err(_) => {
                 st.clone_from(&self.last);
-                self.step_to(h, st, target)
+                self.step_from_reference(h, st, target)
             }
         };
         std::mem::swap(&mut self.prev, &mut self.last);
         self.has_prev = true;
         result
+    }
+
+    /// Force and moment (about the junction point, global) of the clip on each junction held
+    /// by a clip (zero on the others), after an assembly at `st`: the junction's residual
+    /// (branch loads and weight) that the clip balances.
+    pub fn junction_reactions(
+        &self,
+        h: &Harness,
+        st: &HarnessState,
+    ) -> Vec<(Vector3<f64>, Vector3<f64>)> {
+        (0..h.junctions.len())
+            .map(|j| {
+                if !h.held[j] {
+                    return (Vector3::zeros(), Vector3::zeros());
+                }
+                let r = self.junction_residual[j];
+                let q = crate::rotation::rotation_matrix(&st.junctions[j].orientation);
+                (
+                    Vector3::new(r[0], r[1], r[2]),
+                    q * Vector3::new(r[3], r[4], r[5]),
+                )
+            })
+            .collect()
     }
 
     /// Force and moment (about the junction point, global) that each end's cable applies to

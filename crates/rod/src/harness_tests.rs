@@ -415,3 +415,152 @@ fn loops_and_bad_ends_are_named() {
     .unwrap_err();
     assert!(e.0.contains("not at the junction"), "{e}");
 }
+
+/// The internal force of edge e, global.
+fn edge_force_global(ws: &crate::assembly::Workspace, st: &State, e: usize) -> Vector3<f64> {
+    rotation_matrix(&st.p[e]) * ws.edge_force[e]
+}
+
+/// A weightless Y whose branch c1 runs through a frictionless sliding guide at its middle.
+fn y_with_guide(n: usize) -> Harness {
+    let (c, s) = (30f64.to_radians().cos(), 30f64.to_radians().sin());
+    let trunk = straight([-0.5, 0.0, 0.0], [0.0, 0.0, 0.0], n, vec![], 0.0);
+    let mut a = straight([0.0, 0.0, 0.0], [0.4 * c, 0.4 * s, 0.0], n, vec![], 0.0);
+    let b = straight([0.0, 0.0, 0.0], [0.4 * c, -0.4 * s, 0.0], n, vec![], 0.0);
+    let mut spec = a.spec.clone();
+    let q = spec.clips[0].pose.orientation;
+    spec.clips.push(ClipSpec {
+        name: "guide".into(),
+        s: 0.2,
+        length: 0.05,
+        kind: ClipKind::Sliding { friction: 0.0 },
+        pose: Pose {
+            position: Vector3::new(0.2 * c, 0.2 * s, 0.0),
+            orientation: q,
+        },
+    });
+    a = Rod::new(spec).unwrap();
+    Harness::new(
+        names(3),
+        vec![trunk, a, b],
+        vec![junction("y", 0.0, vec![(0, 1), (1, 0), (2, 0)])],
+    )
+    .unwrap()
+}
+
+#[test]
+fn frictionless_guide_on_a_branch_passes_the_tension_and_lets_it_slide() {
+    let n = 40;
+    let h = y_with_guide(n);
+    let mut st = initial(&h);
+    let mut solver = HarnessStatics::new(&h, NewtonOptions::default());
+    solver.solve_static(&h, &mut st).unwrap();
+    // Pull branch c2's far clamp outwards and push the guide 2 cm sideways: the branch bends
+    // through the guide and slides.
+    let (c, s) = (30f64.to_radians().cos(), 30f64.to_radians().sin());
+    let mut target: Vec<Vec<Pose>> = st.cables.iter().map(|x| x.clip_pose.clone()).collect();
+    target[2][1].position += 0.02 * Vector3::new(c, -s, 0.0);
+    target[1][2].position += Vector3::new(0.0, 0.0, 0.02);
+    solver.step_to(&h, &mut st, &target).unwrap();
+    solver.opts.residual_tolerance = 0.0;
+    solver.opts.step_tolerance = 1e-15;
+    solver.opts.max_iterations = 2;
+    let _ = solver.newton(&h, &mut st, 1.0, false);
+    solver.assemble(&h, &st, 1.0, false).unwrap();
+    let sl = solver.sliding[1].as_ref().unwrap();
+    let slid = sl.sigma[0] - 0.2;
+    assert!(slid.abs() > 1e-4, "slid {slid}");
+    let ws = &solver.ws[1];
+    let t = rotation_matrix(&st.cables[1].clip_pose[2].orientation) * Vector3::z();
+    // Edges well outside the guide's window (0.17 … 0.23 m of 0.4 m): before and after.
+    let (before, after) = (
+        edge_force_global(ws, &st.cables[1], n / 4),
+        edge_force_global(ws, &st.cables[1], 3 * n / 4),
+    );
+    let tension = t.dot(&before);
+    assert!(tension > 1.0, "tension {tension} N");
+    assert!(
+        (t.dot(&after) - tension).abs() < 1e-9 * tension,
+        "axial force {tension} before, {} after the guide",
+        t.dot(&after)
+    );
+    // The guide's reaction is the jump of the internal force, across the line only.
+    let (f, _) = sl.reaction[0];
+    assert!(f.norm() > 0.01 * tension, "{f:?}");
+    assert!((f - (before - after)).norm() < 1e-9 * tension, "{f:?}");
+    assert!(t.dot(&f).abs() < 1e-9 * tension, "{f:?}");
+}
+
+#[test]
+fn junction_held_by_a_clip_follows_it_and_the_reactions_balance() {
+    let mut h = y_harness(20, 0.05);
+    h.hold_junction(0).unwrap();
+    let mut st = initial(&h);
+    let mut solver = HarnessStatics::new(&h, NewtonOptions::default());
+    let mut target: Vec<Vec<Pose>> = st.cables.iter().map(|x| x.clip_pose.clone()).collect();
+    // The junction's clip (given as the pose of its first end's clip, cable 0's end b):
+    // moved and turned about a skew axis.
+    let turn =
+        nalgebra::UnitQuaternion::from_scaled_axis(Vector3::new(0.05, -0.1, 0.15)).into_inner();
+    let same = |a: &Quat, b: &Quat| (rotation_matrix(a) - rotation_matrix(b)).norm();
+    let pose = Pose {
+        position: Vector3::new(0.01, 0.02, -0.03),
+        orientation: turn * st.cables[0].clip_pose[1].orientation,
+    };
+    target[0][1] = pose;
+    st.set_clip_poses(&h, &target);
+    solver.solve_static(&h, &mut st).unwrap();
+    solver.opts.residual_tolerance = 0.0;
+    solver.opts.step_tolerance = 1e-15;
+    solver.opts.max_iterations = 2;
+    let _ = solver.newton(&h, &mut st, 1.0, false);
+    solver.assemble(&h, &st, 1.0, false).unwrap();
+    let j = st.junctions[0];
+    assert!((j.position - pose.position).norm() < 1e-15);
+    assert!(same(&(j.orientation * h.ends[0].relative), &pose.orientation) < 1e-12);
+    assert!(same(&j.orientation, &turn) < 1e-12);
+    // Whole harness: the junction clip's reaction, the far clamps' reactions and the weights.
+    let (rf, rm) = solver.junction_reactions(&h, &st)[0];
+    let mut sum_f = rf + Vector3::new(0.0, 0.0, -9.81 * 0.05);
+    let mut sum_m = rm + j.position.cross(&sum_f);
+    for (c, rod) in h.cables.iter().enumerate() {
+        let far = if c == 0 { 0 } else { 1 };
+        let cs = &st.cables[c];
+        let (f, m) = solver.ws[c].clip_reaction(rod, cs, far);
+        sum_f += f;
+        sum_m += m + cs.clip_pose[far].position.cross(&f);
+        for (k, x) in cs.x.iter().enumerate() {
+            let w = rod.ds_node[k] * rod.spec.section.mass_per_length * rod.spec.gravity;
+            sum_f += w;
+            sum_m += x.cross(&w);
+        }
+    }
+    let scale = rf.norm();
+    assert!(scale > 0.1, "{rf:?}");
+    assert!(sum_f.norm() < 1e-9 * scale, "ΣF = {sum_f:?}");
+    assert!(sum_m.norm() < 1e-9 * scale, "ΣM = {sum_m:?}");
+    // The junction's own balance: its reaction against the branch loads and its weight.
+    let loads = solver.branch_loads(&h, &st);
+    let f_j: Vector3<f64> =
+        loads.iter().map(|l| l.0).sum::<Vector3<f64>>() + rf + Vector3::new(0.0, 0.0, -9.81 * 0.05);
+    let m_j: Vector3<f64> = loads.iter().map(|l| l.1).sum::<Vector3<f64>>() + rm;
+    assert!(f_j.norm() < 1e-9 * scale, "{f_j:?}");
+    assert!(m_j.norm() < 1e-9 * scale, "{m_j:?}");
+}
+
+#[test]
+fn a_branch_that_runs_out_of_its_guide_is_named() {
+    let h = y_with_guide(20);
+    let mut st = initial(&h);
+    let mut solver = HarnessStatics::new(&h, NewtonOptions::default());
+    solver.solve_static(&h, &mut st).unwrap();
+    // The guide moves along its line beyond the branch's far end.
+    let (c, s) = (30f64.to_radians().cos(), 30f64.to_radians().sin());
+    let mut target: Vec<Vec<Pose>> = st.cables.iter().map(|x| x.clip_pose.clone()).collect();
+    target[1][2].position += 0.25 * Vector3::new(c, s, 0.0);
+    let e = solver.step_to(&h, &mut st, &target).unwrap_err();
+    assert!(
+        e.0.contains("cable 'c1'") && e.0.contains("ran out of sliding clip 'guide'"),
+        "{e}"
+    );
+}

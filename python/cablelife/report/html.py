@@ -460,6 +460,8 @@ def _run_section(page, k, run: ReportRun, volumes, color_by, frames, factor, cac
     page.h(2, f"Run {run.label} ({res.mode})", f"run-{k}")
     if not res.complete:
         page.note(f"incomplete run: {res.message}", "warning")
+    if res.junctions:
+        _harness_section(page, run, color_by, frames)
     for name, c in res.cables.items():
         s = _summary(cache, c)
         page.h(3, f"cable {name}")
@@ -548,6 +550,41 @@ def _run_section(page, k, run: ReportRun, volumes, color_by, frames, factor, cac
             surroundings_section(page, res, name, view_at)
         if run.damage_of(name) is not None:
             _damage_section(page, run, name, alone, view_at)
+
+
+def _harness_section(page, run: ReportRun, color_by: str, frames: int) -> None:
+    """A harness run: its junctions (largest branch loads, how far each moved) and one 3D view
+    of all its cables with the junctions marked and the damage on every branch."""
+    from cablelife.report.harness_view import harness_figure
+
+    res = run.result
+    page.h(3, f"harness: {len(res.cables)} cables, {len(res.junctions)} junctions")
+    rows = []
+    for name, j in res.junctions.items():
+        moved = float(np.linalg.norm(j.position - j.position[:1], axis=1).max(initial=0.0))
+        for k, (end, force) in enumerate(j.branch_force.items()):
+            rows.append(
+                [
+                    name if k == 0 else "",
+                    end,
+                    _g(float(np.linalg.norm(force, axis=1).max(initial=0.0))),
+                    _g(float(np.linalg.norm(j.branch_moment[end], axis=1).max(initial=0.0))),
+                    f"{moved * 1e3:.3g}" if k == 0 else "",
+                ]
+            )
+    page.table(
+        ["junction", "branch", "max |force| [N]", "max |moment| [N m]", "moved [mm]"],
+        rows,
+        "junctions (max over time)",
+    )
+    damage = {}
+    for name in res.cables:
+        d = run.damage_of(name)
+        if d is not None and d[0].damage.max() > 0:
+            damage[name] = d[0]
+    page.plotly(
+        harness_figure(res, color_by, frames, damage), "3D view of the harness (all cables)"
+    )
 
 
 def run_view(run: ReportRun, name: str, volume, color_by: str, frames: int) -> dict:

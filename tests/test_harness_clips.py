@@ -1,0 +1,130 @@
+"""Clip types on harnesses (docs/harness.md): sliding clips on harness cables (slid length in
+the results, saved and reloaded) and clips holding a junction (pose, reactions, validation)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from cablelife.results import load_result
+from cablelife.scene import SceneError, scene_from_dict
+from cablelife.simulate import simulate
+from test_harness import C30, S30, y_scene
+
+
+def test_sliding_clip_on_a_branch_slides_and_its_slid_length_is_saved(tmp_path):
+    scene = y_scene(mode="quasistatic", duration=0.2, time_step=0.05)
+    # A frictionless guide at the middle of branch a; the trunk's bracket pulls along −x.
+    scene["cables"][1]["clips"].append(
+        {
+            "name": "guide",
+            "type": "sliding",
+            "s": 0.2,
+            "length": 0.05,
+            "position": [0.2 * C30, 0.2 * S30, 0.0],
+            "direction": [C30, S30, 0.0],
+            "normal": [0.0, 0.0, 1.0],
+        }
+    )
+    # x = −0.02 sin(2π 1.25 t): a monotonic pull of 2 cm over the quarter period.
+    pull = {"type": "sine", "amplitude": 0.02, "frequency": 1.25, "phase": np.pi}
+    scene["bodies"][0]["motion"] = [{"channel": "x", "signal": pull}]
+    result = simulate(scene_from_dict(scene))
+    assert result.complete, result.message
+    guide = result.cables["a"].clips["guide"]
+    slid = guide.slid_length
+    assert slid.shape == (5,)
+    # Pulled towards the junction: the cable slides through the guide towards s = 0 (its
+    # material at the guide comes from larger s), monotonically, by less than the pull.
+    assert slid[-1] > 1e-4 and slid[-1] < 0.02, slid
+    assert np.all(np.diff(slid) > 0), slid
+    # A frictionless guide pushes across its line only.
+    t = np.array([C30, S30, 0.0])
+    f = guide.force
+    assert np.abs(f @ t).max() < 1e-6 * max(np.linalg.norm(f, axis=1).max(), 1e-9)
+    back = load_result(result.save(tmp_path / "slid.h5"))
+    np.testing.assert_array_equal(back.cables["a"].clips["guide"].slid_length, slid)
+
+
+def held_y(mode: str = "static", **sim) -> dict:
+    """The Y of test_harness with its junction clamped to the moving body "bracket" (which
+    no longer holds the trunk: the trunk's clamp is on the world)."""
+    scene = y_scene(mode=mode, **sim)
+    scene["cables"][0]["clips"][0]["body"] = "world"
+    scene["junctions"][0]["clip"] = {"body": "bracket", "name": "connector"}
+    return scene
+
+
+def test_junction_held_by_a_clip_moves_with_it_and_the_reactions_balance(tmp_path):
+    scene = held_y("quasistatic", duration=0.2, time_step=0.05)
+    scene["bodies"][0]["motion"] = [
+        {"channel": "z", "signal": {"type": "sine", "amplitude": 0.02, "frequency": 1.25}},
+        {"channel": "rx", "signal": {"type": "sine", "amplitude": 0.1, "frequency": 1.25}},
+    ]
+    result = simulate(scene_from_dict(scene))
+    assert result.complete, result.message
+    j = result.junctions["y"]
+    # The body's origin is the world origin, where the junction sits: it moves up by
+    # 0.02 sin(2π 1.25 t) and turns about x by 0.1 sin(…) rad.
+    t = j.time
+    phase = np.sin(2 * np.pi * 1.25 * t)
+    np.testing.assert_allclose(j.position[:, 2], 0.02 * phase, atol=1e-12)
+    np.testing.assert_allclose(j.position[:, :2], 0.0, atol=1e-12)
+    angle = 2 * np.arctan2(np.linalg.norm(j.quaternion[:, 1:], axis=1), np.abs(j.quaternion[:, 0]))
+    np.testing.assert_allclose(angle, 0.1 * phase, atol=1e-9)
+    # The whole harness is in equilibrium: the junction clip's reaction, the far clamps'
+    # reactions and the weights of the cables and the junction.
+    mass = 0.02
+    for k in range(t.size):
+        f = j.reaction_force[k] + np.array([0.0, 0.0, -9.81 * mass])
+        m = j.reaction_moment[k] + np.cross(j.position[k], f)
+        for c in result.cables.values():
+            (clip,) = c.clips.values()
+            x = c.positions[k, 0] if clip.s == 0.0 else c.positions[k, -1]
+            f = f + clip.force[k]
+            m = m + clip.moment[k] + np.cross(x, clip.force[k])
+            ds = np.diff(c.arc_length)
+            node = np.concatenate([[ds[0] / 2], (ds[1:] + ds[:-1]) / 2, [ds[-1] / 2]])
+            w = np.outer(node, [0.0, 0.0, -9.81 * c.section["mass_per_length"]])
+            f = f + w.sum(axis=0)
+            m = m + np.cross(c.positions[k], w).sum(axis=0)
+        scale = np.linalg.norm(j.reaction_force[k])
+        assert scale > 0.01
+        assert np.linalg.norm(f) < 1e-8 * scale, (k, f)
+        assert np.linalg.norm(m) < 1e-8 * scale, (k, m)
+        # The junction's own balance: its clip against the branch loads and its weight.
+        fj = sum(b[k] for b in j.branch_force.values()) + j.reaction_force[k]
+        assert np.linalg.norm(fj + [0.0, 0.0, -9.81 * mass]) < 1e-8 * scale
+        mj = sum(b[k] for b in j.branch_moment.values()) + j.reaction_moment[k]
+        assert np.linalg.norm(mj) < 1e-8 * scale
+    back = load_result(result.save(tmp_path / "held.h5")).junctions["y"]
+    np.testing.assert_array_equal(back.reaction_force, j.reaction_force)
+    np.testing.assert_array_equal(back.reaction_moment, j.reaction_moment)
+    assert result.junctions["y"].reaction_force is not None
+    free = simulate(scene_from_dict(y_scene())).junctions["y"]
+    assert free.reaction_force is None
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        (lambda s: s["junctions"][0].update(clip={"body": "engine"}), "junctions\\[0\\].clip.body"),
+        (lambda s: s["junctions"][0].update(clip={"bdy": "world"}), "bdy"),
+    ],
+)
+def test_bad_junction_clips_are_named(change, message):
+    scene = held_y()
+    change(scene)
+    with pytest.raises(SceneError, match=message):
+        scene_from_dict(scene)
+
+
+def test_a_junction_clip_holds_a_harness_without_other_clips():
+    # Branches hanging from a clamped junction: no cable clip at all.
+    scene = held_y()
+    for c in scene["cables"]:
+        c["clips"].clear()
+    result = simulate(scene_from_dict(scene))
+    j = result.junctions["y"]
+    weight = sum(c.section["mass_per_length"] * c.arc_length[-1] for c in result.cables.values())
+    w = 9.81 * (weight + 0.02)
+    np.testing.assert_allclose(j.reaction_force[0], [0, 0, w], rtol=1e-8, atol=1e-9 * w)
