@@ -587,10 +587,12 @@ def test_harness_drag_moves_every_cable_and_the_junction(harness_copy, tmp_path)
     cables, junctions = batch_harness(load_scene(out))
     for name, live in session.cables.items():
         assert np.abs(live.state.positions - cables[name]).max() < 1e-9, name
-        assert np.abs(live.state.positions - x0[name]).max() > 1e-3, name  # it answered
+        assert np.abs(live.state.positions - x0[name]).max() > 1e-4, (
+            name
+        )  # it answered (the trunk runs in a guide)
     j1 = np.array(session.state()["junctions"]["breakout"]["position"])
     assert np.abs(j1 - junctions["breakout"]).max() < 1e-9
-    assert np.linalg.norm(j1 - j0) > 1e-3
+    assert np.linalg.norm(j1 - j0) > 1e-4
     # the clips of the other cables stay put, the joined ends sit on the junction
     trunk = session.cables["trunk"].state.positions
     np.testing.assert_allclose(trunk[0], [0.0, 0.0, 0.0], atol=1e-12)
@@ -619,17 +621,22 @@ def test_harness_failed_solve_keeps_every_cable(harness_copy):
 
 def test_harness_edits_rebuild_the_tree(harness_copy):
     session = Session.open(harness_copy)
+
+    def clip(name):
+        return next(c for c in session.cable_spec("gearbox").clips if c.name == name)
+
     session.edit("gearbox", "gearbox-clip", "type", "hinge")
-    clip = session.cable_spec("gearbox").clips[0]
-    assert (clip.type, clip.axis, clip.length) == ("hinge", (0.0, 1.0, 0.0), 0.0)
+    c = clip("gearbox-clip")
+    assert (c.type, c.axis, c.length) == ("hinge", (0.0, 1.0, 0.0), 0.0)
     session.edit("body", "", "length", 0.37)
     cables, _ = batch_harness(edited_scene(session))
     for name, live in session.cables.items():
         assert np.abs(live.state.positions - cables[name]).max() < 1e-9, name
-    session.edit("gearbox", "gearbox-clip", "s", 0.3)  # off the end: a guide would fit
-    with pytest.raises(SceneError, match="sliding clip 'gearbox-clip' on a cable of a harness"):
-        session.edit("gearbox", "gearbox-clip", "type", "sliding")
-    assert session.cable_spec("gearbox").clips[0].type == "hinge"
+    session.edit("gearbox", "gearbox-mid", "type", "sliding")  # sliding on a harness cable
+    assert clip("gearbox-mid").type == "sliding"
+    cables, _ = batch_harness(edited_scene(session))
+    for name, live in session.cables.items():
+        assert np.abs(live.state.positions - cables[name]).max() < 1e-9, name
 
 
 def test_hinge_and_sliding_clip_types(scene_copy):
@@ -715,7 +722,7 @@ def test_page_follows_a_dragged_harness_clip(harness_copy, tmp_path):
     for name, x in cables.items():
         assert np.abs(np.array(last["cables"][name]["positions"]) - x).max() < 1e-9, name
         moved = np.array(last["cables"][name]["positions"]) - first["cables"][name]["positions"]
-        assert np.abs(moved).max() > 1e-3, name  # every cable of the tree answered
+        assert np.abs(moved).max() > 1e-4, name  # every cable of the tree answered
     assert np.abs(np.array(last["junctions"]["breakout"]["position"])
                   - junctions_ref["breakout"]).max() < 1e-9  # fmt: skip
     assert shot.stat().st_size > 20_000
