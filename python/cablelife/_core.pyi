@@ -139,7 +139,18 @@ class Harness:
         (T, J, 4, scalar first), `branch_force` and `branch_moment` (T, E, 3: what each joined
         end's cable applies to its junction, global, moment about the junction point),
         `iterations`, `substeps`, `residual`, `steps` and `error` (None, or why it stopped: the
-        steps before are kept).
+        steps before are kept). Each cable's `unstable` is the number of negative eigenvalues of
+        the whole harness's tangent stiffness at that step (the tree inertia; 0 = stable).
+        """
+        ...
+    def modes(self, count) -> Any:
+        """The `count` lowest natural modes of the whole harness about the last step of
+        `run_sequence` (a static equilibrium): shift-invert on the tree elimination
+        (`rod::harness_modal`). Returns `omega` (k,) rad/s, `cables` (one dict per cable:
+        `displacements` (k, N+1, 3) and `rotations` (k, N, 3), global, mass-normalised over
+        the harness), `junction_displacements` and `junction_rotations` (k, J, 3, global),
+        `shares` (k, 4) and `kind` (k,) as `Cable.modes`. An unstable equilibrium is a
+        ValueError.
         """
         ...
 

@@ -34,10 +34,10 @@ pub struct HarnessMode {
     pub kind: ModeKind,
 }
 
-/// The pencil of a harness: `k` the assembled symmetric stiffness (kept for products),
-/// `work` its shifted copy factored by the tree elimination.
-struct HarnessPencil<'a> {
-    h: &'a Harness,
+/// The buffers of a harness's pencil, allocated once (`HarnessStability` keeps them across the
+/// steps of a sequence): `k` the assembled symmetric stiffness (kept for products), `work` its
+/// shifted copy factored by the tree elimination.
+pub struct ModalSystem {
     k: HarnessStatics,
     work: HarnessStatics,
     /// Lumped mass on the flattened unknowns: the cables' blocks in order, then the junctions.
@@ -48,9 +48,54 @@ struct HarnessPencil<'a> {
     xj: Vec<Vector6<f64>>,
 }
 
-impl<'a> HarnessPencil<'a> {
-    fn new(h: &'a Harness, st: &HarnessState) -> Result<Self, HarnessError> {
-        let mut k = HarnessStatics::new(h, NewtonOptions::default());
+/// The pencil (K, M) of a harness on its buffers.
+struct HarnessPencil<'a> {
+    h: &'a Harness,
+    s: &'a mut ModalSystem,
+}
+
+impl ModalSystem {
+    pub fn new(h: &Harness) -> Self {
+        let k = HarnessStatics::new(h, NewtonOptions::default());
+        let mut work = HarnessStatics::new(h, NewtonOptions::default());
+        work.symmetric = true;
+        let mut m = Vec::new();
+        let mut offsets = Vec::with_capacity(h.cables.len() + 1);
+        for rod in &h.cables {
+            offsets.push(m.len());
+            m.extend(lumped_mass(rod));
+        }
+        offsets.push(m.len());
+        for (j, js) in h.junctions.iter().enumerate() {
+            let ends: f64 = h.junction_ends[j]
+                .iter()
+                .map(|&e| h.cables[h.ends[e].cable].node_mass[h.ends[e].topo.node])
+                .sum();
+            let mt = js.mass + ends;
+            let r = js.rotary_inertia;
+            m.push(Vector6::new(mt, mt, mt, r.x, r.y, r.z));
+        }
+        let xc = h
+            .cables
+            .iter()
+            .map(|r| vec![Vector6::zeros(); r.arc.len()])
+            .collect();
+        let xj = vec![Vector6::zeros(); h.junctions.len()];
+        work.junction_diag = xj.clone();
+        ModalSystem {
+            k,
+            work,
+            m,
+            offsets,
+            sigma: 0.0,
+            xc,
+            xj,
+        }
+    }
+
+    /// Assembles the symmetric tangent stiffness of `h` at `st`.
+    pub fn load(&mut self, h: &Harness, st: &HarnessState) -> Result<(), HarnessError> {
+        let k = &mut self.k;
         k.assemble(h, st, 1.0, true)?;
         // The symmetric part: the Hessian at the equilibrium (see `stability`).
         for ws in &mut k.ws {
@@ -75,67 +120,37 @@ impl<'a> HarnessPencil<'a> {
                 }
             }
         }
-        let mut work = HarnessStatics::new(h, NewtonOptions::default());
-        work.symmetric = true;
-        work.held.clone_from(&k.held);
-        let mut m = Vec::new();
-        let mut offsets = Vec::with_capacity(h.cables.len() + 1);
-        for rod in &h.cables {
-            offsets.push(m.len());
-            m.extend(lumped_mass(rod));
+        for (w, k) in self.work.held.iter_mut().zip(&self.k.held) {
+            w.ends.clone_from(&k.ends);
         }
-        offsets.push(m.len());
-        for (j, js) in h.junctions.iter().enumerate() {
-            let ends: f64 = h.junction_ends[j]
-                .iter()
-                .map(|&e| h.cables[h.ends[e].cable].node_mass[h.ends[e].topo.node])
-                .sum();
-            let mt = js.mass + ends;
-            let r = js.rotary_inertia;
-            m.push(Vector6::new(mt, mt, mt, r.x, r.y, r.z));
-        }
-        let xc = h
-            .cables
-            .iter()
-            .map(|r| vec![Vector6::zeros(); r.arc.len()])
-            .collect();
-        let xj = vec![Vector6::zeros(); h.junctions.len()];
-        work.junction_diag = xj.clone();
-        Ok(HarnessPencil {
-            h,
-            k,
-            work,
-            m,
-            offsets,
-            sigma: 0.0,
-            xc,
-            xj,
-        })
+        Ok(())
     }
+}
 
+impl HarnessPencil<'_> {
     fn split(&mut self, x: &[Vector6<f64>]) {
-        for (c, xc) in self.xc.iter_mut().enumerate() {
-            xc.copy_from_slice(&x[self.offsets[c]..self.offsets[c + 1]]);
+        for (c, xc) in self.s.xc.iter_mut().enumerate() {
+            xc.copy_from_slice(&x[self.s.offsets[c]..self.s.offsets[c + 1]]);
         }
-        let nc = self.offsets[self.xc.len()];
-        self.xj.copy_from_slice(&x[nc..]);
+        let nc = self.s.offsets[self.s.xc.len()];
+        self.s.xj.copy_from_slice(&x[nc..]);
     }
 
     /// y = (K − σM)⁻¹ r for the flattened r (one tree solve).
     fn solve(&mut self, r: &[Vector6<f64>], y: &mut [Vector6<f64>]) {
-        let nc = self.offsets[self.xc.len()];
-        for (c, ws) in self.work.ws.iter_mut().enumerate() {
-            for (o, v) in ws.rhs.iter_mut().zip(&r[self.offsets[c]..]) {
+        let nc = self.s.offsets[self.s.xc.len()];
+        for (c, ws) in self.s.work.ws.iter_mut().enumerate() {
+            for (o, v) in ws.rhs.iter_mut().zip(&r[self.s.offsets[c]..]) {
                 *o = -v;
             }
         }
-        for (o, v) in self.work.junction_residual.iter_mut().zip(&r[nc..]) {
+        for (o, v) in self.s.work.junction_residual.iter_mut().zip(&r[nc..]) {
             *o = -v;
         }
-        self.work.newton_correction(self.h);
-        let (dc, dj) = self.work.correction();
+        self.s.work.newton_correction(self.h);
+        let (dc, dj) = self.s.work.correction();
         for (c, d) in dc.iter().enumerate() {
-            y[self.offsets[c]..self.offsets[c + 1]].copy_from_slice(d);
+            y[self.s.offsets[c]..self.s.offsets[c + 1]].copy_from_slice(d);
         }
         y[nc..].copy_from_slice(dj);
     }
@@ -143,37 +158,37 @@ impl<'a> HarnessPencil<'a> {
     /// r ← b − (K − σM) y.
     fn residual(&mut self, b: &[Vector6<f64>], y: &[Vector6<f64>], r: &mut [Vector6<f64>]) {
         self.split(y);
-        let (kc, kj) = self.k.jacobian_times(self.h, &self.xc, &self.xj);
-        let nc = self.offsets[self.xc.len()];
+        let (kc, kj) = self.s.k.jacobian_times(self.h, &self.s.xc, &self.s.xj);
+        let nc = self.s.offsets[self.s.xc.len()];
         for (c, kv) in kc.iter().enumerate() {
-            r[self.offsets[c]..self.offsets[c + 1]].copy_from_slice(kv);
+            r[self.s.offsets[c]..self.s.offsets[c + 1]].copy_from_slice(kv);
         }
         r[nc..].copy_from_slice(&kj);
-        for (((r, b), y), m) in r.iter_mut().zip(b).zip(y).zip(&self.m) {
-            *r = b - (*r - self.sigma * y.component_mul(m));
+        for (((r, b), y), m) in r.iter_mut().zip(b).zip(y).zip(&self.s.m) {
+            *r = b - (*r - self.s.sigma * y.component_mul(m));
         }
     }
 }
 
 impl ShiftInvert for HarnessPencil<'_> {
     fn mass(&self) -> &[Vector6<f64>] {
-        &self.m
+        &self.s.m
     }
 
     fn factor(&mut self, sigma: f64) -> Option<usize> {
-        self.sigma = sigma;
-        for (c, ws) in self.work.ws.iter_mut().enumerate() {
-            ws.jac.clone_from(&self.k.ws[c].jac);
+        self.s.sigma = sigma;
+        for (c, ws) in self.s.work.ws.iter_mut().enumerate() {
+            ws.jac.clone_from(&self.s.k.ws[c].jac);
             for (b, d) in ws.jac.diag.iter_mut().enumerate() {
-                *d -= Block::from_diagonal(&(self.m[self.offsets[c] + b] * sigma));
+                *d -= Block::from_diagonal(&(self.s.m[self.s.offsets[c] + b] * sigma));
             }
         }
-        let nc = self.offsets[self.xc.len()];
-        for (d, m) in self.work.junction_diag.iter_mut().zip(&self.m[nc..]) {
+        let nc = self.s.offsets[self.s.xc.len()];
+        for (d, m) in self.s.work.junction_diag.iter_mut().zip(&self.s.m[nc..]) {
             *d = -sigma * m;
         }
-        self.work.factor(self.h).ok()?;
-        (self.work.inertia.zero == 0).then_some(self.work.inertia.negative)
+        self.s.work.factor(self.h).ok()?;
+        (self.s.work.inertia.zero == 0).then_some(self.s.work.inertia.negative)
     }
 
     /// y = (K − σM)⁻¹ M x by the tree solve with two steps of iterative refinement (as the
@@ -181,7 +196,7 @@ impl ShiftInvert for HarnessPencil<'_> {
     fn apply(&mut self, x: &[Vector6<f64>], y: &mut [Vector6<f64>], r: &mut [Vector6<f64>]) {
         let b: Vec<Vector6<f64>> = x
             .iter()
-            .zip(&self.m)
+            .zip(&self.s.m)
             .map(|(x, m)| x.component_mul(m))
             .collect();
         self.solve(&b, y);
@@ -197,7 +212,7 @@ impl ShiftInvert for HarnessPencil<'_> {
 }
 
 /// Eigenvalue scale for shifts off a singular point: the largest translational K_ii/M_ii.
-fn eigen_scale(p: &HarnessPencil) -> f64 {
+fn eigen_scale(p: &ModalSystem) -> f64 {
     let mut scale = 0.0f64;
     for (c, ws) in p.k.ws.iter().enumerate() {
         for (b, kb) in ws.jac.diag.iter().enumerate() {
@@ -214,9 +229,22 @@ fn eigen_scale(p: &HarnessPencil) -> f64 {
 /// (0: a stable equilibrium), from the pivots of its tree LDLᵀ. A singular K (a free rigid
 /// motion) is shifted by a round-off amount below its zero eigenvalues.
 pub fn harness_negative_count(h: &Harness, st: &HarnessState) -> Result<usize, HarnessError> {
-    let mut p = HarnessPencil::new(h, st)?;
-    let scale = eigen_scale(&p);
-    Ok(p.factor_near(0.0, 1e-12 * scale).1)
+    ModalSystem::new(h).negative_count(h, st)
+}
+
+impl ModalSystem {
+    /// `harness_negative_count` on these buffers (no allocation after the first call).
+    pub fn negative_count(
+        &mut self,
+        h: &Harness,
+        st: &HarnessState,
+    ) -> Result<usize, HarnessError> {
+        self.load(h, st)?;
+        let scale = eigen_scale(self);
+        Ok(HarnessPencil { h, s: self }
+            .factor_near(0.0, 1e-12 * scale)
+            .1)
+    }
 }
 
 /// The `count` lowest natural modes of the harness at the equilibrium `st`.
@@ -226,7 +254,9 @@ pub fn harness_lowest_modes(
     count: usize,
 ) -> Result<Vec<HarnessMode>, HarnessError> {
     let describe = |e: ModalError| HarnessError(format!("modal analysis of the harness: {e}"));
-    let mut p = HarnessPencil::new(h, st)?;
+    let mut sys = ModalSystem::new(h);
+    sys.load(h, st)?;
+    let p = &sys;
     let massive =
         p.m.iter()
             .flat_map(|v| v.iter())
@@ -236,8 +266,10 @@ pub fn harness_lowest_modes(
         return Err(describe(ModalError::NoUnknowns));
     }
     let count = count.clamp(1, massive);
-    let scale = eigen_scale(&p);
-    let ritz = lowest_pairs(&mut p, count, massive, scale).map_err(describe)?;
+    let scale = eigen_scale(p);
+    let ritz = lowest_pairs(&mut HarnessPencil { h, s: &mut sys }, count, massive, scale)
+        .map_err(describe)?;
+    let p = &sys;
     let nc = p.offsets[h.cables.len()];
     Ok(ritz
         .values

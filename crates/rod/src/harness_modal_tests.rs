@@ -181,7 +181,9 @@ fn collinear_pair_has_the_frequencies_of_the_single_cable() {
         );
     }
     // The mass normalisation covers cables and junction: φᵀMφ = 1.
-    let p = HarnessPencil::new(&h, &initial(&h)).unwrap();
+    let mut sys = ModalSystem::new(&h);
+    sys.load(&h, &initial(&h)).unwrap();
+    let p = HarnessPencil { h: &h, s: &mut sys };
     let flat: Vec<Vector6<f64>> = modes[0]
         .cables
         .iter()
@@ -210,7 +212,8 @@ fn strained_pair(n: usize, strain: f64) -> (Harness, HarnessState) {
 
 /// Negative eigenvalues of the dense assembled symmetric stiffness over the active unknowns.
 fn dense_negative_count(h: &Harness, st: &HarnessState) -> usize {
-    let p = HarnessPencil::new(h, st).unwrap();
+    let mut p = ModalSystem::new(h);
+    p.load(h, st).unwrap();
     let mut slots = Vec::new(); // (cable or None for the junction, block, slot)
     for (c, rod) in h.cables.iter().enumerate() {
         for (b, m) in rod.mask.iter().enumerate() {
