@@ -201,7 +201,8 @@ def test_harness_modes_equal_the_single_cable_and_the_cli_prints_them(tmp_path):
     path.write_bytes(tomli_w.dumps(pair_scene(True)).encode())
     out = CliRunner().invoke(app, ["modes", str(path), "-n", "3"])
     assert out.exit_code == 0, out.output
-    assert "cable 'c'" in out.output and "cable 'd'" in out.output
+    assert "harness ('c', 'd'): natural frequencies" in out.output
+    assert f"{single.frequencies[0]:.4g}" in out.output
 
 
 def test_harness_static_states_are_checked_for_stability():
