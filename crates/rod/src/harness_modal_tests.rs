@@ -295,3 +295,66 @@ fn tree_inertia_counts_the_negative_eigenvalues_of_the_dense_stiffness() {
     let e = harness_lowest_modes(&h, &st, 3).unwrap_err();
     assert!(e.0.contains("unstable"), "{e}");
 }
+
+/// The first root β of a clamped–clamped beam of length 2a with a point mass `mass` at its
+/// middle (the junction), symmetric mode: each half is clamped at its far end and guided at
+/// the middle (slope zero), the two halves' shear forces carry the mass: 2 EI β³ N/D = m ω²,
+/// N = cosh x sin x + sinh x cos x, D = 1 − cosh x cos x, x = βa, ω² = β⁴ EI/ρA; cleared:
+/// 2N − (m β/ρA) D = 0.
+fn point_mass_beta(a: f64, mass: f64) -> f64 {
+    let g = |b: f64| {
+        let x = b * a;
+        let n = x.cosh() * x.sin() + x.sinh() * x.cos();
+        let d = 1.0 - x.cosh() * x.cos();
+        2.0 * n - mass * b / RHO_A * d
+    };
+    let mut lo = 0.5;
+    while g(lo) * g(lo + 1e-3) > 0.0 {
+        lo += 1e-3;
+    }
+    let mut hi = lo + 1e-3;
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if g(lo) * g(mid) <= 0.0 {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+#[test]
+fn junction_mass_on_a_clamped_pair_matches_the_point_mass_beam() {
+    // Without the mass: the clamped–clamped beam, β L = 4.7300.
+    assert!((point_mass_beta(0.5, 0.0) - 4.730_040_7).abs() < 1e-6);
+    let mass = 0.05; // half the beam's mass
+    let beta = point_mass_beta(0.5, mass);
+    let exact = beta * beta * (EI / RHO_A).sqrt();
+    let clamped = 4.730_040_7f64.powi(2) * (EI / RHO_A).sqrt();
+    assert!(exact < 0.8 * clamped, "{exact} vs {clamped}");
+    let omegas: Vec<f64> = [8, 16, 32]
+        .iter()
+        .map(|&n| {
+            let a = straight([0.0, 0.0, 0.0], [0.5, 0.0, 0.0], n);
+            let b = straight([0.5, 0.0, 0.0], [1.0, 0.0, 0.0], n);
+            let names = vec!["a".to_string(), "b".to_string()];
+            let j = JunctionSpec {
+                name: "j".into(),
+                mass,
+                rotary_inertia: Vector3::zeros(),
+                ends: vec![(0, 1), (1, 0)],
+            };
+            let h = Harness::new(names, vec![a, b], vec![j]).unwrap();
+            harness_lowest_modes(&h, &initial(&h), 2).unwrap()[0].omega
+        })
+        .collect();
+    let errors: Vec<f64> = omegas.iter().map(|w| (w - exact).abs() / exact).collect();
+    let richardson = ((4.0 * omegas[2] - omegas[1]) / 3.0 - exact).abs() / exact;
+    eprintln!("point mass: ω exact {exact}, errors {errors:?}, extrapolated {richardson:e}");
+    for w in errors.windows(2) {
+        let order = (w[0] / w[1]).log2();
+        assert!((1.8..2.3).contains(&order), "errors {errors:?}");
+    }
+    assert!(richardson < 0.05 * errors[2], "{richardson} vs {errors:?}");
+}
