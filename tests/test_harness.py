@@ -143,11 +143,72 @@ def test_dynamic_harness_is_a_clear_error():
         simulate(scene)
 
 
-def test_modal_analysis_of_a_harness_is_a_clear_error():
-    from cablelife.modal import modes
+def pair_scene(joined: bool) -> dict:
+    """A 1 m cable clamped at both ends along x without gravity: one cable, or two 0.5 m
+    cables joined by a massless junction at x = 0.5 (the same discrete model)."""
 
-    with pytest.raises(SceneError, match="modal analysis of harnesses"):
-        modes(scene_from_dict(y_scene()))
+    def clip(name, s, x):
+        return {"name": name, "s": s, "position": [x, 0.0, 0.0], "direction": [1.0, 0.0, 0.0]}
+
+    def cable(name, length, segments, clips):
+        return {
+            "name": name,
+            "length": length,
+            "segments": segments,
+            "section": SECTION,
+            "material": MATERIAL,
+            "clips": clips,
+        }
+
+    scene = {"simulation": {"mode": "static", "gravity": [0.0, 0.0, 0.0]}}
+    if not joined:
+        scene["cables"] = [cable("c", 1.0, 32, [clip("a", 0.0, 0.0), clip("b", 1.0, 1.0)])]
+        return scene
+    scene["cables"] = [
+        cable("c", 0.5, 16, [clip("a", 0.0, 0.0)]),
+        cable("d", 0.5, 16, [clip("b", 0.5, 1.0)]),
+    ]
+    scene["junctions"] = [
+        {
+            "name": "j",
+            "ends": ["c:end", "d:start"],
+            "position": [0.5, 0.0, 0.0],
+            "directions": [[-1.0, 0.0, 0.0], [1.0, 0.0, 0.0]],
+            "mass": 0.0,
+        }
+    ]
+    return scene
+
+
+def test_harness_modes_equal_the_single_cable_and_the_cli_prints_them(tmp_path):
+    from cablelife.cli import app
+    from cablelife.modal import modes
+    from typer.testing import CliRunner
+
+    single = modes(scene_from_dict(pair_scene(False)), 6)["c"]
+    harness = modes(scene_from_dict(pair_scene(True)), 6)
+    assert set(harness) == {"c", "d"}
+    np.testing.assert_allclose(harness["c"].omega, single.omega, rtol=1e-6)
+    np.testing.assert_array_equal(harness["d"].omega, harness["c"].omega)
+    # Each cable holds its part of the shape: the first bending mode is symmetric about the
+    # junction (mirror node k of c and N−k of d).
+    c, d = harness["c"].shapes[0], harness["d"].shapes[0]
+    assert np.abs(c).max() > 0
+    np.testing.assert_allclose(c[1:-1], d[::-1][1:-1], atol=1e-6 * np.abs(c).max())
+    path = tmp_path / "pair.toml"
+    import tomli_w
+
+    path.write_bytes(tomli_w.dumps(pair_scene(True)).encode())
+    out = CliRunner().invoke(app, ["modes", str(path), "-n", "3"])
+    assert out.exit_code == 0, out.output
+    assert "harness ('c', 'd'): natural frequencies" in out.output
+    assert f"{single.frequencies[0]:.4g}" in out.output
+
+
+def test_harness_static_states_are_checked_for_stability():
+    result = simulate(scene_from_dict(y_scene()))
+    for name in ("trunk", "a", "b"):
+        np.testing.assert_array_equal(result.cables[name].solver["unstable"], [0])
 
 
 def test_example_harness_runs_from_the_command_line(tmp_path):

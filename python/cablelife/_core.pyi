@@ -142,10 +142,21 @@ class Harness:
         end's cable applies to its junction, global, moment about the junction point),
         `junction_reaction_force` and `junction_reaction_moment` (T, J, 3: of the clip on each
         junction in `held`, zero for the others), `iterations`, `substeps`, `residual`, `steps`
-        and `error` (None, or why it stopped: the steps before are kept). `warm`: step 0 starts
-        from the last equilibrium of the previous warm run (the first from the routed shapes),
-        and a complete run's last equilibrium is kept for the next; a failed one keeps the
-        previous (the workbench's drags).
+        and `error` (None, or why it stopped: the steps before are kept). Each cable's
+        `unstable` is the number of negative eigenvalues of the whole harness's tangent
+        stiffness at that step (the tree inertia; 0 = stable). `warm`: step 0 starts from the
+        last equilibrium of the previous run (the first from the routed shapes); a failed run
+        keeps the previous (the workbench's drags).
+        """
+        ...
+    def modes(self, count) -> Any:
+        """The `count` lowest natural modes of the whole harness about the last step of
+        `run_sequence` (a static equilibrium): shift-invert on the tree elimination
+        (`rod::harness_modal`). Returns `omega` (k,) rad/s, `cables` (one dict per cable:
+        `displacements` (k, N+1, 3) and `rotations` (k, N, 3), global, mass-normalised over
+        the harness), `junction_displacements` and `junction_rotations` (k, J, 3, global),
+        `shares` (k, 4) and `kind` (k,) as `Cable.modes`. An unstable equilibrium is a
+        ValueError.
         """
         ...
 

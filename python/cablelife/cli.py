@@ -243,7 +243,8 @@ def modes(
     scene: Annotated[Path, typer.Argument(help="scene TOML file")],
     count: Annotated[int, typer.Option("--count", "-n", help="number of modes")] = 6,
 ) -> None:
-    """Natural frequencies of each mounted cable about its static equilibrium."""
+    """Natural frequencies of each mounted cable (of the whole harness if the scene has
+    junctions) about its static equilibrium."""
     from rich.table import Table
 
     from cablelife.modal import modes as compute_modes
@@ -255,8 +256,13 @@ def modes(
         found = compute_modes(sc, count)
     except (SceneError, SignalError) as err:
         raise fail(str(err)) from None
+    if sc.junctions:
+        # One system: the frequencies are those of the whole harness (the same per cable).
+        names = ", ".join(f"'{n}'" for n in found)
+        found = {f"harness ({names})": next(iter(found.values()))}
     for name, m in found.items():
-        t = Table(title=escape(f"cable '{name}': natural frequencies"), title_justify="left")
+        title = name if sc.junctions else f"cable '{name}'"
+        t = Table(title=escape(f"{title}: natural frequencies"), title_justify="left")
         t.add_column("mode", justify="right")
         t.add_column(escape("f [Hz]"), justify="right")
         t.add_column(escape("ω [rad/s]"), justify="right")

@@ -2,8 +2,9 @@
 
 Each joined cable end gets a fixed point clip ("junction <name>") whose pose follows the
 junction; the Rust harness solver (``_core.Harness``) eliminates the cables onto the junctions
-and solves the junction tree. Static and quasistatic runs; dynamic and modal analyses of
-harnesses are not supported yet (a clear error).
+and solves the junction tree. Static and quasistatic runs (each state checked for stability)
+and modal analysis (``cablelife.modal.harness_modes``); dynamic analysis of harnesses is not
+supported yet (a clear error).
 """
 
 from __future__ import annotations
@@ -136,6 +137,30 @@ def harness_cables(scene: Scene) -> tuple[list[Cable], list[tuple]]:
         for c in scene.cables
     ]
     return cables, specs
+
+
+def harness_equilibrium(scene: Scene):
+    """The harness solver at the static equilibrium with the clip poses of t = 0: (the
+    ``_core.Harness``, its cables, their ``_core.Cable`` objects, the run's output)."""
+    from cablelife import _core
+    from cablelife.scene import SceneError
+    from cablelife.simulate import body_motions, build_cable, clip_kinematics
+
+    cables, specs = harness_cables(scene)
+    cores = [build_cable(scene, c) for c in cables]
+    times = np.array([0.0])
+    try:
+        core = _core.Harness(
+            cores, [c.name for c in cables], specs, max_iterations=scene.simulation.max_iterations
+        )
+        motions = body_motions(scene, times)
+        kin = [clip_kinematics(scene, c, times, motions=motions) for c in cables]
+        out = core.run_sequence([k["positions"] for k in kin], [k["quaternions"] for k in kin])
+    except ValueError as err:
+        raise SceneError(f"harness: {err}") from None
+    if out["error"]:
+        raise SceneError(f"harness: no static equilibrium: {out['error']}")
+    return core, cables, cores, out
 
 
 def run_harness(scene: Scene, times: np.ndarray, mode: str, progress, stop):

@@ -44,11 +44,6 @@ class Modes:
 
 def _equilibrium(scene: Scene, cable: Cable):
     """The solver object at the static equilibrium with the clip poses of t = 0."""
-    if scene.junctions:
-        raise SceneError(
-            "modal analysis of harnesses (scenes with [[junctions]]) is not supported yet: the "
-            "modes of a single cable would ignore its junctions"
-        )
     core = build_cable(scene, cable)
     pos, quat = clip_poses(scene, cable, np.array([0.0]), with_motion=True)
     try:
@@ -65,6 +60,8 @@ def cable_modes(scene: Scene, cable: Cable, count: int = 6) -> Modes:
     of t = 0 (the banded Rust solver)."""
     if count < 1:
         raise SceneError(f"count = {count}: ask for at least 1 mode")
+    if scene.junctions:
+        return harness_modes(scene, count)[cable.name]
     core, out = _equilibrium(scene, cable)
     try:
         found = core.modes(count)
@@ -82,6 +79,35 @@ def cable_modes(scene: Scene, cable: Cable, count: int = 6) -> Modes:
     )
 
 
+def harness_modes(scene: Scene, count: int = 6) -> dict[str, Modes]:
+    """The ``count`` lowest modes of a harness (a scene with ``[[junctions]]``) about its
+    static equilibrium with the clip poses of t = 0: modes of the whole tree (``rod::
+    harness_modal``), so every cable's ``Modes`` has the same frequencies and its part of each
+    mode shape (mass-normalised over the harness; ``shares`` and ``kind`` of the whole)."""
+    from cablelife.harness import harness_equilibrium
+
+    if count < 1:
+        raise SceneError(f"count = {count}: ask for at least 1 mode")
+    core, cables, cores, out = harness_equilibrium(scene)
+    try:
+        found = core.modes(count)
+    except ValueError as err:
+        raise SceneError(f"harness: {err}") from None
+    return {
+        c.name: Modes(
+            cable=c.name,
+            omega=found["omega"],
+            shapes=fc["displacements"],
+            arc_length=co.arc_length,
+            equilibrium=o["positions"][0],
+            rotations=fc["rotations"],
+            shares=found["shares"],
+            kind=list(found["kind"]),
+        )
+        for c, co, o, fc in zip(cables, cores, out["cables"], found["cables"], strict=True)
+    }
+
+
 def cable_modes_dense(scene: Scene, cable: Cable, count: int = 6) -> Modes:
     """The former dense solver (LAPACK on the (6N)² matrices, static condensation of the
     massless unknowns): O(N²) memory, O(N³) time. For comparison only."""
@@ -89,6 +115,8 @@ def cable_modes_dense(scene: Scene, cable: Cable, count: int = 6) -> Modes:
 
     if count < 1:
         raise SceneError(f"count = {count}: ask for at least 1 mode")
+    if scene.junctions:
+        raise SceneError("cable_modes_dense: harnesses (scenes with [[junctions]]) not supported")
     core, out = _equilibrium(scene, cable)
     lin = core.linearize()
     k = lin["stiffness"]
@@ -127,7 +155,9 @@ def cable_modes_dense(scene: Scene, cable: Cable, count: int = 6) -> Modes:
 
 
 def modes(scene: Scene, count: int = 6) -> dict[str, Modes]:
-    """Modes of every cable of the scene."""
+    """Modes of every cable of the scene (of the whole harness if it has junctions)."""
+    if scene.junctions:
+        return harness_modes(scene, count)
     return {c.name: cable_modes(scene, c, count) for c in scene.cables}
 
 

@@ -7,6 +7,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use rod::harness::{Harness as Tree, HarnessState, HarnessStatics, JunctionSpec};
+use rod::harness_modal::{harness_lowest_modes, ModalSystem};
 use rod::routing::route;
 use rod::{NewtonOptions, Pose};
 
@@ -20,7 +21,10 @@ type JunctionTuple = (String, f64, Vec<f64>, Vec<(usize, usize)>);
 pub struct Harness {
     tree: Tree,
     solver: HarnessStatics,
-    /// The last equilibrium of a `warm` run (the workbench's warm start).
+    /// The stability check's buffers (the tree inertia of each equilibrium).
+    stability: ModalSystem,
+    /// The last equilibrium of `run_sequence`: for `modes`, and the start of a `warm` run
+    /// (the workbench's warm start).
     state: Option<HarnessState>,
 }
 
@@ -65,9 +69,11 @@ impl Harness {
             ..Default::default()
         };
         let solver = HarnessStatics::new(&tree, opts);
+        let stability = ModalSystem::new(&tree);
         Ok(Harness {
             tree,
             solver,
+            stability,
             state: None,
         })
     }
@@ -91,10 +97,11 @@ impl Harness {
     /// end's cable applies to its junction, global, moment about the junction point),
     /// `junction_reaction_force` and `junction_reaction_moment` (T, J, 3: of the clip on each
     /// junction in `held`, zero for the others), `iterations`, `substeps`, `residual`, `steps`
-    /// and `error` (None, or why it stopped: the steps before are kept). `warm`: step 0 starts
-    /// from the last equilibrium of the previous warm run (the first from the routed shapes),
-    /// and a complete run's last equilibrium is kept for the next; a failed one keeps the
-    /// previous (the workbench's drags).
+    /// and `error` (None, or why it stopped: the steps before are kept). Each cable's
+    /// `unstable` is the number of negative eigenvalues of the whole harness's tangent
+    /// stiffness at that step (the tree inertia; 0 = stable). `warm`: step 0 starts from the
+    /// last equilibrium of the previous run (the first from the routed shapes); a failed run
+    /// keeps the previous (the workbench's drags).
     #[pyo3(signature = (positions, quaternions, progress=None, progress_every=50, stop=None,
         warm=false))]
     #[allow(clippy::too_many_arguments)]
@@ -162,6 +169,7 @@ impl Harness {
             }
         };
         let solver = &mut self.solver;
+        let stability = &mut self.stability;
         let mut poller = Poller::new(stop.as_ref(), progress, progress_every, t);
         let (nj, ne) = (tree.junctions.len(), tree.ends.len());
         struct Out {
@@ -203,10 +211,14 @@ impl Harness {
                 } else {
                     solver.sequence_step(tree, &mut st, &target)
                 };
-                let stats = match result {
+                let mut stats = match result {
                     Ok(s) => s,
                     Err(e) => return (out, Some(format!("step {k}: {e}")), None),
                 };
+                match stability.negative_count(tree, &st) {
+                    Ok(n) => stats.unstable = Some(n),
+                    Err(e) => return (out, Some(format!("step {k}: {e}")), None),
+                }
                 if let Err(e) = solver.assemble(tree, &st, 1.0, false) {
                     return (out, Some(format!("step {k}: {e}")), None);
                 }
@@ -232,12 +244,12 @@ impl Harness {
                 out.residual.push(stats.residual);
                 out.steps += 1;
                 if let Some(why) = poller.poll(k + 1) {
-                    return (out, Some(why), None);
+                    return (out, Some(why), Some(st));
                 }
             }
-            (out, None, Some(st))
+            (out, None, (t > 0).then_some(st))
         });
-        if warm && last.is_some() {
+        if last.is_some() {
             self.state = last;
         }
         let d = PyDict::new(py);
@@ -269,6 +281,87 @@ impl Harness {
         d.set_item("residual", PyArray1::from_vec(py, out.residual))?;
         d.set_item("steps", n)?;
         d.set_item("error", error)?;
+        Ok(d)
+    }
+
+    /// The `count` lowest natural modes of the whole harness about the last step of
+    /// `run_sequence` (a static equilibrium): shift-invert on the tree elimination
+    /// (`rod::harness_modal`). Returns `omega` (k,) rad/s, `cables` (one dict per cable:
+    /// `displacements` (k, N+1, 3) and `rotations` (k, N, 3), global, mass-normalised over
+    /// the harness), `junction_displacements` and `junction_rotations` (k, J, 3, global),
+    /// `shares` (k, 4) and `kind` (k,) as `Cable.modes`. An unstable equilibrium is a
+    /// ValueError.
+    fn modes<'py>(&mut self, py: Python<'py>, count: usize) -> PyResult<Bound<'py, PyDict>> {
+        let st = self.state.as_ref().ok_or_else(|| {
+            PyValueError::new_err("run a static solve (run_sequence) of the harness first")
+        })?;
+        let tree = &self.tree;
+        let modes = py
+            .detach(|| harness_lowest_modes(tree, st, count))
+            .map_err(|e| PyValueError::new_err(e.0))?;
+        let k = modes.len();
+        let nj = tree.junctions.len();
+        let d = PyDict::new(py);
+        let cables = PyList::empty(py);
+        for (c, rod) in tree.cables.iter().enumerate() {
+            let (nodes, edges) = (rod.arc.len(), rod.n_edges());
+            let mut disp = Vec::with_capacity(k * nodes * 3);
+            let mut rot = Vec::with_capacity(k * edges * 3);
+            for m in &modes {
+                let single = rod::modal::Mode {
+                    eigenvalue: m.eigenvalue,
+                    omega: m.omega,
+                    shape: m.cables[c].clone(),
+                    shares: m.shares,
+                    kind: m.kind,
+                };
+                for u in single.displacements(rod) {
+                    disp.extend_from_slice(u.as_slice());
+                }
+                for r in single.rotations(&st.cables[c]) {
+                    rot.extend_from_slice(r.as_slice());
+                }
+            }
+            let cd = PyDict::new(py);
+            cd.set_item(
+                "displacements",
+                PyArray1::from_vec(py, disp).reshape([k, nodes, 3])?,
+            )?;
+            cd.set_item(
+                "rotations",
+                PyArray1::from_vec(py, rot).reshape([k, edges, 3])?,
+            )?;
+            cables.append(cd)?;
+        }
+        let mut jd = Vec::with_capacity(k * nj * 3);
+        let mut jr = Vec::with_capacity(k * nj * 3);
+        for m in &modes {
+            for (v, pose) in m.junctions.iter().zip(&st.junctions) {
+                jd.extend_from_slice(&[v[0], v[1], v[2]]);
+                let r = rod::rotation::rotation_matrix(&pose.orientation)
+                    * nalgebra::Vector3::new(v[3], v[4], v[5]);
+                jr.extend_from_slice(r.as_slice());
+            }
+        }
+        d.set_item(
+            "omega",
+            PyArray1::from_vec(py, modes.iter().map(|m| m.omega).collect()),
+        )?;
+        d.set_item("cables", cables)?;
+        d.set_item(
+            "junction_displacements",
+            PyArray1::from_vec(py, jd).reshape([k, nj, 3])?,
+        )?;
+        d.set_item(
+            "junction_rotations",
+            PyArray1::from_vec(py, jr).reshape([k, nj, 3])?,
+        )?;
+        let shares: Vec<f64> = modes.iter().flat_map(|m| m.shares).collect();
+        d.set_item("shares", PyArray1::from_vec(py, shares).reshape([k, 4])?)?;
+        d.set_item(
+            "kind",
+            modes.iter().map(|m| m.kind.name()).collect::<Vec<_>>(),
+        )?;
         Ok(d)
     }
 }

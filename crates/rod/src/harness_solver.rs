@@ -3,6 +3,7 @@
 //! segment's chain onto its junctions, then the junction tree leaves first), Newton,
 //! pseudo-transient and load continuation, sequences.
 use crate::assembly::Workspace;
+use crate::block_tridiag::{pivot_inertia, Inertia};
 use crate::harness::{Harness, HarnessError, HarnessState};
 use crate::junction::HeldEnds;
 use crate::model::{Pose, Rod};
@@ -82,6 +83,13 @@ pub struct HarnessStatics {
     /// Pseudo-transient damping added to the junction pivots by `factor` (position, rotation).
     junction_shift: (f64, f64),
     force_scale: f64,
+    /// With `symmetric`, `factor` uses the symmetric block LDLᵀ on the cables and records the
+    /// inertia of the tree factorisation (Sylvester: the cables' chain pivots plus the junction
+    /// pivots) in `inertia` — the stability check and the Sturm count of `harness_modal`.
+    pub symmetric: bool,
+    pub inertia: Inertia,
+    /// Per junction: a diagonal added to its pivot (−σ M_j in `harness_modal`; empty: none).
+    pub junction_diag: Vec<Vector6<f64>>,
     /// Length scales: the shortest cable (steps) and the finest mean segment (moments).
     length: f64,
     h: f64,
@@ -144,6 +152,9 @@ impl HarnessStatics {
             has_prev: false,
             junction_shift: (0.0, 0.0),
             force_scale,
+            symmetric: false,
+            inertia: Inertia::default(),
+            junction_diag: Vec::new(),
             length,
             h: hmin,
         }
@@ -231,11 +242,18 @@ impl HarnessStatics {
     /// Factors the assembled system: each cable segment, the Schur complements onto the
     /// junctions, the junction tree (leaves first).
     pub fn factor(&mut self, h: &Harness) -> Result<(), HarnessError> {
+        self.inertia = Inertia::default();
         for (c, rod) in h.cables.iter().enumerate() {
             for seg in &rod.segments {
-                self.ws[c]
-                    .factor_segment(rod, seg)
-                    .map_err(|e| Self::cable_err(h, c, e))?;
+                if self.symmetric {
+                    let i = self.ws[c].jac.ldlt(seg.blocks.clone());
+                    self.inertia.negative += i.negative;
+                    self.inertia.zero += i.zero;
+                } else {
+                    self.ws[c]
+                        .factor_segment(rod, seg)
+                        .map_err(|e| Self::cable_err(h, c, e))?;
+                }
             }
         }
         for (j, list) in h.junction_ends.iter().enumerate() {
@@ -251,6 +269,9 @@ impl HarnessStatics {
                 } else {
                     self.junction_shift.1
                 };
+            }
+            if let Some(extra) = self.junction_diag.get(j) {
+                d += Matrix6::from_diagonal(extra);
             }
             self.pivot[j] = d;
         }
@@ -314,6 +335,10 @@ impl HarnessStatics {
                 // A prescribed junction: no increment, no coupling to its parent.
                 self.pivot_inv[j] = Matrix6::zeros();
                 continue;
+            }
+            if self.symmetric {
+                let scale = self.pivot[j].diagonal().amax();
+                pivot_inertia(&self.pivot[j], scale, &mut self.inertia);
             }
             let inv = invert(&self.pivot[j]).ok_or_else(|| {
                 HarnessError(format!(

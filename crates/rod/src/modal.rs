@@ -44,6 +44,20 @@ pub enum ModeKind {
 }
 
 impl ModeKind {
+    /// The kind with the largest energy share (bending d1, bending d2, torsion, axial).
+    pub fn dominant(shares: &[f64; 4]) -> ModeKind {
+        let kinds = [
+            ModeKind::BendingD1,
+            ModeKind::BendingD2,
+            ModeKind::Torsion,
+            ModeKind::Axial,
+        ];
+        let i = (0..4)
+            .max_by(|&a, &b| shares[a].total_cmp(&shares[b]))
+            .unwrap();
+        kinds[i]
+    }
+
     pub fn name(&self) -> &'static str {
         match self {
             ModeKind::BendingD1 => "bending d1",
@@ -166,29 +180,19 @@ pub fn tangent_stiffness(rod: &Rod, st: &State) -> Result<BlockTridiag, ModalErr
     Ok(k)
 }
 
-/// The pencil (K, M) on the block structure, with a work copy for the factorisations.
-struct Pencil {
-    k: BlockTridiag,
-    m: Vec<Vector6<f64>>,
-    work: BlockTridiag,
-}
-
-impl Pencil {
-    fn n(&self) -> usize {
-        self.m.len()
-    }
-
+/// A pencil (K, M) with a lumped (diagonal) M whose K − σM can be factored and solved: the
+/// single cable's block-tridiagonal one here, the harness's tree (`harness_modal`).
+pub(crate) trait ShiftInvert {
+    /// The lumped mass per block slot of the flattened unknowns.
+    fn mass(&self) -> &[Vector6<f64>];
     /// Factors K − σM; returns its inertia (the number of eigenvalues below σ), or None if a
     /// pivot is zero (σ on or next to an eigenvalue).
-    fn factor(&mut self, sigma: f64) -> Option<usize> {
-        let n = self.n();
-        for b in 0..n {
-            self.work.diag[b] = self.k.diag[b] - Block::from_diagonal(&(self.m[b] * sigma));
-            self.work.lower[b] = self.k.lower[b];
-            self.work.upper[b] = self.k.upper[b];
-        }
-        let inertia = self.work.ldlt(0..n);
-        (inertia.zero == 0).then_some(inertia.negative)
+    fn factor(&mut self, sigma: f64) -> Option<usize>;
+    /// y = (K − σM)⁻¹ M x with the current factorisation (`r`: work space).
+    fn apply(&mut self, x: &[Vector6<f64>], y: &mut [Vector6<f64>], r: &mut [Vector6<f64>]);
+
+    fn n(&self) -> usize {
+        self.mass().len()
     }
 
     /// Factors K − σM, moving σ down by `step`, 2 `step`, 4 `step` … off an eigenvalue if it
@@ -207,9 +211,33 @@ impl Pencil {
     fn mdot(&self, x: &[Vector6<f64>], y: &[Vector6<f64>]) -> f64 {
         x.iter()
             .zip(y)
-            .zip(&self.m)
+            .zip(self.mass())
             .map(|((a, b), m)| a.component_mul(b).dot(m))
             .sum()
+    }
+}
+
+/// The pencil (K, M) on the block structure, with a work copy for the factorisations.
+struct Pencil {
+    k: BlockTridiag,
+    m: Vec<Vector6<f64>>,
+    work: BlockTridiag,
+}
+
+impl ShiftInvert for Pencil {
+    fn mass(&self) -> &[Vector6<f64>] {
+        &self.m
+    }
+
+    fn factor(&mut self, sigma: f64) -> Option<usize> {
+        let n = self.n();
+        for b in 0..n {
+            self.work.diag[b] = self.k.diag[b] - Block::from_diagonal(&(self.m[b] * sigma));
+            self.work.lower[b] = self.k.lower[b];
+            self.work.upper[b] = self.k.upper[b];
+        }
+        let inertia = self.work.ldlt(0..n);
+        (inertia.zero == 0).then_some(inertia.negative)
     }
 
     /// y = (K − σM)⁻¹ M x with the current factorisation and two steps of iterative
@@ -217,7 +245,7 @@ impl Pencil {
     /// axial terms against soft bending, σ near the spectrum): one solve leaves a relative
     /// error ~1e-5 in the bending directions of a section with GA/EI = 5e8 1/m²; refinement
     /// brings the Ritz values to ~1e-7.
-    fn apply(&self, x: &[Vector6<f64>], y: &mut [Vector6<f64>], r: &mut [Vector6<f64>]) {
+    fn apply(&mut self, x: &[Vector6<f64>], y: &mut [Vector6<f64>], r: &mut [Vector6<f64>]) {
         let n = self.n();
         for ((y, x), m) in y.iter_mut().zip(x).zip(&self.m) {
             *y = x.component_mul(m);
@@ -248,14 +276,14 @@ impl Rng {
 }
 
 /// Ritz pairs of the subspace iteration: eigenvalues ascending and M-orthonormal vectors.
-struct Ritz {
-    values: Vec<f64>,
-    vectors: Vec<Vec<Vector6<f64>>>,
+pub(crate) struct Ritz {
+    pub values: Vec<f64>,
+    pub vectors: Vec<Vec<Vector6<f64>>>,
 }
 
 /// Subspace iteration with `p` vectors from the start vectors `x` at shift σ (factored).
-fn subspace_iteration(
-    pencil: &Pencil,
+fn subspace_iteration<P: ShiftInvert>(
+    pencil: &mut P,
     sigma: f64,
     mut x: Vec<Vec<Vector6<f64>>>,
     count: usize,
@@ -397,6 +425,28 @@ pub fn lowest_modes(rod: &Rod, st: &State, count: usize) -> Result<Vec<Mode>, Mo
         k,
         m,
     };
+    let ritz = lowest_pairs(&mut pencil, count, massive, scale)?;
+    Ok((0..count)
+        .map(|i| {
+            let shape = ritz.vectors[i]
+                .iter()
+                .zip(&d)
+                .map(|(v, d)| v.component_mul(d))
+                .collect();
+            classify(rod, st, &mass, ritz.values[i], shape)
+        })
+        .collect())
+}
+
+/// The `count` lowest eigenpairs of a pencil with `massive` slots of positive mass (values
+/// clamped at 0 from below; `scale`: the eigenvalue scale for shifts off a singular point):
+/// the stability check (inertia of K), shift-invert subspace iteration, the Sturm cut.
+pub(crate) fn lowest_pairs<P: ShiftInvert>(
+    pencil: &mut P,
+    count: usize,
+    massive: usize,
+    scale: f64,
+) -> Result<Ritz, ModalError> {
     // Stability: the inertia of K (shifted below a zero mode if K is singular).
     let (sigma, negative) = pencil.factor_near(0.0, 1e-12 * scale);
     let mut rng = Rng(0x5eed_cab1e);
@@ -407,13 +457,13 @@ pub fn lowest_modes(rod: &Rod, st: &State, count: usize) -> Result<Vec<Mode>, Mo
         // Start vectors: the previous Ritz vectors, then random ones on the massive slots.
         while start.len() < p {
             let v: Vec<Vector6<f64>> = pencil
-                .m
+                .mass()
                 .iter()
                 .map(|mb| Vector6::from_fn(|k, _| if mb[k] > 0.0 { rng.next() } else { 0.0 }))
                 .collect();
             start.push(v);
         }
-        let ritz = subspace_iteration(&pencil, sigma, start, count, &mut iterations)
+        let ritz = subspace_iteration(pencil, sigma, start, count, &mut iterations)
             .ok_or(ModalError::NotConverged { iterations })?;
         let top = ritz.values[..count]
             .iter()
@@ -438,21 +488,12 @@ pub fn lowest_modes(rod: &Rod, st: &State, count: usize) -> Result<Vec<Mode>, Mo
                     eigenvalue: ritz.values[0],
                 });
             }
-            return Ok((0..count)
-                .map(|i| {
-                    let lambda = if ritz.values[i] < 0.0 {
-                        0.0
-                    } else {
-                        ritz.values[i]
-                    };
-                    let shape = ritz.vectors[i]
-                        .iter()
-                        .zip(&d)
-                        .map(|(v, d)| v.component_mul(d))
-                        .collect();
-                    classify(rod, st, &mass, lambda, shape)
-                })
-                .collect());
+            let mut values = ritz.values;
+            let mut vectors = ritz.vectors;
+            values.truncate(count);
+            vectors.truncate(count);
+            values.iter_mut().for_each(|v| *v = v.max(0.0));
+            return Ok(Ritz { values, vectors });
         }
         // a mode was missed: enlarge the subspace, keep the Ritz vectors
         start = ritz.vectors;
@@ -461,15 +502,14 @@ pub fn lowest_modes(rod: &Rod, st: &State, count: usize) -> Result<Vec<Mode>, Mo
     Err(ModalError::NotConverged { iterations })
 }
 
-/// Mode from its eigenpair: kinetic energy shares in the local frames, sign convention (the
-/// largest displacement component positive).
-fn classify(
+/// The unnormalised kinetic energy of a mode shape of one cable by deformation (bending d1,
+/// bending d2, torsion, axial), and its largest mass-weighted component (|value|, sign).
+pub(crate) fn energy_shares(
     rod: &Rod,
     st: &State,
     m: &[Vector6<f64>],
-    lambda: f64,
-    mut shape: Vec<Vector6<f64>>,
-) -> Mode {
+    shape: &[Vector6<f64>],
+) -> ([f64; 4], (f64, f64)) {
     let n_edges = rod.n_edges();
     let mut shares = [0.0; 4];
     let mut big = (0.0f64, 1.0f64);
@@ -487,26 +527,30 @@ fn classify(
             }
         }
     }
+    (shares, big)
+}
+
+/// Mode from its eigenpair: kinetic energy shares in the local frames, sign convention (the
+/// largest displacement component positive).
+fn classify(
+    rod: &Rod,
+    st: &State,
+    m: &[Vector6<f64>],
+    lambda: f64,
+    mut shape: Vec<Vector6<f64>>,
+) -> Mode {
+    let (mut shares, big) = energy_shares(rod, st, m, &shape);
     let total: f64 = shares.iter().sum();
     if total > 0.0 {
         shares.iter_mut().for_each(|s| *s /= total);
         let nrm = total.sqrt() * big.1;
         shape.iter_mut().for_each(|v| *v /= nrm);
     }
-    let kinds = [
-        ModeKind::BendingD1,
-        ModeKind::BendingD2,
-        ModeKind::Torsion,
-        ModeKind::Axial,
-    ];
-    let i = (0..4)
-        .max_by(|&a, &b| shares[a].total_cmp(&shares[b]))
-        .unwrap();
     Mode {
         eigenvalue: lambda,
         omega: lambda.sqrt(),
         shape,
         shares,
-        kind: kinds[i],
+        kind: ModeKind::dominant(&shares),
     }
 }

@@ -1,0 +1,318 @@
+//! Modal analysis and stability of a harness at a static equilibrium (docs/harness.md,
+//! "Modal analysis and stability"): the pencil (K, M) of the whole tree — the cables' symmetric
+//! tangent stiffness with their junction couplings, the cables' lumped masses, and per junction
+//! its mass plus the node masses of the cable ends it holds (translations) and its rotary
+//! inertia (body-frame rotations) — solved by the shift-invert subspace iteration of
+//! `modal` with K − σM factored by the harness's tree elimination (`HarnessStatics::factor`
+//! in its symmetric mode: block LDLᵀ on the cable chains, then the junction tree, leaves
+//! first; O(N)).
+//!
+//! Stability and the Sturm count: by Sylvester's law of inertia the number of negative
+//! eigenvalues of K − σM is the number of negative pivots of the tree LDLᵀ — the cables' chain
+//! pivots plus the junction pivots (the Schur complements of the tree elimination).
+use crate::block_tridiag::Block;
+use crate::harness::{Harness, HarnessError, HarnessState};
+use crate::harness_solver::HarnessStatics;
+use crate::modal::{energy_shares, lowest_pairs, lumped_mass, ModalError, ModeKind, ShiftInvert};
+use crate::statics::NewtonOptions;
+use nalgebra::Vector6;
+
+/// One natural mode of a harness, mass-normalised over the whole harness (φᵀ M φ = 1).
+#[derive(Clone, Debug)]
+pub struct HarnessMode {
+    /// λ = ω², 1/s².
+    pub eigenvalue: f64,
+    /// ω, rad/s.
+    pub omega: f64,
+    /// Per cable, per block: node displacement (global) and edge rotation (body frame), as
+    /// `modal::Mode::shape` (zero at the nodes held by clips and junctions).
+    pub cables: Vec<Vec<Vector6<f64>>>,
+    /// Per junction: displacement (global) and rotation (junction body frame).
+    pub junctions: Vec<Vector6<f64>>,
+    /// Shares of the cables' modal kinetic energy: bending d1, bending d2, torsion, axial.
+    pub shares: [f64; 4],
+    pub kind: ModeKind,
+}
+
+/// The buffers of a harness's pencil, allocated once (`HarnessStability` keeps them across the
+/// steps of a sequence): `k` the assembled symmetric stiffness (kept for products), `work` its
+/// shifted copy factored by the tree elimination.
+pub struct ModalSystem {
+    k: HarnessStatics,
+    work: HarnessStatics,
+    /// Lumped mass on the flattened unknowns: the cables' blocks in order, then the junctions.
+    m: Vec<Vector6<f64>>,
+    offsets: Vec<usize>,
+    sigma: f64,
+    xc: Vec<Vec<Vector6<f64>>>,
+    xj: Vec<Vector6<f64>>,
+}
+
+/// The pencil (K, M) of a harness on its buffers.
+struct HarnessPencil<'a> {
+    h: &'a Harness,
+    s: &'a mut ModalSystem,
+}
+
+impl ModalSystem {
+    pub fn new(h: &Harness) -> Self {
+        let k = HarnessStatics::new(h, NewtonOptions::default());
+        let mut work = HarnessStatics::new(h, NewtonOptions::default());
+        work.symmetric = true;
+        let mut m = Vec::new();
+        let mut offsets = Vec::with_capacity(h.cables.len() + 1);
+        for rod in &h.cables {
+            offsets.push(m.len());
+            m.extend(lumped_mass(rod));
+        }
+        offsets.push(m.len());
+        for (j, js) in h.junctions.iter().enumerate() {
+            let ends: f64 = h.junction_ends[j]
+                .iter()
+                .map(|&e| h.cables[h.ends[e].cable].node_mass[h.ends[e].topo.node])
+                .sum();
+            let mt = js.mass + ends;
+            let r = js.rotary_inertia;
+            m.push(Vector6::new(mt, mt, mt, r.x, r.y, r.z));
+        }
+        let xc = h
+            .cables
+            .iter()
+            .map(|r| vec![Vector6::zeros(); r.arc.len()])
+            .collect();
+        let xj = vec![Vector6::zeros(); h.junctions.len()];
+        work.junction_diag = xj.clone();
+        ModalSystem {
+            k,
+            work,
+            m,
+            offsets,
+            sigma: 0.0,
+            xc,
+            xj,
+        }
+    }
+
+    /// Assembles the symmetric tangent stiffness of `h` at `st`.
+    pub fn load(&mut self, h: &Harness, st: &HarnessState) -> Result<(), HarnessError> {
+        let k = &mut self.k;
+        k.assemble(h, st, 1.0, true)?;
+        // The symmetric part: the Hessian at the equilibrium (see `stability`).
+        for ws in &mut k.ws {
+            let jac = &mut ws.jac;
+            let n = jac.n_blocks();
+            for b in 0..n {
+                jac.diag[b] = 0.5 * (jac.diag[b] + jac.diag[b].transpose());
+                if b + 1 < n {
+                    let u = 0.5 * (jac.upper[b] + jac.lower[b + 1].transpose());
+                    jac.upper[b] = u;
+                    jac.lower[b + 1] = u.transpose();
+                }
+            }
+        }
+        for held in &mut k.held {
+            for end in &mut held.ends {
+                end.ee = 0.5 * (end.ee + end.ee.transpose());
+                for i in 0..2 {
+                    let s = 0.5 * (end.ec[i] + end.ce[i].transpose());
+                    end.ec[i] = s;
+                    end.ce[i] = s.transpose();
+                }
+            }
+        }
+        for (w, k) in self.work.held.iter_mut().zip(&self.k.held) {
+            w.ends.clone_from(&k.ends);
+        }
+        Ok(())
+    }
+}
+
+impl HarnessPencil<'_> {
+    fn split(&mut self, x: &[Vector6<f64>]) {
+        for (c, xc) in self.s.xc.iter_mut().enumerate() {
+            xc.copy_from_slice(&x[self.s.offsets[c]..self.s.offsets[c + 1]]);
+        }
+        let nc = self.s.offsets[self.s.xc.len()];
+        self.s.xj.copy_from_slice(&x[nc..]);
+    }
+
+    /// y = (K − σM)⁻¹ r for the flattened r (one tree solve).
+    fn solve(&mut self, r: &[Vector6<f64>], y: &mut [Vector6<f64>]) {
+        let nc = self.s.offsets[self.s.xc.len()];
+        for (c, ws) in self.s.work.ws.iter_mut().enumerate() {
+            for (o, v) in ws.rhs.iter_mut().zip(&r[self.s.offsets[c]..]) {
+                *o = -v;
+            }
+        }
+        for (o, v) in self.s.work.junction_residual.iter_mut().zip(&r[nc..]) {
+            *o = -v;
+        }
+        self.s.work.newton_correction(self.h);
+        let (dc, dj) = self.s.work.correction();
+        for (c, d) in dc.iter().enumerate() {
+            y[self.s.offsets[c]..self.s.offsets[c + 1]].copy_from_slice(d);
+        }
+        y[nc..].copy_from_slice(dj);
+    }
+
+    /// r ← b − (K − σM) y.
+    fn residual(&mut self, b: &[Vector6<f64>], y: &[Vector6<f64>], r: &mut [Vector6<f64>]) {
+        self.split(y);
+        let (kc, kj) = self.s.k.jacobian_times(self.h, &self.s.xc, &self.s.xj);
+        let nc = self.s.offsets[self.s.xc.len()];
+        for (c, kv) in kc.iter().enumerate() {
+            r[self.s.offsets[c]..self.s.offsets[c + 1]].copy_from_slice(kv);
+        }
+        r[nc..].copy_from_slice(&kj);
+        for (((r, b), y), m) in r.iter_mut().zip(b).zip(y).zip(&self.s.m) {
+            *r = b - (*r - self.s.sigma * y.component_mul(m));
+        }
+    }
+}
+
+impl ShiftInvert for HarnessPencil<'_> {
+    fn mass(&self) -> &[Vector6<f64>] {
+        &self.s.m
+    }
+
+    fn factor(&mut self, sigma: f64) -> Option<usize> {
+        self.s.sigma = sigma;
+        for (c, ws) in self.s.work.ws.iter_mut().enumerate() {
+            ws.jac.clone_from(&self.s.k.ws[c].jac);
+            for (b, d) in ws.jac.diag.iter_mut().enumerate() {
+                *d -= Block::from_diagonal(&(self.s.m[self.s.offsets[c] + b] * sigma));
+            }
+        }
+        let nc = self.s.offsets[self.s.xc.len()];
+        for (d, m) in self.s.work.junction_diag.iter_mut().zip(&self.s.m[nc..]) {
+            *d = -sigma * m;
+        }
+        self.s.work.factor(self.h).ok()?;
+        (self.s.work.inertia.zero == 0).then_some(self.s.work.inertia.negative)
+    }
+
+    /// y = (K − σM)⁻¹ M x by the tree solve with two steps of iterative refinement (as the
+    /// single cable's `apply`).
+    fn apply(&mut self, x: &[Vector6<f64>], y: &mut [Vector6<f64>], r: &mut [Vector6<f64>]) {
+        let b: Vec<Vector6<f64>> = x
+            .iter()
+            .zip(&self.s.m)
+            .map(|(x, m)| x.component_mul(m))
+            .collect();
+        self.solve(&b, y);
+        let mut dy = vec![Vector6::zeros(); y.len()];
+        for _ in 0..2 {
+            self.residual(&b, y, r);
+            self.solve(r, &mut dy);
+            for (y, d) in y.iter_mut().zip(&dy) {
+                *y += d;
+            }
+        }
+    }
+}
+
+/// Eigenvalue scale for shifts off a singular point: the largest translational K_ii/M_ii.
+fn eigen_scale(p: &ModalSystem) -> f64 {
+    let mut scale = 0.0f64;
+    for (c, ws) in p.k.ws.iter().enumerate() {
+        for (b, kb) in ws.jac.diag.iter().enumerate() {
+            let mb = p.m[p.offsets[c] + b];
+            for s in (0..3).filter(|&s| mb[s] > 0.0) {
+                scale = scale.max(kb[(s, s)].abs() / mb[s]);
+            }
+        }
+    }
+    scale.max(1e-300)
+}
+
+/// The number of negative eigenvalues of the harness's symmetric tangent stiffness at `st`
+/// (0: a stable equilibrium), from the pivots of its tree LDLᵀ. A singular K (a free rigid
+/// motion) is shifted by a round-off amount below its zero eigenvalues.
+pub fn harness_negative_count(h: &Harness, st: &HarnessState) -> Result<usize, HarnessError> {
+    ModalSystem::new(h).negative_count(h, st)
+}
+
+impl ModalSystem {
+    /// `harness_negative_count` on these buffers (no allocation after the first call).
+    pub fn negative_count(
+        &mut self,
+        h: &Harness,
+        st: &HarnessState,
+    ) -> Result<usize, HarnessError> {
+        self.load(h, st)?;
+        let scale = eigen_scale(self);
+        Ok(HarnessPencil { h, s: self }
+            .factor_near(0.0, 1e-12 * scale)
+            .1)
+    }
+}
+
+/// The `count` lowest natural modes of the harness at the equilibrium `st`.
+pub fn harness_lowest_modes(
+    h: &Harness,
+    st: &HarnessState,
+    count: usize,
+) -> Result<Vec<HarnessMode>, HarnessError> {
+    let describe = |e: ModalError| HarnessError(format!("modal analysis of the harness: {e}"));
+    let mut sys = ModalSystem::new(h);
+    sys.load(h, st)?;
+    let p = &sys;
+    let massive =
+        p.m.iter()
+            .flat_map(|v| v.iter())
+            .filter(|&&x| x > 0.0)
+            .count();
+    if massive == 0 {
+        return Err(describe(ModalError::NoUnknowns));
+    }
+    let count = count.clamp(1, massive);
+    let scale = eigen_scale(p);
+    let ritz = lowest_pairs(&mut HarnessPencil { h, s: &mut sys }, count, massive, scale)
+        .map_err(describe)?;
+    let p = &sys;
+    let nc = p.offsets[h.cables.len()];
+    Ok(ritz
+        .values
+        .iter()
+        .zip(&ritz.vectors)
+        .map(|(&lambda, v)| {
+            let mut shares = [0.0; 4];
+            let mut big = (0.0f64, 1.0f64);
+            let mut total = 0.0;
+            for (c, rod) in h.cables.iter().enumerate() {
+                let range = p.offsets[c]..p.offsets[c + 1];
+                let (s, b) = energy_shares(rod, &st.cables[c], &p.m[range.clone()], &v[range]);
+                for k in 0..4 {
+                    shares[k] += s[k];
+                }
+                if b.0 > big.0 {
+                    big = b;
+                }
+            }
+            for (x, m) in v[nc..].iter().zip(&p.m[nc..]) {
+                total += x.component_mul(x).dot(m);
+            }
+            total += shares.iter().sum::<f64>();
+            let cable_total: f64 = shares.iter().sum();
+            if cable_total > 0.0 {
+                shares.iter_mut().for_each(|s| *s /= cable_total);
+            }
+            let nrm = total.sqrt().max(1e-300) * big.1;
+            let scaled: Vec<Vector6<f64>> = v.iter().map(|x| x / nrm).collect();
+            HarnessMode {
+                eigenvalue: lambda,
+                omega: lambda.sqrt(),
+                cables: (0..h.cables.len())
+                    .map(|c| scaled[p.offsets[c]..p.offsets[c + 1]].to_vec())
+                    .collect(),
+                junctions: scaled[nc..].to_vec(),
+                shares,
+                kind: ModeKind::dominant(&shares),
+            }
+        })
+        .collect())
+}
+
+#[cfg(test)]
+#[path = "harness_modal_tests.rs"]
+mod tests;
