@@ -27,7 +27,7 @@ fn cols_to_junction(m: &Matrix6<f64>, r: &Matrix3<f64>) -> Matrix6<f64> {
 }
 
 #[inline]
-fn vec_to_junction(v: &Vector6<f64>, r: &Matrix3<f64>) -> Vector6<f64> {
+pub(crate) fn vec_to_junction(v: &Vector6<f64>, r: &Matrix3<f64>) -> Vector6<f64> {
     let mut out = *v;
     let low = r * v.fixed_rows::<3>(3);
     out.fixed_rows_mut::<3>(3).copy_from(&low);
@@ -50,10 +50,10 @@ pub struct HarnessStatics {
     pub ws: Vec<Workspace>,
     pub held: Vec<HeldEnds>,
     pub opts: NewtonOptions,
-    delta: Vec<Vec<Vector6<f64>>>,
+    pub(crate) delta: Vec<Vec<Vector6<f64>>>,
     trial: Vec<Vec<Vector6<f64>>>,
     y: Vec<Vec<Vector6<f64>>>,
-    dj: Vec<Vector6<f64>>,
+    pub(crate) dj: Vec<Vector6<f64>>,
     trial_j: Vec<Vector6<f64>>,
     /// Junction residuals (∂V/∂(X, Θ)).
     pub junction_residual: Vec<Vector6<f64>>,
@@ -77,6 +77,8 @@ pub struct HarnessStatics {
     has_prev: bool,
     /// Pseudo-transient damping added to the junction pivots by `factor` (position, rotation).
     junction_shift: (f64, f64),
+    /// Further junction pivot blocks (the junctions' inertia in dynamics; zero in statics).
+    pub(crate) junction_extra: Vec<Matrix6<f64>>,
     force_scale: f64,
     /// Length scales: the shortest cable (steps) and the finest mean segment (moments).
     length: f64,
@@ -137,6 +139,7 @@ impl HarnessStatics {
             prev: HarnessState::empty(),
             has_prev: false,
             junction_shift: (0.0, 0.0),
+            junction_extra: vec![Matrix6::zeros(); nj],
             force_scale,
             length,
             h: hmin,
@@ -234,7 +237,7 @@ impl HarnessStatics {
                     self.junction_shift.1
                 };
             }
-            self.pivot[j] = d;
+            self.pivot[j] = d + self.junction_extra[j];
         }
         self.link_ab.iter_mut().for_each(|m| m.fill(0.0));
         self.link_ba.iter_mut().for_each(|m| m.fill(0.0));
@@ -320,7 +323,7 @@ impl HarnessStatics {
 
     /// Solves J Δ = −r with the factorisation for the cable residuals `rc` (block vectors, as
     /// `ws.rhs`) and junction residuals `rj`; returns the largest |Δx| and |θ|.
-    fn solve(&mut self, h: &Harness, use_trial: bool) -> (f64, f64) {
+    pub(crate) fn solve(&mut self, h: &Harness, use_trial: bool) -> (f64, f64) {
         for (c, rod) in h.cables.iter().enumerate() {
             let y = &mut self.y[c];
             y.copy_from_slice(&self.ws[c].rhs);
