@@ -10,8 +10,9 @@
 //! Junction unknowns: the position increment (v̇ += c_m δx, exact) and the rotation increment
 //! applied to the pose, Q ← Q ⊗ exp(δθ), with Δq = log(Q_nᵀQ)/h and v̇ following from it (the
 //! coupling blocks of the ends are then exact; the inertia block carries J_r⁻¹(hΔq)). The
-//! junction-end coupling blocks are the static ones: without the viscous (Kelvin–Voigt)
-//! derivatives of the two elements next to each end (a modified Newton there when damped).
+//! junction-end coupling blocks include the Kelvin–Voigt damping (`EndBlocks::
+//! compute_with_rates`); the rate of a held ghost is taken as c_damp δθ (its J_r⁻¹(hΔq)
+//! factor, 1 + O(hΔq), is left out).
 use crate::assembly::{KinkAt, Part};
 use crate::dynamics::{
     ClipMotion, DynamicOptions, Dynamics, Energies, GenAlpha, StepStats, STALL_TOLERANCE,
@@ -19,7 +20,7 @@ use crate::dynamics::{
 };
 use crate::harness::{Harness, HarnessError, HarnessState, HarnessStatics};
 use crate::harness_solver::vec_to_junction;
-use crate::model::{EdgeKind, Pose};
+use crate::model::Pose;
 use crate::rotation::{log_vec, right_jacobian, rotate_body, rotation_matrix, skew};
 use crate::statics::{NewtonOptions, SolveError};
 use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
@@ -115,6 +116,23 @@ impl HarnessDynamics {
         hd
     }
 
+    /// Sets the retardation times τ of cable c's Kelvin–Voigt damping ((GA₁, GA₂, EA) and
+    /// (EI₁, EI₂, GJ), s) when they differ from the options' (call before `start`).
+    pub fn set_retardation_times(
+        &mut self,
+        h: &Harness,
+        c: usize,
+        tau_shear: Vector3<f64>,
+        tau_bend: Vector3<f64>,
+    ) {
+        let sec = &h.cables[c].spec.section;
+        let dy = &mut self.cables[c];
+        dy.opts.tau_shear = tau_shear;
+        dy.opts.tau_bend = tau_bend;
+        dy.rates.shear_damping = tau_shear.component_mul(&sec.shear_stiffness);
+        dy.rates.bend_damping = tau_bend.component_mul(&sec.bend_stiffness);
+    }
+
     fn cable_err(h: &Harness, c: usize, e: SolveError) -> HarnessError {
         HarnessError(format!("cable '{}': {e}", h.names[c]))
     }
@@ -179,17 +197,8 @@ impl HarnessDynamics {
                 .map_err(|k| Self::kink(h, c, k))?;
             if want_jac {
                 for end in &mut self.tree.held[c].ends {
-                    end.compute(rod, &st.cables[c], &dy.ws)
+                    end.compute_with_rates(rod, &st.cables[c], &dy.ws, Some(&dy.rates))
                         .map_err(|k| Self::kink(h, c, k))?;
-                    // The derivatives along a free edge's rotation times J_r(hΔθ) of its step
-                    // (as in the cable's own blocks; the Newton update moves the increment).
-                    for (i, &b) in end.topo.blocks().iter().enumerate() {
-                        if b < rod.n_edges() && rod.edge_kind[b] == EdgeKind::Free {
-                            let t = dy.rates.tangent[b];
-                            let cols = end.ec[i].fixed_view::<6, 3>(0, 3) * t;
-                            end.ec[i].fixed_view_mut::<6, 3>(0, 3).copy_from(&cols);
-                        }
-                    }
                 }
             }
         }
