@@ -6,8 +6,10 @@ the engine shaken by the ISO 16750-3 engine PSD (as the demo), 1 ms steps. Print
 - the static equilibrium (from the routed shape): the solver's wall time and the whole
   `simulate(scene, "static")` call a user makes;
 - a quasistatic run of 1 s at 1 ms steps through the PSD motion: wall time per simulated
-  second (real-time factor of quasistatic sequences).
-Dynamic analysis of harnesses is not implemented yet (docs/harness.md): no dynamic figure.
+  second (real-time factor of quasistatic sequences);
+- a dynamic run (generalized-α, default damping and Newton tolerance) of 1 s at 1 ms steps
+  through the PSD motion: real-time factor (simulated time / solver wall time; target ≥ 10×)
+  and of the whole simulate() call, harness and single cable alternated.
 One core: OpenBLAS held to one thread.
 Run: python benchmarks/bench_harness.py [--repeat K]
 """
@@ -118,19 +120,21 @@ def single(mode: str, duration: float) -> dict:
     return sc
 
 
-def timed(sc, repeat: int) -> tuple[float, float, float]:
-    """Medians of the solver wall time, the whole simulate() call and the mean Newton
-    iterations per step after the first."""
-    solver, whole, iters = [], [], []
+def timed(sc, repeat: int) -> tuple[float, float, float, float]:
+    """Medians of the solver wall time, the whole simulate() call, the mean Newton
+    iterations per step after the first and the CPU time of the simulate() call (one
+    thread: the time on one core, whatever the machine's load)."""
+    solver, whole, iters, cpu = [], [], [], []
     for _ in range(repeat):
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         res = simulate(sc)
         whole.append(time.perf_counter() - t0)
+        cpu.append(time.process_time() - c0)
         s = next(iter(res.cables.values())).solver
         solver.append(s["wall_time"])
         it = s["iterations"]
         iters.append(float(it[1:].mean()) if it.size > 1 else float(it[0]))
-    return statistics.median(solver), statistics.median(whole), statistics.median(iters)
+    return tuple(statistics.median(v) for v in (solver, whole, iters, cpu))
 
 
 def main() -> None:
@@ -151,7 +155,20 @@ def main() -> None:
     print(f"{'quasistatic 1 s @ 1 ms: solver [s]':<34} {hq[0]:>12.3f} {sq[0]:>14.3f}")
     print(f"{'  × real time':<34} {1 / hq[0]:>12.2f} {1 / sq[0]:>14.2f}")
     print(f"{'  Newton iterations per step':<34} {hq[2]:>12.2f} {sq[2]:>14.2f}")
-    print("dynamic: not implemented for harnesses yet (docs/harness.md)")
+    hd_scene = scene_from_dict(scene("dynamic", 1.0))
+    sd_scene = scene_from_dict(single("dynamic", 1.0))
+    hd, sd = [], []
+    for _ in range(k):  # alternated: the machine's load affects both alike
+        hd.append(timed(hd_scene, 1))
+        sd.append(timed(sd_scene, 1))
+    med = lambda runs, i: statistics.median(r[i] for r in runs)  # noqa: E731
+    print(f"{'dynamic 1 s @ 1 ms: solver [s]':<34} {med(hd, 0):>12.3f} {med(sd, 0):>14.3f}")
+    print(f"{'  × real time (solver)':<34} {1 / med(hd, 0):>12.2f} {1 / med(sd, 0):>14.2f}")
+    whole = (1 / med(hd, 1), 1 / med(sd, 1))
+    print(f"{'  × real time (whole simulate())':<34} {whole[0]:>12.2f} {whole[1]:>14.2f}")
+    cpu = (1 / med(hd, 3), 1 / med(sd, 3))
+    print(f"{'  × real time (simulate() CPU)':<34} {cpu[0]:>12.2f} {cpu[1]:>14.2f}")
+    print(f"{'  Newton iterations per step':<34} {med(hd, 2):>12.2f} {med(sd, 2):>14.2f}")
 
 
 if __name__ == "__main__":

@@ -159,6 +159,30 @@ class Harness:
         ValueError.
         """
         ...
+    def run_dynamic(
+        self,
+        time_step,
+        kinematics,
+        output_every,
+        tau_shear,
+        tau_bend,
+        spectral_radius=0.9,
+        newton_tolerance=...,
+        progress=None,
+        progress_every=100,
+        stop=None,
+    ) -> Any:
+        """Dynamic run (generalized-α on the harness): static equilibrium at the clip poses of
+        step 0, then steps of `time_step` through each cable's clip kinematics `kinematics[c]`
+        = (positions, quaternions, velocities, angular velocities, accelerations, angular
+        accelerations), (T, C_c, ·) global (the entries of joined ends are ignored). Every
+        `output_every`-th step is recorded (and step 0). τ per cable: `tau_shear[c]`,
+        `tau_bend[c]` (3 each). Returns what `run_sequence` returns, the cables' dicts with the
+        energies of `Cable.run_dynamic`, and `junction_velocities` (T, J, 6: ẋ global, ω body),
+        `kinetic_energy`, `elastic_energy`, `load_potential`, `dissipated_energy` (T,) of the
+        whole harness (junctions included).
+        """
+        ...
 
 INTERRUPTED: str
 

@@ -2,9 +2,9 @@
 
 Each joined cable end gets a fixed point clip ("junction <name>") whose pose follows the
 junction; the Rust harness solver (``_core.Harness``) eliminates the cables onto the junctions
-and solves the junction tree. Static and quasistatic runs (each state checked for stability)
-and modal analysis (``cablelife.modal.harness_modes``); dynamic analysis of harnesses is not
-supported yet (a clear error).
+and solves the junction tree. Static and quasistatic runs (each state checked for stability),
+dynamic runs (generalized-α on the whole harness) and modal analysis
+(``cablelife.modal.harness_modes``).
 """
 
 from __future__ import annotations
@@ -146,6 +146,20 @@ def harness_equilibrium(scene: Scene):
     from cablelife.scene import SceneError
     from cablelife.simulate import body_motions, build_cable, clip_kinematics
 
+    if mode == "dynamic":
+        held = [j.name for j in scene.junctions if j.clip is not None]
+        sliding = [(c.name, k.name) for c in scene.cables for k in c.clips if k.type == "sliding"]
+        if held:
+            raise SceneError(
+                f"junction '{held[0]}' is held by a clip: dynamic analysis of harnesses with "
+                "held junctions is not supported yet; allowed: static and quasistatic"
+            )
+        if sliding:
+            raise SceneError(
+                f"cable '{sliding[0][0]}': sliding clip '{sliding[0][1]}' on a harness: dynamic "
+                "analysis of harnesses with sliding clips is not supported yet; allowed: static "
+                "and quasistatic, or a fixed/hinge clip there"
+            )
     cables, specs = harness_cables(scene)
     cores = [build_cable(scene, c) for c in cables]
     times = np.array([0.0])
@@ -164,16 +178,22 @@ def harness_equilibrium(scene: Scene):
 
 
 def run_harness(scene: Scene, times: np.ndarray, mode: str, progress, stop):
-    """Runs a harness scene (static or quasistatic). Returns the cable results (by name), the
-    junction results (by name) and the error message (None: complete)."""
+    """Runs a harness scene (static, quasistatic or dynamic). Returns the cable results (by
+    name), the junction results (by name) and the error message (None: complete)."""
     from cablelife import _core
     from cablelife.scene import SceneError
-    from cablelife.simulate import _stability_info, body_motions, build_cable, clip_kinematics
+    from cablelife.simulate import (
+        _stability_info,
+        body_motions,
+        build_cable,
+        clip_kinematics,
+        output_every,
+    )
 
-    if mode not in ("static", "quasistatic"):
+    if mode not in ("static", "quasistatic", "dynamic"):
         raise SceneError(
             f"mode = {mode!r}: {mode} analysis of harnesses (scenes with [[junctions]]) is not "
-            "supported yet; allowed for harnesses: 'static', 'quasistatic'"
+            "supported yet; allowed for harnesses: 'static', 'quasistatic', 'dynamic'"
         )
     if scene.contact is not None:
         raise SceneError(
@@ -196,17 +216,49 @@ def run_harness(scene: Scene, times: np.ndarray, mode: str, progress, stop):
     kin = [clip_kinematics(scene, c, times, motions=motions) for c in cables]
     poses = [(k["positions"], k["quaternions"]) for k in kin]
     callback = (lambda k, n: progress("harness", k, n)) if progress else None
-    start = _time.perf_counter()
-    out = core.run_sequence(
-        [p for p, _ in poses],
-        [q for _, q in poses],
-        callback,
-        max(1, times.size // 100),
-        stop=stop,
-    )
+    extra: dict = {}
+    if mode == "dynamic":
+        from cablelife.modal import retardation_times
+
+        every = output_every(scene)
+        # Default damping from each cable's first mode with its joined ends clamped (the
+        # modes of the harness as one are harness-modal's; docs/harness.md).
+        alone = scene.model_copy(update={"junctions": []})
+        taus = [retardation_times(alone, c) for c in cables]
+        names = ("positions", "quaternions", "velocities", "angular_velocities")
+        names += ("accelerations", "angular_accelerations")
+        start = _time.perf_counter()
+        out = core.run_dynamic(
+            scene.simulation.time_step,
+            [tuple(k[m] for m in names) for k in kin],
+            every,
+            [t[0] for t in taus],
+            [t[1] for t in taus],
+            scene.simulation.spectral_radius,
+            scene.simulation.newton_tolerance,
+            callback,
+            max(1, times.size // 200),
+            stop=stop,
+        )
+        saved_all = times[::every]
+        extra = dict(
+            spectral_radius=scene.simulation.spectral_radius,
+            newton_tolerance=scene.simulation.newton_tolerance,
+            time_step=scene.simulation.time_step,
+        )
+    else:
+        start = _time.perf_counter()
+        out = core.run_sequence(
+            [p for p, _ in poses],
+            [q for _, q in poses],
+            callback,
+            max(1, times.size // 100),
+            stop=stop,
+        )
+        saved_all = times
     wall = _time.perf_counter() - start
     n = int(out["steps"])
-    saved = times[:n]
+    saved = saved_all[:n]
     simulated = float(saved[-1] - saved[0]) if n > 1 else 0.0
     results: dict[str, CableResult] = {}
     for k, (c, co, o) in enumerate(zip(cables, cores, out["cables"], strict=True)):
@@ -230,7 +282,22 @@ def run_harness(scene: Scene, times: np.ndarray, mode: str, progress, stop):
             real_time_factor=wall / simulated if simulated > 0 else float("nan"),
             error=out["error"] or "",
             harness=1,
+            **extra,
         )
+        energies = {"elastic_energy": o["elastic_energy"]}
+        if mode == "dynamic":
+            tau_shear, tau_bend, info = taus[k]
+            solver.update(
+                tau_shear=np.array(tau_shear),
+                tau_bend=np.array(tau_bend),
+                damping_source=info["source"],
+                viscous_peak=np.asarray(o["viscous_peak"]),
+            )
+            energies.update(
+                kinetic_energy=o["kinetic_energy"],
+                dissipated_energy=o["dissipated_energy"],
+                load_potential=o["load_potential"],
+            )
         solver.update(_stability_info(o, saved, co.arc_length, c.name))
         results[c.name] = CableResult(
             name=c.name,
@@ -243,7 +310,7 @@ def run_harness(scene: Scene, times: np.ndarray, mode: str, progress, stop):
             clips=clips,
             section=c.properties().as_attrs(),
             solver=solver,
-            energies={"elastic_energy": o["elastic_energy"]},
+            energies=energies,
         )
     junctions: dict[str, JunctionResult] = {}
     ends = core.ends

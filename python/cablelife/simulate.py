@@ -482,7 +482,7 @@ def _simulate_harness(scene: Scene, mode: str, times: np.ndarray, env, progress)
         junctions=junctions,
     )
     if env is not None:
-        add_clearance(env, scene, result, times, 1)
+        add_clearance(env, scene, result, times, output_every(scene) if mode == "dynamic" else 1)
     if errors:
         raise SimulationError(result.message, result)
     return result

@@ -85,7 +85,7 @@ pub(crate) struct Record {
 
 impl Record {
     /// A record with room for `n` saved steps (no reallocation while recording).
-    fn with_capacity(n: usize, rod: &Rod) -> Record {
+    pub(crate) fn with_capacity(n: usize, rod: &Rod) -> Record {
         let (nodes, edges, clips) = (rod.arc.len(), rod.n_edges(), rod.spec.clips.len());
         Record {
             steps: 0,
@@ -186,7 +186,7 @@ impl Record {
     }
 
     /// Updates the peaks of the viscous section loads (dynamic runs).
-    fn push_viscous(&mut self, ws: &Workspace) {
+    pub(crate) fn push_viscous(&mut self, ws: &Workspace) {
         let p = &mut self.viscous_peak;
         for f in &ws.edge_force_viscous {
             p[0] = p[0].max(f.z.abs());
@@ -198,7 +198,7 @@ impl Record {
         }
     }
 
-    fn push_energies(&mut self, e: &rod::Energies) {
+    pub(crate) fn push_energies(&mut self, e: &rod::Energies) {
         self.kinetic_energy.push(e.kinetic);
         self.dissipated_energy.push(e.dissipated);
     }

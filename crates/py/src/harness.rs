@@ -2,14 +2,16 @@
 //! quasistatic sequences. Runs release the GIL, poll Ctrl-C and report progress like `Cable`.
 use crate::cable::{read_poses, vec3, Cable, Record};
 use crate::stop::{Poller, StopFlag};
+use nalgebra::Vector3;
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray3};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use rod::harness::{Harness as Tree, HarnessState, HarnessStatics, JunctionSpec};
 use rod::harness_modal::{harness_lowest_modes, ModalSystem};
+use rod::harness_dynamics::HarnessDynamics;
 use rod::routing::route;
-use rod::{NewtonOptions, Pose};
+use rod::{ClipMotion, DynamicOptions, NewtonOptions, Pose};
 
 /// (name, mass, rotary inertia [3], ends as (cable index, clip index)).
 type JunctionTuple = (String, f64, Vec<f64>, Vec<(usize, usize)>);
@@ -362,6 +364,290 @@ impl Harness {
             "kind",
             modes.iter().map(|m| m.kind.name()).collect::<Vec<_>>(),
         )?;
+        Ok(d)
+    }
+
+    /// Dynamic run (generalized-α on the harness): static equilibrium at the clip poses of
+    /// step 0, then steps of `time_step` through each cable's clip kinematics `kinematics[c]`
+    /// = (positions, quaternions, velocities, angular velocities, accelerations, angular
+    /// accelerations), (T, C_c, ·) global (the entries of joined ends are ignored). Every
+    /// `output_every`-th step is recorded (and step 0). τ per cable: `tau_shear[c]`,
+    /// `tau_bend[c]` (3 each). Returns what `run_sequence` returns, the cables' dicts with the
+    /// energies of `Cable.run_dynamic`, and `junction_velocities` (T, J, 6: ẋ global, ω body),
+    /// `kinetic_energy`, `elastic_energy`, `load_potential`, `dissipated_energy` (T,) of the
+    /// whole harness (junctions included).
+    #[pyo3(signature = (time_step, kinematics, output_every, tau_shear, tau_bend,
+        spectral_radius=0.9, newton_tolerance=DynamicOptions::default().tolerance, progress=None,
+        progress_every=100, stop=None))]
+    #[allow(clippy::too_many_arguments, clippy::type_complexity)]
+    fn run_dynamic<'py>(
+        &mut self,
+        py: Python<'py>,
+        time_step: f64,
+        kinematics: Vec<(
+            PyReadonlyArray3<'py, f64>,
+            PyReadonlyArray3<'py, f64>,
+            PyReadonlyArray3<'py, f64>,
+            PyReadonlyArray3<'py, f64>,
+            PyReadonlyArray3<'py, f64>,
+            PyReadonlyArray3<'py, f64>,
+        )>,
+        output_every: usize,
+        tau_shear: Vec<Vec<f64>>,
+        tau_bend: Vec<Vec<f64>>,
+        spectral_radius: f64,
+        newton_tolerance: f64,
+        progress: Option<Py<PyAny>>,
+        progress_every: usize,
+        stop: Option<Bound<'py, StopFlag>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        if !(newton_tolerance > 0.0 && newton_tolerance < 1.0) {
+            return Err(PyValueError::new_err(format!(
+                "newton_tolerance = {newton_tolerance}: allowed is 0 < tolerance < 1"
+            )));
+        }
+        if !(time_step.is_finite() && time_step > 0.0) {
+            return Err(PyValueError::new_err(format!(
+                "time_step = {time_step}: must be > 0 s"
+            )));
+        }
+        if !(0.0..=1.0).contains(&spectral_radius) {
+            return Err(PyValueError::new_err(format!(
+                "spectral_radius = {spectral_radius}: allowed is 0 ≤ ρ∞ ≤ 1"
+            )));
+        }
+        let nc = self.tree.cables.len();
+        if kinematics.len() != nc || tau_shear.len() != nc || tau_bend.len() != nc {
+            return Err(PyValueError::new_err(format!(
+                "clip kinematics and retardation times of {nc} cables expected; got {}, {} and {}",
+                kinematics.len(),
+                tau_shear.len(),
+                tau_bend.len()
+            )));
+        }
+        let mut taus = Vec::with_capacity(nc);
+        for (c, (ts, tb)) in tau_shear.iter().zip(&tau_bend).enumerate() {
+            let name = &self.tree.names[c];
+            taus.push((
+                vec3(ts, &format!("cable '{name}' tau_shear"))?,
+                vec3(tb, &format!("cable '{name}' tau_bend"))?,
+            ));
+        }
+        // motions[t][c][clip]
+        let mut steps = None;
+        let mut per_cable: Vec<Vec<Vec<ClipMotion>>> = Vec::with_capacity(nc);
+        for (c, (p, q, v, w, a, aw)) in kinematics.iter().enumerate() {
+            let n_clips = self.tree.cables[c].spec.clips.len();
+            let (pa, qa) = (p.as_array(), q.as_array());
+            let arrays = [v.as_array(), w.as_array(), a.as_array(), aw.as_array()];
+            let t = pa.dim().0;
+            if pa.dim() != (t, n_clips, 3)
+                || qa.dim() != (t, n_clips, 4)
+                || arrays.iter().any(|x| x.dim() != (t, n_clips, 3))
+            {
+                return Err(PyValueError::new_err(format!(
+                    "cable '{}': clip kinematics must be (T, {n_clips}, 3), quaternions (T, \
+                     {n_clips}, 4)",
+                    self.tree.names[c]
+                )));
+            }
+            if *steps.get_or_insert(t) != t {
+                return Err(PyValueError::new_err(
+                    "clip kinematics of all cables must have the same number of steps",
+                ));
+            }
+            let poses = read_poses(&pa, &qa)?;
+            let at = |x: &numpy::ndarray::ArrayView3<f64>, k: usize, j: usize| {
+                Vector3::new(x[[k, j, 0]], x[[k, j, 1]], x[[k, j, 2]])
+            };
+            per_cable.push(
+                (0..t)
+                    .map(|k| {
+                        (0..n_clips)
+                            .map(|j| ClipMotion {
+                                pose: poses[k][j],
+                                velocity: at(&arrays[0], k, j),
+                                angular_velocity: at(&arrays[1], k, j),
+                                acceleration: at(&arrays[2], k, j),
+                                angular_acceleration: at(&arrays[3], k, j),
+                            })
+                            .collect()
+                    })
+                    .collect(),
+            );
+        }
+        let t = steps.unwrap_or(0);
+        let motions: Vec<Vec<Vec<ClipMotion>>> = (0..t)
+            .map(|k| per_cable.iter().map(|m| m[k].clone()).collect())
+            .collect();
+        drop(per_cable);
+        let tree = &self.tree;
+        let mut initial = HarnessState {
+            cables: Vec::with_capacity(nc),
+            junctions: tree.reference.clone(),
+        };
+        for (c, rod) in tree.cables.iter().enumerate() {
+            let first: Option<Vec<Pose>> =
+                (t > 0).then(|| motions[0][c].iter().map(|m| m.pose).collect());
+            initial
+                .cables
+                .push(route(rod, first.as_deref()).map_err(|e| {
+                    PyValueError::new_err(format!("cable '{}': {}", tree.names[c], e.0))
+                })?);
+        }
+        let opts = DynamicOptions {
+            rho_inf: spectral_radius,
+            tolerance: newton_tolerance,
+            outputs_every_step: false,
+            ..Default::default()
+        };
+        let solver = &mut self.solver;
+        let every = output_every.max(1);
+        let mut poller = Poller::new(stop.as_ref(), progress, progress_every, t);
+        let (nj, ne) = (tree.junctions.len(), tree.ends.len());
+        struct Out {
+            records: Vec<Record>,
+            jpos: Vec<f64>,
+            jquat: Vec<f64>,
+            jvel: Vec<f64>,
+            force: Vec<f64>,
+            moment: Vec<f64>,
+            energies: [Vec<f64>; 4],
+            iterations: Vec<i64>,
+            substeps: Vec<i64>,
+            residual: Vec<f64>,
+            steps: usize,
+        }
+        let (out, error) = py.detach(move || {
+            let saved = t.saturating_sub(1) / every + 1;
+            let mut out = Out {
+                records: tree
+                    .cables
+                    .iter()
+                    .map(|r| Record::with_capacity(saved, r))
+                    .collect(),
+                jpos: Vec::with_capacity(saved * nj * 3),
+                jquat: Vec::with_capacity(saved * nj * 4),
+                jvel: Vec::with_capacity(saved * nj * 6),
+                force: Vec::with_capacity(saved * ne * 3),
+                moment: Vec::with_capacity(saved * ne * 3),
+                energies: std::array::from_fn(|_| Vec::with_capacity(saved)),
+                iterations: Vec::with_capacity(saved),
+                substeps: Vec::with_capacity(saved),
+                residual: Vec::with_capacity(saved),
+                steps: 0,
+            };
+            if t == 0 {
+                return (out, None);
+            }
+            let mut st = initial;
+            let poses: Vec<Vec<Pose>> = motions[0]
+                .iter()
+                .map(|m| m.iter().map(|x| x.pose).collect())
+                .collect();
+            st.set_clip_poses(tree, &poses);
+            let stats = match solver.solve_static(tree, &mut st) {
+                Ok(s) => s,
+                Err(e) => return (out, Some(format!("static equilibrium at t = 0: {e}"))),
+            };
+            let mut hd = HarnessDynamics::new(tree, &st, &motions[0], opts);
+            for (c, (ts, tb)) in taus.iter().enumerate() {
+                hd.set_retardation_times(tree, c, *ts, *tb);
+            }
+            if let Err(e) = hd.start(tree, &mut st) {
+                return (out, Some(format!("start: {e}")));
+            }
+            let record =
+                |out: &mut Out, hd: &HarnessDynamics, st: &HarnessState, s: &rod::SolveStats| {
+                    for (c, rod) in tree.cables.iter().enumerate() {
+                        let dy = &hd.cables[c];
+                        let rec = &mut out.records[c];
+                        rec.push(rod, &st.cables[c], &dy.ws, s);
+                        rec.push_sliding(rod, None);
+                        rec.push_viscous(&dy.ws);
+                        rec.push_energies(&dy.energies);
+                    }
+                    for (pose, v) in st.junctions.iter().zip(hd.junction_velocities()) {
+                        out.jpos.extend_from_slice(pose.position.as_slice());
+                        let q = pose.orientation;
+                        out.jquat.extend_from_slice(&[q.w, q.i, q.j, q.k]);
+                        out.jvel.extend_from_slice(v.as_slice());
+                    }
+                    for (f, m) in hd.branch_loads(tree, st) {
+                        out.force.extend_from_slice(f.as_slice());
+                        out.moment.extend_from_slice(m.as_slice());
+                    }
+                    let e = &hd.energies;
+                    for (v, x) in out.energies.iter_mut().zip([
+                        e.kinetic,
+                        e.elastic,
+                        e.load_potential,
+                        e.dissipated,
+                    ]) {
+                        v.push(x);
+                    }
+                    out.iterations.push(s.iterations as i64);
+                    out.substeps.push(s.substeps as i64);
+                    out.residual.push(s.residual);
+                    out.steps += 1;
+                };
+            record(&mut out, &hd, &st, &stats);
+            for k in 1..t {
+                match hd.advance(tree, &mut st, time_step, &motions[k - 1], &motions[k], 6) {
+                    Ok(s) => {
+                        if k % every == 0 {
+                            if let Err(e) = hd.update_outputs(tree, &st) {
+                                return (out, Some(format!("step {k}: {e}")));
+                            }
+                            let stats = rod::SolveStats {
+                                iterations: s.iterations,
+                                residual: s.residual,
+                                substeps: s.substeps - 1,
+                                ..Default::default()
+                            };
+                            record(&mut out, &hd, &st, &stats);
+                        }
+                    }
+                    Err(e) => {
+                        return (
+                            out,
+                            Some(format!("step {k} (t = {:.6} s): {e}", k as f64 * time_step)),
+                        )
+                    }
+                }
+                if let Some(why) = poller.poll(k + 1) {
+                    return (out, Some(why));
+                }
+            }
+            (out, None)
+        });
+        let d = PyDict::new(py);
+        let cables = PyList::empty(py);
+        for (c, rec) in out.records.into_iter().enumerate() {
+            let rod = &self.tree.cables[c];
+            let cd = rec.into_dict(py, rod.arc.len(), rod.spec.clips.len())?;
+            cd.set_item("error", error.clone())?;
+            cables.append(cd)?;
+        }
+        let n = out.steps;
+        let shaped =
+            |v: Vec<f64>, shape: &[usize]| PyArray1::from_vec(py, v).reshape(shape.to_vec());
+        d.set_item("cables", cables)?;
+        d.set_item("junction_positions", shaped(out.jpos, &[n, nj, 3])?)?;
+        d.set_item("junction_quaternions", shaped(out.jquat, &[n, nj, 4])?)?;
+        d.set_item("junction_velocities", shaped(out.jvel, &[n, nj, 6])?)?;
+        d.set_item("branch_force", shaped(out.force, &[n, ne, 3])?)?;
+        d.set_item("branch_moment", shaped(out.moment, &[n, ne, 3])?)?;
+        let [kin, ela, pot, dis] = out.energies;
+        d.set_item("kinetic_energy", PyArray1::from_vec(py, kin))?;
+        d.set_item("elastic_energy", PyArray1::from_vec(py, ela))?;
+        d.set_item("load_potential", PyArray1::from_vec(py, pot))?;
+        d.set_item("dissipated_energy", PyArray1::from_vec(py, dis))?;
+        d.set_item("iterations", PyArray1::from_vec(py, out.iterations))?;
+        d.set_item("substeps", PyArray1::from_vec(py, out.substeps))?;
+        d.set_item("residual", PyArray1::from_vec(py, out.residual))?;
+        d.set_item("steps", n)?;
+        d.set_item("error", error)?;
         Ok(d)
     }
 }

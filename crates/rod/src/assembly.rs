@@ -140,7 +140,7 @@ impl Rates {
     /// J_r of a rotation's step (free edges only: the swivel twists and hinge angles are moved by
     /// the Newton update directly).
     #[inline]
-    fn tangent_of(&self, r: RotRef, rod: &Rod) -> Option<Matrix3<f64>> {
+    pub(crate) fn tangent_of(&self, r: RotRef, rod: &Rod) -> Option<Matrix3<f64>> {
         match r {
             RotRef::Edge(e) if !self.tangent.is_empty() && rod.edge_kind[e] == EdgeKind::Free => {
                 Some(self.tangent[e])
@@ -149,7 +149,7 @@ impl Rates {
         }
     }
 
-    fn omega(&self, r: RotRef) -> Vector3<f64> {
+    pub(crate) fn omega(&self, r: RotRef) -> Vector3<f64> {
         match r {
             RotRef::Edge(e) => self.v[e].fixed_rows::<3>(3).into(),
             RotRef::Ghost(g) => self.ghost_omega[g],

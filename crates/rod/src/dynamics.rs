@@ -208,10 +208,10 @@ pub struct Dynamics {
     pub contact: Option<Contact>,
     /// The sliding clips' term (None without sliding clips).
     pub sliding: Option<SlidingClips>,
-    ga: GenAlpha,
-    rates: Rates,
-    vdot: Vec<Vector6<f64>>,
-    a: Vec<Vector6<f64>>,
+    pub(crate) ga: GenAlpha,
+    pub(crate) rates: Rates,
+    pub(crate) vdot: Vec<Vector6<f64>>,
+    pub(crate) a: Vec<Vector6<f64>>,
     // Values at t_n.
     x_n: Vec<Vector3<f64>>,
     p_n: Vec<Quat>,
@@ -220,18 +220,18 @@ pub struct Dynamics {
     v_n: Vec<Vector6<f64>>,
     vdot_n: Vec<Vector6<f64>>,
     a_n: Vec<Vector6<f64>>,
-    delta: Vec<Vector6<f64>>,
+    pub(crate) delta: Vec<Vector6<f64>>,
     /// Slots with inertia (free nodes, free edges).
-    inertial: Vec<[bool; 6]>,
+    pub(crate) inertial: Vec<[bool; 6]>,
     /// Per block: whether the node and the edge have inertia.
     inertial_half: Vec<[bool; 2]>,
     /// Δq = dq0 + k_dq v̇, v = v0 + k_v v̇, a = a0 + k_a v̇ during a step.
     dq0: Vec<Vector6<f64>>,
     v0: Vec<Vector6<f64>>,
     a0: Vec<Vector6<f64>>,
-    k_dq: f64,
-    k_v: f64,
-    k_a: f64,
+    pub(crate) k_dq: f64,
+    pub(crate) k_v: f64,
+    pub(crate) k_a: f64,
     /// The step size of the current step.
     h: f64,
     edge_inertia: Vec<Vector3<f64>>,
@@ -252,7 +252,7 @@ pub struct Dynamics {
     outputs_current: bool,
     /// An obstacle moved in the last step (its work is not accounted: no energy check).
     obstacles_moved: bool,
-    power_n: f64,
+    pub(crate) power_n: f64,
     poses: Vec<Pose>,
     length: f64,
 }
@@ -369,7 +369,7 @@ impl Dynamics {
     }
 
     /// Assembles the residual (and the iteration matrix) of a part at the current iterate.
-    fn assemble(
+    pub(crate) fn assemble(
         &mut self,
         rod: &Rod,
         st: &State,
@@ -439,14 +439,10 @@ impl Dynamics {
         Ok(())
     }
 
-    /// Advances from t_n to t_n + h with the clips at their kinematics at t_{n+1}.
-    pub fn step(
-        &mut self,
-        rod: &Rod,
-        st: &mut State,
-        h: f64,
-        clips: &[ClipMotion],
-    ) -> Result<StepStats, SolveError> {
+    /// The start of a step from t_n to t_n + h (shared with the harness integrator): saves the
+    /// values at t_n, sets the clips to their kinematics at t_{n+1}, the predictor and the
+    /// fixed parts of the kinematics.
+    pub(crate) fn begin_step(&mut self, rod: &Rod, st: &mut State, h: f64, clips: &[ClipMotion]) {
         let ga = self.ga;
         // Values at t_n.
         self.x_n.clone_from(&st.x);
@@ -499,6 +495,17 @@ impl Dynamics {
             }
         }
         self.begin_kinematics(h);
+    }
+
+    /// Advances from t_n to t_n + h with the clips at their kinematics at t_{n+1}.
+    pub fn step(
+        &mut self,
+        rod: &Rod,
+        st: &mut State,
+        h: f64,
+        clips: &[ClipMotion],
+    ) -> Result<StepStats, SolveError> {
+        self.begin_step(rod, st, h, clips);
         for (k, seg) in rod.segments.iter().enumerate() {
             let clips_still = seg.clips.iter().all(|&c| self.clip_still[c]);
             self.resting[k] &= clips_still;
@@ -770,7 +777,7 @@ impl Dynamics {
     }
 
     /// Returns to the values at the start of the last (failed) step.
-    fn rollback(&mut self, st: &mut State) {
+    pub(crate) fn rollback(&mut self, st: &mut State) {
         st.x.clone_from(&self.x_n);
         st.p.clone_from(&self.p_n);
         st.ghost.clone_from(&self.ghost_n);
@@ -866,7 +873,7 @@ impl Dynamics {
 
     /// The parts of Δq, v_{n+1} and a_{n+1} fixed during a step (from the values at t_n): all
     /// three are then affine in v̇_{n+1}. Call once the values at t_n are set.
-    fn begin_kinematics(&mut self, h: f64) {
+    pub(crate) fn begin_kinematics(&mut self, h: f64) {
         let ga = self.ga;
         let ka = (1.0 - ga.alpha_f) / (1.0 - ga.alpha_m);
         let (c_vn, c_an) = (
@@ -888,7 +895,12 @@ impl Dynamics {
 
     /// v and q_{n+1} of the inertial unknowns of blocks `r` from the current v̇_{n+1}; returns
     /// their largest increment h|Δq| (positions relative to the cable length).
-    fn update_kinematics(&mut self, st: &mut State, h: f64, r: std::ops::Range<usize>) -> f64 {
+    pub(crate) fn update_kinematics(
+        &mut self,
+        st: &mut State,
+        h: f64,
+        r: std::ops::Range<usize>,
+    ) -> f64 {
         let mut dx_max = 0.0f64;
         let mut dth_max = 0.0f64;
         let (k_dq, k_v) = (self.k_dq, self.k_v);
@@ -920,7 +932,7 @@ impl Dynamics {
     /// Applies the Newton correction `delta` of a segment (v̇ += c_m δq on inertial slots, the
     /// swivel twists directly) and updates v and q_{n+1} there; returns the segment's largest
     /// increment h|Δq| (as `update_kinematics`).
-    fn apply_correction(
+    pub(crate) fn apply_correction(
         &mut self,
         rod: &Rod,
         st: &mut State,
@@ -985,7 +997,7 @@ impl Dynamics {
     /// The estimated local time-discretisation error of blocks `r` at the current v̇_{n+1}:
     /// |β − 1/6| h² |v̇_{n+1} − v̇_n| (max over the inertial slots; positions relative to the
     /// cable length, as the Newton corrections).
-    fn local_error(&self, r: std::ops::Range<usize>) -> f64 {
+    pub(crate) fn local_error(&self, r: std::ops::Range<usize>) -> f64 {
         let (mut dx, mut dth) = (0.0f64, 0.0f64);
         for ((half, vd), vd_n) in self.inertial_half[r.clone()]
             .iter()
@@ -1004,7 +1016,7 @@ impl Dynamics {
     }
 
     /// a_{n+1} of the inertial unknowns from the current v̇_{n+1}.
-    fn update_accelerations(&mut self) {
+    pub(crate) fn update_accelerations(&mut self) {
         for b in 0..self.vdot.len() {
             let a = self.a0[b] + self.k_a * self.vdot[b];
             for k in 0..6 {

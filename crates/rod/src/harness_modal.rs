@@ -15,7 +15,7 @@ use crate::harness::{Harness, HarnessError, HarnessState};
 use crate::harness_solver::HarnessStatics;
 use crate::modal::{energy_shares, lowest_pairs, lumped_mass, ModalError, ModeKind, ShiftInvert};
 use crate::statics::NewtonOptions;
-use nalgebra::Vector6;
+use nalgebra::{Matrix6, Vector6};
 
 /// One natural mode of a harness, mass-normalised over the whole harness (φᵀ M φ = 1).
 #[derive(Clone, Debug)]
@@ -81,7 +81,6 @@ impl ModalSystem {
             .map(|r| vec![Vector6::zeros(); r.arc.len()])
             .collect();
         let xj = vec![Vector6::zeros(); h.junctions.len()];
-        work.junction_diag = xj.clone();
         ModalSystem {
             k,
             work,
@@ -184,8 +183,8 @@ impl ShiftInvert for HarnessPencil<'_> {
             }
         }
         let nc = self.s.offsets[self.s.xc.len()];
-        for (d, m) in self.s.work.junction_diag.iter_mut().zip(&self.s.m[nc..]) {
-            *d = -sigma * m;
+        for (d, m) in self.s.work.junction_extra.iter_mut().zip(&self.s.m[nc..]) {
+            *d = Matrix6::from_diagonal(&(-sigma * m));
         }
         self.s.work.factor(self.h).ok()?;
         (self.s.work.inertia.zero == 0).then_some(self.s.work.inertia.negative)

@@ -29,7 +29,7 @@ fn cols_to_junction(m: &Matrix6<f64>, r: &Matrix3<f64>) -> Matrix6<f64> {
 }
 
 #[inline]
-fn vec_to_junction(v: &Vector6<f64>, r: &Matrix3<f64>) -> Vector6<f64> {
+pub(crate) fn vec_to_junction(v: &Vector6<f64>, r: &Matrix3<f64>) -> Vector6<f64> {
     let mut out = *v;
     let low = r * v.fixed_rows::<3>(3);
     out.fixed_rows_mut::<3>(3).copy_from(&low);
@@ -54,10 +54,10 @@ pub struct HarnessStatics {
     /// Per cable: the sliding clips' term (None without sliding clips).
     pub sliding: Vec<Option<SlidingClips>>,
     pub opts: NewtonOptions,
-    delta: Vec<Vec<Vector6<f64>>>,
+    pub(crate) delta: Vec<Vec<Vector6<f64>>>,
     trial: Vec<Vec<Vector6<f64>>>,
     y: Vec<Vec<Vector6<f64>>>,
-    dj: Vec<Vector6<f64>>,
+    pub(crate) dj: Vec<Vector6<f64>>,
     trial_j: Vec<Vector6<f64>>,
     /// Junction residuals (∂V/∂(X, Θ)).
     pub junction_residual: Vec<Vector6<f64>>,
@@ -82,14 +82,15 @@ pub struct HarnessStatics {
     has_prev: bool,
     /// Pseudo-transient damping added to the junction pivots by `factor` (position, rotation).
     junction_shift: (f64, f64),
+    /// Further junction pivot blocks: the junctions' inertia in dynamics, −σ M_j in
+    /// `harness_modal`; zero in statics.
+    pub(crate) junction_extra: Vec<Matrix6<f64>>,
     force_scale: f64,
     /// With `symmetric`, `factor` uses the symmetric block LDLᵀ on the cables and records the
     /// inertia of the tree factorisation (Sylvester: the cables' chain pivots plus the junction
     /// pivots) in `inertia` — the stability check and the Sturm count of `harness_modal`.
     pub symmetric: bool,
     pub inertia: Inertia,
-    /// Per junction: a diagonal added to its pivot (−σ M_j in `harness_modal`; empty: none).
-    pub junction_diag: Vec<Vector6<f64>>,
     /// Length scales: the shortest cable (steps) and the finest mean segment (moments).
     length: f64,
     h: f64,
@@ -151,10 +152,10 @@ impl HarnessStatics {
             prev: HarnessState::empty(),
             has_prev: false,
             junction_shift: (0.0, 0.0),
+            junction_extra: vec![Matrix6::zeros(); nj],
             force_scale,
             symmetric: false,
             inertia: Inertia::default(),
-            junction_diag: Vec::new(),
             length,
             h: hmin,
         }
@@ -270,10 +271,7 @@ impl HarnessStatics {
                     self.junction_shift.1
                 };
             }
-            if let Some(extra) = self.junction_diag.get(j) {
-                d += Matrix6::from_diagonal(extra);
-            }
-            self.pivot[j] = d;
+            self.pivot[j] = d + self.junction_extra[j];
         }
         self.link_ab.iter_mut().for_each(|m| m.fill(0.0));
         self.link_ba.iter_mut().for_each(|m| m.fill(0.0));
@@ -368,7 +366,7 @@ impl HarnessStatics {
 
     /// Solves J Δ = −r with the factorisation for the cable residuals `rc` (block vectors, as
     /// `ws.rhs`) and junction residuals `rj`; returns the largest |Δx| and |θ|.
-    fn solve(&mut self, h: &Harness, use_trial: bool) -> (f64, f64) {
+    pub(crate) fn solve(&mut self, h: &Harness, use_trial: bool) -> (f64, f64) {
         for (c, rod) in h.cables.iter().enumerate() {
             let y = &mut self.y[c];
             y.copy_from_slice(&self.ws[c].rhs);

@@ -5,11 +5,11 @@
 //! unknowns (Δx_n, φ of the ghost, body frame) that a clip eliminates: the end–end block and
 //! the coupling blocks between the end and the cable blocks next to it. The harness maps them
 //! to the junction's unknowns and eliminates the cable onto the junction.
-use crate::assembly::{Eval, KinkAt, Term, Workspace};
-use crate::bending::BendKinematics;
+use crate::assembly::{Eval, KinkAt, Rates, Term, Workspace};
+use crate::bending::{BendKinematics, BendViscous};
 use crate::model::{EdgeKind, NodeKind, Rod, RotRef};
 use crate::rotation::{skew, Quat};
-use crate::shear::ShearKinematics;
+use crate::shear::{ShearKinematics, ShearViscous};
 use crate::state::State;
 use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 
@@ -112,6 +112,20 @@ impl EndBlocks {
     /// Computes the blocks at state `st` (static: no rates); the cable's elastic assembly must
     /// have run (the ghost gradient gives the rotation-group correction ½[g]×).
     pub fn compute(&mut self, rod: &Rod, st: &State, ws: &Workspace) -> Result<(), KinkAt> {
+        self.compute_with_rates(rod, st, ws, None)
+    }
+
+    /// `compute` with the Kelvin–Voigt damping of `rates` (dynamics: the viscous forces and
+    /// their derivatives, `rates.damping_factor` × those along the rates, the held end's
+    /// velocity and rotation rate included; derivatives along a free edge's rotation times its
+    /// step's J_r, as in the cable's own blocks).
+    pub fn compute_with_rates(
+        &mut self,
+        rod: &Rod,
+        st: &State,
+        ws: &Workspace,
+        rates: Option<&Rates>,
+    ) -> Result<(), KinkAt> {
         let t = self.topo;
         self.ee.fill(0.0);
         for m in self.ec.iter_mut().chain(self.ce.iter_mut()) {
@@ -128,8 +142,23 @@ impl EndBlocks {
             rod.ds_edge[e],
             &Vector3::zeros(),
         );
-        let f = sec.shear_stiffness.component_mul(&kin.strain);
-        let jb = kin.jacobian(&f, &sec.shear_stiffness, None);
+        let mut f = sec.shear_stiffness.component_mul(&kin.strain);
+        let viscous = rates.map(|r| {
+            let va: Vector3<f64> = r.v[e].fixed_rows::<3>(0).into();
+            let vb: Vector3<f64> = r.v[e + 1].fixed_rows::<3>(0).into();
+            let omega: Vector3<f64> = r.v[e].fixed_rows::<3>(3).into();
+            f += r.shear_damping.component_mul(&kin.rate(&va, &vb, &omega));
+            ShearViscous {
+                coeff: r.shear_damping,
+                factor: r.damping_factor,
+                rate_theta: rod.edge_kind[e] == EdgeKind::Free,
+                va,
+                vb,
+                omega,
+                tangent: r.tangent_of(RotRef::Edge(e), rod),
+            }
+        });
+        let jb = kin.jacobian(&f, &sec.shear_stiffness, viscous.as_ref());
         let (i_end, i_other, other) = if t.at_start { (0, 1, e + 1) } else { (1, 0, e) };
         {
             let mut v = self.ee.fixed_view_mut::<3, 3>(0, 0);
@@ -157,10 +186,30 @@ impl EndBlocks {
             node: bt.node,
             kink,
         })?;
-        let m = sec
+        let mut m = sec
             .bend_stiffness
             .component_mul(&(bk.curvature - rod.spec.natural_curvature));
-        let h = bk.jacobian(&m, &sec.bend_stiffness, None);
+        let viscous = rates.map(|r| {
+            let (omega_a, omega_b) = (r.omega(bt.a), r.omega(bt.b));
+            m += r.bend_damping.component_mul(&bk.rate(&omega_a, &omega_b));
+            // The held ghost turns with its junction: a rate too (its J_r is not tracked: the
+            // junction's rotation is moved from the right by the Newton update).
+            let tracked = |x: RotRef| match x {
+                RotRef::Ghost(_) => true,
+                RotRef::Edge(k) => rod.edge_kind[k] == EdgeKind::Free,
+            };
+            BendViscous {
+                coeff: r.bend_damping,
+                factor: r.damping_factor,
+                rate_a: tracked(bt.a),
+                rate_b: tracked(bt.b),
+                omega_a,
+                omega_b,
+                tangent_a: r.tangent_of(bt.a, rod),
+                tangent_b: r.tangent_of(bt.b, rod),
+            }
+        });
+        let h = bk.jacobian(&m, &sec.bend_stiffness, viscous.as_ref());
         let (ig, io) = if bt.a == RotRef::Ghost(t.ghost) {
             (0, 1)
         } else {
