@@ -74,7 +74,7 @@ impl Candidates {
         // a few steps of the last displacement, if small against the distance (the set grows
         // with distance × margin, the hierarchy's work with the distance alone)
         let margin = SKIN_STEPS * step;
-        let margin = if margin <= SKIN_OF_DISTANCE * self.distance {
+        let margin = if margin.is_finite() && margin <= SKIN_OF_DISTANCE * self.distance {
             margin
         } else {
             0.0
