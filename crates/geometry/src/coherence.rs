@@ -16,16 +16,26 @@
 //! `SKIN_OF_DISTANCE` of the distance, the query goes to the hierarchy (warm-started) and
 //! no set is kept. Measured on the clearance benchmark (docs/environment.md): nodes moving
 //! 0.04 % of their distance per step take a third of the time, at 0.2 % it is even, at 2 %
-//! (the benchmark's 60 Hz motion) every query goes to the hierarchy.
+//! (the benchmark's 60 Hz motion) every query goes to the hierarchy. Where many triangles
+//! are nearly equally far (near the axis of a ring, under a concave surface) a set is long
+//! even for a small margin: a set longer than `MAX_SET` halves the node's margin (in steps),
+//! below `MIN_SKIN` steps the hierarchy answers and the margin grows back slowly.
 use crate::{PointProjection, Surface, TriMesh, V3};
 
 /// The margin in steps of the last displacement.
 const SKIN_STEPS: f64 = 8.0;
+/// A set longer than this costs more to scan than the hierarchy: the margin is halved for
+/// the node's next set.
+const MAX_SET: usize = 96;
+/// Below this many steps of margin a set does not last: the hierarchy answers, and the
+/// margin grows back slowly (by `REGROW` per query) to try a set again.
+const MIN_SKIN: f64 = 2.0;
+const REGROW: f64 = 1.02;
 /// A set only where the margin is at most this fraction of the distance.
 const SKIN_OF_DISTANCE: f64 = 0.01;
 
 /// Candidate triangles of one query (a node, or its half-edges) on one mesh.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub struct Candidates {
     /// Positions when gathered (the start, then the ends) and their number (0: no set).
     at: [V3; 3],
@@ -36,15 +46,33 @@ pub struct Candidates {
     /// Distance found by the previous query.
     distance: f64,
     margin: f64,
+    /// The margin in steps of the last displacement (adapted to the set's length).
+    skin: f64,
     /// Number of sets gathered so far.
     gatherings: usize,
     /// (δ, triangle), sorted by δ.
     list: Vec<(f64, u32)>,
 }
 
+impl Default for Candidates {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
 impl Candidates {
     pub fn new() -> Self {
-        Self::default()
+        Candidates {
+            at: [V3::zeros(); 3],
+            n_at: 0,
+            last: [V3::zeros(); 3],
+            n_last: 0,
+            distance: 0.0,
+            margin: 0.0,
+            skin: SKIN_STEPS,
+            gatherings: 0,
+            list: Vec::new(),
+        }
     }
 
     /// Records the positions of this query. Returns the distance moved since the set was
@@ -73,7 +101,11 @@ impl Candidates {
         }
         // a few steps of the last displacement, if small against the distance (the set grows
         // with distance × margin, the hierarchy's work with the distance alone)
-        let margin = SKIN_STEPS * step;
+        if self.skin < MIN_SKIN {
+            self.skin = (self.skin * REGROW).min(SKIN_STEPS);
+            return (None, 0.0);
+        }
+        let margin = self.skin * step;
         let margin = if margin.is_finite() && margin <= SKIN_OF_DISTANCE * self.distance {
             margin
         } else {
@@ -87,6 +119,11 @@ impl Candidates {
         self.n_at = pos.len();
         self.margin = margin;
         self.gatherings += 1;
+        self.skin = if self.list.len() > MAX_SET {
+            0.5 * self.skin
+        } else {
+            (self.skin * 1.25).min(SKIN_STEPS)
+        };
     }
 
     /// Number of candidate sets gathered so far (the other queries were answered by a set or
