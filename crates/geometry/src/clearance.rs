@@ -138,7 +138,7 @@ fn step(
             let h = &mut hints[3 * (i * n_parts + k)];
             dist[k] = f64::INFINITY;
             let found = match &pt.shape {
-                Shape::Mesh(mesh) => Some(sets[i * n_parts + k].0.project_point(mesh, x, *h)),
+                Shape::Mesh(mesh) => sets[i * n_parts + k].0.project_point(mesh, x, *h),
                 shape => shape.project_point(x, f64::INFINITY, *h),
             };
             if let Some(r) = found {

@@ -139,7 +139,12 @@ impl Candidates {
 
     /// Signed distance of p to `mesh` as [`crate::Surface::project_point`] (no bound), from the
     /// set while it holds, else gathered again; `hint` warm-starts a new gathering.
-    pub fn project_point(&mut self, mesh: &TriMesh, p: &V3, hint: usize) -> PointProjection {
+    pub fn project_point(
+        &mut self,
+        mesh: &TriMesh,
+        p: &V3,
+        hint: usize,
+    ) -> Option<PointProjection> {
         let pos = [*p];
         let moved = match self.update(&pos) {
             (Some(m), _) => m,
@@ -150,19 +155,16 @@ impl Candidates {
             }
             (None, _) => {
                 self.n_at = 0;
-                let r = mesh
-                    .project_point(p, f64::INFINITY, hint)
-                    .expect("a mesh has a nearest triangle");
+                let r = mesh.project_point(p, f64::INFINITY, hint)?;
                 self.distance = r.distance.abs();
-                return r;
+                return Some(r);
             }
         };
-        let (t, c) = mesh
-            .nearest_triangle_among(p, &self.list, moved, f64::INFINITY)
-            .expect("a candidate set holds the nearest triangle");
+        // (a set holds the nearest triangle; empty only for a non-finite p)
+        let (t, c) = mesh.nearest_triangle_among(p, &self.list, moved, f64::INFINITY)?;
         let r = mesh.point_projection(p, t, c);
         self.distance = r.distance.abs();
-        r
+        Some(r)
     }
 
     /// [`TriMesh::nearest_of_segments`] of [a, ends[j]] within `max_distance`, from the set
@@ -270,7 +272,7 @@ mod tests {
         for t in 0..120 {
             let x: Vec<V3> = (0..n).map(|i| node(t, i)).collect();
             for i in 0..n {
-                let r = points[i].project_point(&mesh, &x[i], usize::MAX);
+                let r = points[i].project_point(&mesh, &x[i], usize::MAX).unwrap();
                 let h = mesh
                     .project_point(&x[i], f64::INFINITY, usize::MAX)
                     .unwrap();
@@ -351,7 +353,7 @@ mod tests {
                 })
                 .collect();
             for i in 0..3 {
-                let r = sets[i].0.project_point(&mesh, &x[i], usize::MAX);
+                let r = sets[i].0.project_point(&mesh, &x[i], usize::MAX).unwrap();
                 let brute = tris
                     .iter()
                     .map(|[a, b, c]| (point_triangle(&x[i], a, b, c).0 - x[i]).norm())
