@@ -8,7 +8,7 @@ clearance kernel runs on the cores given by RAYON_NUM_THREADS (2 here); the hier
 and the clearance are timed separately, medians of --repeat runs, plus the cold cost per
 query (no warm start: every step from scratch) for comparison.
 
-    RAYON_NUM_THREADS=2 python benchmarks/bench_clearance.py [--repeat 5] [--quads 707]
+    RAYON_NUM_THREADS=2 python benchmarks/bench_clearance.py [--repeat 5] [--quads 707] [--dt 1e-3]
 """
 
 from __future__ import annotations
@@ -43,8 +43,8 @@ def bumpy_surface(n: int) -> tuple[np.ndarray, np.ndarray]:
     return v, faces.astype(np.int64)
 
 
-def cable_motion(steps: int = 5001, edges: int = 100) -> np.ndarray:
-    t = np.arange(steps)[:, None] * 1e-3
+def cable_motion(steps: int = 5001, edges: int = 100, dt: float = 1e-3) -> np.ndarray:
+    t = np.arange(steps)[:, None] * dt
     u = np.linspace(0.0, 1.0, edges + 1)[None, :]
     x = 0.1 + 0.8 * u + 0.002 * np.sin(2 * np.pi * 10 * t + 3 * u)
     y = 0.2 + 0.6 * u + 0.05 * np.sin(np.pi * u) + 0.002 * np.sin(2 * np.pi * 23 * t + 5 * u)
@@ -56,14 +56,22 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--quads", type=int, default=707, help="quads per side (2 n² triangles)")
+    ap.add_argument(
+        "--dt",
+        type=float,
+        default=1e-3,
+        help="time between saved steps, s (smaller: slower motion per step, as sampled "
+        "finely or excited at low frequency)",
+    )
     args = ap.parse_args()
     v, f = bumpy_surface(args.quads)
-    pos = cable_motion()
+    pos = cable_motion(dt=args.dt)
     steps, nodes = pos.shape[:2]
     maps = np.zeros((1, steps, 3, 4))
     maps[0, :, :, :3] = np.eye(3)
     print(
         f"mesh {len(f):,} triangles; cable {nodes} nodes × {steps} steps; "
+        f"dt {args.dt * 1e3:g} ms; "
         f"RAYON_NUM_THREADS={os.environ.get('RAYON_NUM_THREADS', '(all cores)')}"
     )
     builds, runs, cpus = [], [], []

@@ -555,6 +555,45 @@ def test_decimation_for_display():
     assert r.min() > 0.95 and r.max() <= 1.0 + 1e-12  # still the sphere
 
 
+def test_decimation_equals_the_row_unique_clustering():
+    # the packed-key clustering gives exactly what np.unique over rows and np.add.at give
+    from cablelife.surroundings.display import _unique_rows, decimate
+
+    def reference(vertices, faces, max_faces):
+        lo = vertices.min(axis=0)
+        extent = float(np.ptp(vertices, axis=0).max())
+        cells = 2.0 * np.sqrt(max_faces)
+        while True:
+            key = np.floor((vertices - lo) / (extent / cells)).astype(np.int64)
+            _, inverse, counts = np.unique(key, axis=0, return_inverse=True, return_counts=True)
+            inverse = inverse.ravel()
+            sums = np.zeros((counts.size, 3))
+            np.add.at(sums, inverse, vertices)
+            v = sums / counts[:, None]
+            f = inverse[faces]
+            keep = (f[:, 0] != f[:, 1]) & (f[:, 1] != f[:, 2]) & (f[:, 0] != f[:, 2])
+            f = np.unique(f[keep], axis=0)
+            if len(f) <= max_faces or cells < 4:
+                used, f = np.unique(f, return_inverse=True)
+                return v[used], f.reshape(-1, 3)
+            cells *= 0.7
+
+    ico = trimesh.creation.icosphere(subdivisions=5, radius=0.3)  # 20 480 triangles
+    ico.apply_transform(trimesh.transformations.rotation_matrix(0.3, [1, 2, 3]))
+    v0, f0 = np.asarray(ico.vertices) + [5.0, -2.0, 1.0], np.asarray(ico.faces)
+    for m in (3_000, 500):
+        v, f = decimate(v0, f0, m)
+        rv, rf = reference(v0, f0, m)
+        assert np.array_equal(f, rf) and np.allclose(v, rv, rtol=0, atol=1e-15)
+    rows = np.random.default_rng(1).integers(0, 7, size=(500, 3))
+    first, inverse, counts = _unique_rows(rows)
+    u, rfirst, rinv, rcounts = np.unique(
+        rows, axis=0, return_index=True, return_inverse=True, return_counts=True
+    )
+    assert np.array_equal(rows[first], u) and np.array_equal(inverse, rinv.ravel())
+    assert np.array_equal(counts, rcounts)
+
+
 def test_report_has_the_clearance_section(scene_dict, tmp_path):
     from cablelife.cli import app
     from cablelife.simulate import simulate

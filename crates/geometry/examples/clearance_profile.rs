@@ -1,5 +1,5 @@
 //! The clearance benchmark's case without Python, for profiling (perf, callgrind):
-//! `cargo run -p cablelife-geometry --release --example clearance_profile -- [quads] [steps]`.
+//! `cargo run -p cablelife-geometry --release --example clearance_profile -- [quads] [steps] [dt in µs]`.
 //! The figures to report come from `benchmarks/bench_clearance.py`.
 use std::f64::consts::PI;
 use std::time::Instant;
@@ -30,6 +30,8 @@ fn main() {
         .collect();
     let n = args.first().copied().unwrap_or(707);
     let steps = args.get(1).copied().unwrap_or(5001);
+    // time between saved steps in µs (1000: the benchmark's 1 ms)
+    let dt = args.get(2).copied().unwrap_or(1000) as f64 * 1e-6;
     let mut v = Vec::with_capacity((n + 1) * (n + 1));
     for i in 0..=n {
         for j in 0..=n {
@@ -52,7 +54,7 @@ fn main() {
     let edges = 100;
     let mut pos = Vec::with_capacity(steps * (edges + 1));
     for s in 0..steps {
-        let t = s as f64 * 1e-3;
+        let t = s as f64 * dt;
         for k in 0..=edges {
             let u = k as f64 / edges as f64;
             let x = 0.1 + 0.8 * u + 0.002 * (2.0 * PI * 10.0 * t + 3.0 * u).sin();

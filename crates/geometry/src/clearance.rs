@@ -12,7 +12,7 @@
 use nalgebra::Matrix3;
 use rayon::prelude::*;
 
-use crate::{Shape, Surface, V3};
+use crate::{Candidates, Shape, Surface, V3};
 
 /// Takes global points into a body's reference frame at one step: X = m x + v.
 #[derive(Clone, Copy, Debug)]
@@ -89,6 +89,8 @@ pub fn clearance(
             let first = k * chunk_steps;
             // per node and part: the feature nearest to the node, to its two half-edges
             let mut hints = vec![usize::MAX; 3 * n_nodes * parts.len()];
+            // per node and mesh part: candidate sets of the node and of its half-edges
+            let mut sets = vec![(Candidates::new(), Candidates::new()); n_nodes * parts.len()];
             let mut dist = vec![f64::INFINITY; parts.len()];
             let mut local = vec![V3::zeros(); n_bodies * n_nodes];
             for (j, (vrow, prow)) in val
@@ -105,7 +107,7 @@ pub fn clearance(
                     }
                 }
                 step(
-                    parts, &local, n_nodes, radius, &mut hints, &mut dist, vrow, prow,
+                    parts, &local, n_nodes, radius, &mut hints, &mut sets, &mut dist, vrow, prow,
                 );
             }
         });
@@ -122,6 +124,7 @@ fn step(
     n: usize,
     radius: f64,
     hints: &mut [usize],
+    sets: &mut [(Candidates, Candidates)],
     dist: &mut [f64],
     value: &mut [f64],
     part: &mut [u32],
@@ -134,7 +137,11 @@ fn step(
             let x = &local[pt.body * n + i];
             let h = &mut hints[3 * (i * n_parts + k)];
             dist[k] = f64::INFINITY;
-            if let Some(r) = pt.shape.project_point(x, f64::INFINITY, *h) {
+            let found = match &pt.shape {
+                Shape::Mesh(mesh) => sets[i * n_parts + k].0.project_point(mesh, x, *h),
+                shape => shape.project_point(x, f64::INFINITY, *h),
+            };
+            if let Some(r) = found {
                 *h = r.feature;
                 dist[k] = r.distance;
                 if r.distance < best {
@@ -167,14 +174,24 @@ fn step(
                 if let Shape::Mesh(mesh) = &pt.shape {
                     // both half-edges in one traversal; warm start: the triangle nearest to
                     // them at the previous step, else the node's
+                    // (all of the node's half-edges: the candidate set is theirs)
                     if m == 0 {
                         continue;
+                    }
+                    let mut all = [V3::zeros(); 2];
+                    let mut m = 0;
+                    for nb in [i.wrapping_sub(1), i + 1] {
+                        if nb < n {
+                            all[m] = (x + local[base + nb]) * 0.5;
+                            m += 1;
+                        }
                     }
                     let h = match hints[at + 1] {
                         usize::MAX => hints[at],
                         h => h,
                     };
-                    if let Some((d, _, t)) = mesh.nearest_of_segments(x, &ends[..m], best, h) {
+                    let set = &mut sets[i * n_parts + k].1;
+                    if let Some((d, _, t)) = set.nearest_of_segments(mesh, x, &all[..m], best, h) {
                         hints[at + 1] = t;
                         if d < best {
                             best = d;
@@ -247,5 +264,55 @@ mod tests {
             c.value[4]
         );
         assert_eq!(c.part[4], 0);
+    }
+
+    #[test]
+    fn coherent_steps_equal_cold_steps() {
+        // a slowly moving cable over a bumpy mesh (candidate sets kept over steps), with one
+        // node jumping far at one step: every step equals the step computed alone (cold: no
+        // warm start, no set)
+        use crate::TriMesh;
+        let n = 30;
+        let h = |x: f64, y: f64| 0.05 * (x * 7.0).sin() * (y * 5.0).cos();
+        let mut v = vec![];
+        for i in 0..=n {
+            for j in 0..=n {
+                let (x, y) = (i as f64 / n as f64, j as f64 / n as f64);
+                v.push(V3::new(x, y, h(x, y)));
+            }
+        }
+        let mut f = vec![];
+        for i in 0..n {
+            for j in 0..n {
+                let a = (i * (n + 1) + j) as u32;
+                let (b, c, d) = (a + n as u32 + 1, a + 1, a + n as u32 + 2);
+                f.push([a, b, d]);
+                f.push([a, d, c]);
+            }
+        }
+        let parts = vec![Part {
+            shape: Shape::Mesh(TriMesh::new(&v, &f).unwrap()),
+            body: 0,
+        }];
+        let (steps, nodes) = (200, 8);
+        let mut positions = vec![];
+        for t in 0..steps {
+            for i in 0..nodes {
+                let s = t as f64 * 1e-5;
+                let (x, y) = (0.1 + 0.1 * i as f64 + s, 0.4 + 0.03 * i as f64 - s);
+                let mut p = V3::new(x, y, h(x, y) + 0.04 + 2e-4 * (t as f64 * 0.1).sin());
+                if i == 3 && t == 120 {
+                    p.z += 0.5;
+                }
+                positions.push(p);
+            }
+        }
+        let maps = vec![RigidMap::identity(); steps];
+        let c = clearance(&parts, &positions, nodes, 0.005, &maps).unwrap();
+        for t in 0..steps {
+            let one = &positions[t * nodes..(t + 1) * nodes];
+            let cold = clearance(&parts, one, nodes, 0.005, &maps[t..t + 1]).unwrap();
+            assert_eq!(cold.value, c.value[t * nodes..(t + 1) * nodes], "step {t}");
+        }
     }
 }

@@ -16,6 +16,7 @@
 
 pub mod clearance;
 pub mod closest;
+pub mod coherence;
 pub mod mesh;
 pub mod primitives;
 
@@ -24,6 +25,7 @@ use nalgebra::Vector3;
 pub type V3 = Vector3<f64>;
 
 pub use clearance::{clearance, Clearance, Part, RigidMap};
+pub use coherence::Candidates;
 pub use mesh::{MeshError, TriMesh};
 pub use primitives::{Cuboid, Cylinder, HalfSpace, Sphere};
 

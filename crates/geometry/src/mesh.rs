@@ -506,6 +506,245 @@ impl TriMesh {
         best.map(|(j, t)| (best_d2.sqrt(), j, t))
     }
 
+    /// Candidate triangles of point p for later queries near p (temporal coherence): every
+    /// triangle within d + 2·margin of p, d the distance of the nearest, with its distance,
+    /// sorted by it, into `out`. One traversal bounded by best + 2·margin; `hint` a triangle
+    /// to try first. See [`crate::coherence`] for why the set answers exactly while the query
+    /// stays within `margin` of p.
+    pub(crate) fn gather_point(&self, p: &V3, margin: f64, hint: usize, out: &mut Vec<(f64, u32)>) {
+        out.clear();
+        let mut best = f64::INFINITY;
+        if hint < self.triangles.len() {
+            let [a, b, c] = &self.triangles[hint];
+            best = (point_triangle(p, a, b, c).0 - p).norm();
+        }
+        // round-off of the distances kept on the safe side: relative, and absolute by the size
+        let slack = 1e-12 * (1.0 + p.amax());
+        let reach = |best: f64| (best + 2.0 * margin) * (1.0 + 1e-9) + slack;
+        let mut stack = [0u32; 64];
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let r = reach(best);
+            let node = &self.nodes[stack[top] as usize];
+            if node.excludes_point(p, r * r) {
+                continue;
+            }
+            if node.count > 0 {
+                let start = node.index as usize;
+                for t in start..start + node.count as usize {
+                    let r = reach(best);
+                    if self.point_lower2(t, p) > r * r {
+                        continue;
+                    }
+                    let [a, b, c] = &self.triangles[t];
+                    let d = (point_triangle(p, a, b, c).0 - p).norm();
+                    if d <= r {
+                        out.push((d, t as u32));
+                    }
+                    best = best.min(d);
+                }
+            } else {
+                let left = stack[top] + 1;
+                let right = node.index;
+                let dl = self.nodes[left as usize].box_distance2(p);
+                let dr = self.nodes[right as usize].box_distance2(p);
+                let (near, far) = if dl <= dr {
+                    (left, right)
+                } else {
+                    (right, left)
+                };
+                stack[top] = far;
+                stack[top + 1] = near;
+                top += 2;
+            }
+        }
+        let r = reach(best);
+        out.retain(|c| c.0 <= r);
+        out.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
+    }
+
+    /// Nearest triangle to p among `candidates` (sorted by their distance δ to a point p₀
+    /// with |p − p₀| ≤ moved) within sqrt(best_d2): as [`Self::nearest_triangle`] when the
+    /// candidates hold the nearest triangle. A candidate is at least δ − moved from p (the
+    /// distance is 1-Lipschitz), so the scan stops at the first δ − moved above the best.
+    pub(crate) fn nearest_triangle_among(
+        &self,
+        p: &V3,
+        candidates: &[(f64, u32)],
+        moved: f64,
+        mut best_d2: f64,
+    ) -> Option<(usize, V3)> {
+        let mut best = None;
+        let slack = 1e-12 * (1.0 + p.amax());
+        for &(delta, t) in candidates {
+            let lower = (delta - moved) * (1.0 - 1e-9) - slack;
+            if lower > 0.0 && lower * lower > best_d2 {
+                break;
+            }
+            let t = t as usize;
+            if self.point_lower2(t, p) > best_d2 {
+                continue;
+            }
+            let [a, b, c] = &self.triangles[t];
+            let (cp, _) = point_triangle(p, a, b, c);
+            let d2 = (cp - p).norm_squared();
+            if d2 < best_d2 || (d2 == best_d2 && best.is_none()) {
+                best_d2 = d2;
+                best = Some((t, cp));
+            }
+        }
+        best
+    }
+
+    /// Candidate triangles of the segments [a, ends[j]] for later queries near them, as
+    /// [`Self::gather_point`]: every triangle within d + 2·margin of any of the segments (d
+    /// the least distance), with the least of its distances to them, sorted.
+    pub(crate) fn gather_segments(
+        &self,
+        a: &V3,
+        ends: &[V3],
+        margin: f64,
+        hint: usize,
+        out: &mut Vec<(f64, u32)>,
+    ) {
+        const MAX_ENDS: usize = 4;
+        assert!(ends.len() <= MAX_ENDS, "at most {MAX_ENDS} segments");
+        out.clear();
+        let mut seg = [(V3::zeros(), V3::zeros(), V3::zeros(), 0.0); MAX_ENDS];
+        let (mut vlo, mut vhi) = (*a, *a);
+        for (j, b) in ends.iter().enumerate() {
+            seg[j] = (a.inf(b), a.sup(b), (a + b) * 0.5, (b - a).norm() * 0.5);
+            vlo = vlo.inf(b);
+            vhi = vhi.sup(b);
+        }
+        let seg = &seg[..ends.len()];
+        let slack = 1e-12 * (1.0 + ends.iter().fold(a.amax(), |m, b| m.max(b.amax())));
+        let reach = |best: f64| (best + 2.0 * margin) * (1.0 + 1e-9) + slack;
+        // least distance of triangle t to the segments, if within r (else None)
+        let dist = |t: usize, r: f64| {
+            let [p, q, w] = &self.triangles[t];
+            let mut least = f64::INFINITY;
+            for b in ends {
+                if self.segment_excluded(t, a, b, r * r) {
+                    continue;
+                }
+                let (_, x, y) = segment_triangle(a, b, p, q, w);
+                least = least.min((x - y).norm());
+            }
+            least
+        };
+        let mut best = f64::INFINITY;
+        if hint < self.triangles.len() {
+            best = dist(hint, f64::INFINITY);
+        }
+        let mut stack = [0u32; 64];
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let r = reach(best);
+            let r2 = r * r;
+            let node = &self.nodes[stack[top] as usize];
+            let mut d2 = 0.0;
+            for k in 0..3 {
+                let e = (node.min[k] - vhi[k]).max(vlo[k] - node.max[k]).max(0.0);
+                d2 += e * e;
+            }
+            if d2 > r2
+                || ends.iter().zip(seg).all(|(b, (lo, hi, mid, half))| {
+                    node.excludes_segment(a, b, lo, hi, mid, *half, r2)
+                })
+            {
+                continue;
+            }
+            if node.count > 0 {
+                let start = node.index as usize;
+                for t in start..start + node.count as usize {
+                    let r = reach(best);
+                    let d = dist(t, r);
+                    if d <= r {
+                        out.push((d, t as u32));
+                    }
+                    best = best.min(d);
+                }
+            } else {
+                let left = stack[top] + 1;
+                let right = node.index;
+                let dl = self.nodes[left as usize].box_distance2(a);
+                let dr = self.nodes[right as usize].box_distance2(a);
+                let (near, far) = if dl <= dr {
+                    (left, right)
+                } else {
+                    (right, left)
+                };
+                stack[top] = far;
+                stack[top + 1] = near;
+                top += 2;
+            }
+        }
+        let r = reach(best);
+        out.retain(|c| c.0 <= r);
+        out.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
+    }
+
+    /// [`Self::nearest_of_segments`] among `candidates` (sorted by their least distance δ to
+    /// segments that each moved at most `moved` from [a, ends[j]]; a segment moves no
+    /// farther than its ends): stops at the first δ − moved above the best.
+    pub(crate) fn nearest_of_segments_among(
+        &self,
+        a: &V3,
+        ends: &[V3],
+        candidates: &[(f64, u32)],
+        moved: f64,
+        max_distance: f64,
+    ) -> Option<(f64, usize, usize)> {
+        let mut best_d2 = max_distance * max_distance;
+        let mut best: Option<(usize, usize)> = None;
+        let slack = 1e-12 * (1.0 + ends.iter().fold(a.amax(), |m, b| m.max(b.amax())));
+        for &(delta, t) in candidates {
+            let lower = (delta - moved) * (1.0 - 1e-9) - slack;
+            if lower > 0.0 && lower * lower > best_d2 {
+                break;
+            }
+            let t = t as usize;
+            let [p, q, r] = &self.triangles[t];
+            for (j, b) in ends.iter().enumerate() {
+                if self.segment_excluded(t, a, b, best_d2) {
+                    continue;
+                }
+                let (_, x, y) = segment_triangle(a, b, p, q, r);
+                let d2 = (x - y).norm_squared();
+                if d2 < best_d2 || (d2 == best_d2 && best.is_none()) {
+                    best_d2 = d2;
+                    best = Some((j, t));
+                }
+            }
+        }
+        best.map(|(j, t)| (best_d2.sqrt(), j, t))
+    }
+
+    /// The signed point projection of p on triangle t with closest point c (the sign by the
+    /// pseudo-normal of the feature c lies on).
+    pub(crate) fn point_projection(&self, p: &V3, t: usize, c: V3) -> PointProjection {
+        let [a, b, cc] = &self.triangles[t];
+        let (_, feature) = point_triangle(p, a, b, cc);
+        let n = self.pseudo_normal(t, feature);
+        let d = p - c;
+        let dist = d.norm();
+        let sign = if d.dot(&n) < 0.0 { -1.0 } else { 1.0 };
+        let normal = if dist > 1e-12 * (1.0 + c.norm()) {
+            d * (sign / dist)
+        } else {
+            n.normalize()
+        };
+        PointProjection {
+            distance: sign * dist,
+            point: c,
+            normal,
+            feature: t,
+        }
+    }
+
     /// Closest triangle to segment [a, b] within sqrt(best_d2).
     fn nearest_to_segment(
         &self,
@@ -569,23 +808,7 @@ impl TriMesh {
 impl Surface for TriMesh {
     fn project_point(&self, p: &V3, max_distance: f64, hint: usize) -> Option<PointProjection> {
         let (t, c) = self.nearest_triangle(p, max_distance * max_distance, hint)?;
-        let [a, b, cc] = &self.triangles[t];
-        let (_, feature) = point_triangle(p, a, b, cc);
-        let n = self.pseudo_normal(t, feature);
-        let d = p - c;
-        let dist = d.norm();
-        let sign = if d.dot(&n) < 0.0 { -1.0 } else { 1.0 };
-        let normal = if dist > 1e-12 * (1.0 + c.norm()) {
-            d * (sign / dist)
-        } else {
-            n.normalize()
-        };
-        Some(PointProjection {
-            distance: sign * dist,
-            point: c,
-            normal,
-            feature: t,
-        })
+        Some(self.point_projection(p, t, c))
     }
 
     fn closest_to_segment(

@@ -62,18 +62,36 @@ def decimate(vertices: np.ndarray, faces: np.ndarray, max_faces: int = MAX_FACES
     while True:
         size = extent / cells
         key = np.floor((vertices - lo) / size).astype(np.int64)
-        _, inverse, counts = np.unique(key, axis=0, return_inverse=True, return_counts=True)
-        inverse = inverse.ravel()
-        sums = np.zeros((counts.size, 3))
-        np.add.at(sums, inverse, vertices)
+        _, inverse, counts = _unique_rows(key)
+        sums = np.stack(
+            [np.bincount(inverse, weights=vertices[:, k], minlength=counts.size) for k in range(3)],
+            axis=1,
+        )
         v = sums / counts[:, None]
         f = inverse[faces]
         keep = (f[:, 0] != f[:, 1]) & (f[:, 1] != f[:, 2]) & (f[:, 0] != f[:, 2])
-        f = np.unique(f[keep], axis=0)
+        f = f[keep][_unique_rows(f[keep])[0]]
         if len(f) <= max_faces or cells < 4:
             used, f = np.unique(f, return_inverse=True)
             return v[used], f.reshape(-1, 3)
         cells *= 0.7
+
+
+def _unique_rows(rows: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``np.unique(rows, axis=0, return_index, return_inverse, return_counts)`` of
+    non-negative integer rows (n, 3) in the same (lexicographic) order: the rows packed into
+    one int64 each, unique on that (several times faster than on rows)."""
+    span = rows.max(axis=0).astype(np.int64) + 1 if len(rows) else np.ones(3, np.int64)
+    if float(span[0]) * float(span[1]) * float(span[2]) >= 2.0**62:
+        _, first, inverse, counts = np.unique(
+            rows, axis=0, return_index=True, return_inverse=True, return_counts=True
+        )
+        return first, inverse.ravel(), counts
+    packed = (rows[:, 0] * span[1] + rows[:, 1]) * span[2] + rows[:, 2]
+    _, first, inverse, counts = np.unique(
+        packed, return_index=True, return_inverse=True, return_counts=True
+    )
+    return first, inverse.ravel(), counts
 
 
 def primitive_mesh(part, size: float, near=None) -> tuple[np.ndarray, np.ndarray]:
