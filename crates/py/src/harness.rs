@@ -8,8 +8,8 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use rod::harness::{Harness as Tree, HarnessState, HarnessStatics, JunctionSpec};
-use rod::harness_modal::{harness_lowest_modes, ModalSystem};
 use rod::harness_dynamics::HarnessDynamics;
+use rod::harness_modal::{harness_lowest_modes, ModalSystem};
 use rod::routing::route;
 use rod::{ClipMotion, DynamicOptions, NewtonOptions, Pose};
 
