@@ -128,3 +128,26 @@ def test_a_junction_clip_holds_a_harness_without_other_clips():
     weight = sum(c.section["mass_per_length"] * c.arc_length[-1] for c in result.cables.values())
     w = 9.81 * (weight + 0.02)
     np.testing.assert_allclose(j.reaction_force[0], [0, 0, w], rtol=1e-8, atol=1e-9 * w)
+
+
+def test_dynamic_harness_with_sliding_clips_or_held_junctions_is_a_clear_error():
+    """Dynamic harness runs have no sliding term and no held junctions yet: named errors."""
+    import tomllib
+    from pathlib import Path
+
+    d = tomllib.loads((Path(__file__).parents[1] / "examples/harness/scene.toml").read_text())
+    d["simulation"].update(mode="dynamic", duration=0.01, time_step=0.001)
+    with pytest.raises(SceneError, match=r"sliding clip '.*' on a harness: dynamic analysis"):
+        simulate(scene_from_dict(d))
+    for c in d["cables"]:
+        for k in c["clips"]:
+            k.pop("friction", None)
+            if k.get("type") == "sliding":
+                k["type"], k["length"] = "fixed", 0.0
+    d["junctions"][0]["clip"] = {"body": "world", "name": "tape"}
+    with pytest.raises(SceneError, match="junction 'breakout' is held by a clip: dynamic"):
+        simulate(scene_from_dict(d))
+    del d["junctions"][0]["clip"]
+    result = simulate(scene_from_dict(d))  # without them the example runs dynamically
+    for cable in result.cables.values():
+        assert np.isfinite(cable.positions).all() and len(cable.time) == 11

@@ -146,20 +146,6 @@ def harness_equilibrium(scene: Scene):
     from cablelife.scene import SceneError
     from cablelife.simulate import body_motions, build_cable, clip_kinematics
 
-    if mode == "dynamic":
-        held = [j.name for j in scene.junctions if j.clip is not None]
-        sliding = [(c.name, k.name) for c in scene.cables for k in c.clips if k.type == "sliding"]
-        if held:
-            raise SceneError(
-                f"junction '{held[0]}' is held by a clip: dynamic analysis of harnesses with "
-                "held junctions is not supported yet; allowed: static and quasistatic"
-            )
-        if sliding:
-            raise SceneError(
-                f"cable '{sliding[0][0]}': sliding clip '{sliding[0][1]}' on a harness: dynamic "
-                "analysis of harnesses with sliding clips is not supported yet; allowed: static "
-                "and quasistatic, or a fixed/hinge clip there"
-            )
     cables, specs = harness_cables(scene)
     cores = [build_cable(scene, c) for c in cables]
     times = np.array([0.0])
@@ -200,6 +186,20 @@ def run_harness(scene: Scene, times: np.ndarray, mode: str, progress, stop):
             "contact with the geometry is not supported yet for harnesses (scenes with "
             "[[junctions]]); remove [contact] or the junctions"
         )
+    if mode == "dynamic":
+        held = [j.name for j in scene.junctions if j.clip is not None]
+        sliding = [(c.name, k.name) for c in scene.cables for k in c.clips if k.type == "sliding"]
+        if held:
+            raise SceneError(
+                f"junction '{held[0]}' is held by a clip: dynamic analysis of harnesses with "
+                "held junctions is not supported yet; allowed: static and quasistatic"
+            )
+        if sliding:
+            raise SceneError(
+                f"cable '{sliding[0][0]}': sliding clip '{sliding[0][1]}' on a harness: dynamic "
+                "analysis of harnesses with sliding clips is not supported yet; allowed: static "
+                "and quasistatic, or a fixed/hinge clip there"
+            )
     cables, specs = harness_cables(scene)
     cores = [build_cable(scene, c) for c in cables]
     try:
