@@ -431,4 +431,4 @@ impl HarnessState {
 
 #[cfg(test)]
 #[path = "harness_tests.rs"]
-mod tests;
+pub(crate) mod tests;

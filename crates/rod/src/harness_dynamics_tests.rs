@@ -3,49 +3,20 @@
 //! differences.
 use super::*;
 use crate::harness::JunctionSpec;
-use crate::model::{CableSpec, ClipKind, ClipSpec, Rod, Section};
-use crate::rotation::{frame_quaternion, Quat};
+use crate::model::Rod;
 use crate::routing::route;
 use crate::state::State;
 
-fn section() -> Section {
-    Section {
-        shear_stiffness: Vector3::new(2e4, 2e4, 5e4),
-        bend_stiffness: Vector3::new(0.02, 0.02, 0.015),
-        mass_per_length: 0.1,
-        rotary_inertia: Vector3::new(1e-6, 1e-6, 2e-6),
-    }
-}
-
-fn frame(t: &Vector3<f64>) -> Quat {
-    frame_quaternion(t, &Vector3::z()).unwrap()
-}
-
-/// A straight cable from a to b with fixed point clips at both ends.
+/// A straight cable from a to b with fixed clips at both ends.
 fn straight(a: [f64; 3], b: [f64; 3], n: usize) -> Rod {
-    let (a, b) = (Vector3::from(a), Vector3::from(b));
-    let l = (b - a).norm();
-    let q = frame(&((b - a) / l));
-    let clip = |name: &str, s: f64, p: Vector3<f64>| ClipSpec {
-        name: name.into(),
-        s,
-        length: 0.0,
-        kind: ClipKind::Fixed,
-        pose: Pose {
-            position: p,
-            orientation: q,
-        },
-    };
-    Rod::new(CableSpec {
-        length: l,
-        segments: n,
-        section: section(),
-        natural_curvature: Vector3::zeros(),
-        clips: vec![clip("a", 0.0, a), clip("b", l, b)],
-        loads: vec![],
-        gravity: Vector3::new(0.0, 0.0, -9.81),
-    })
-    .unwrap()
+    crate::harness::tests::straight_with(
+        a,
+        b,
+        n,
+        crate::harness::tests::section(),
+        vec![],
+        Vector3::new(0.0, 0.0, -9.81),
+    )
 }
 
 fn junction(mass: f64, inertia: f64, ends: Vec<(usize, usize)>) -> JunctionSpec {

@@ -3,8 +3,7 @@
 //! against the eigenvalues of the dense assembled stiffness.
 use super::*;
 use crate::harness::JunctionSpec;
-use crate::model::{CableSpec, ClipKind, ClipSpec, Pose, Rod, Section};
-use crate::rotation::{frame_quaternion, Quat};
+use crate::model::{Rod, Section};
 use crate::routing::route;
 use nalgebra::{DMatrix, Vector3};
 
@@ -22,35 +21,9 @@ fn section() -> Section {
     }
 }
 
-fn frame(t: &Vector3<f64>) -> Quat {
-    frame_quaternion(t, &Vector3::z()).unwrap()
-}
-
 /// A straight cable from a to b with fixed clips at both ends.
 fn straight(a: [f64; 3], b: [f64; 3], n: usize) -> Rod {
-    let (a, b) = (Vector3::from(a), Vector3::from(b));
-    let l = (b - a).norm();
-    let q = frame(&((b - a) / l));
-    let clip = |name: &str, s: f64, p: Vector3<f64>| ClipSpec {
-        name: name.into(),
-        s,
-        length: 0.0,
-        kind: ClipKind::Fixed,
-        pose: Pose {
-            position: p,
-            orientation: q,
-        },
-    };
-    Rod::new(CableSpec {
-        length: l,
-        segments: n,
-        section: section(),
-        natural_curvature: Vector3::zeros(),
-        clips: vec![clip("a", 0.0, a), clip("b", l, b)],
-        loads: vec![],
-        gravity: Vector3::zeros(),
-    })
-    .unwrap()
+    crate::harness::tests::straight_with(a, b, n, section(), vec![], Vector3::zeros())
 }
 
 fn harness(cables: Vec<Rod>, ends: Vec<(usize, usize)>) -> Harness {

@@ -9,7 +9,7 @@ use crate::junction::HeldEnds;
 use crate::model::{Pose, Rod};
 use crate::rotation::slerp;
 use crate::sliding::SlidingClips;
-use crate::statics::{NewtonOptions, SolveError, SolveStats};
+use crate::statics::{continue_load, NewtonOptions, SolveError, SolveStats};
 use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 
 #[inline]
@@ -766,37 +766,17 @@ impl HarnessStatics {
             Err(e) => e,
         };
         st.clone_from(&start);
-        let mut total = match self.newton(h, st, 0.0, true) {
+        let total = match self.newton(h, st, 0.0, true) {
             Ok(s) => s,
             Err(_) => {
                 st.clone_from(&start);
                 return Err(last);
             }
         };
-        total.substeps = 1;
-        let mut lambda = 0.0;
-        let mut dl = 0.25f64;
-        while lambda < 1.0 {
-            let trial = (lambda + dl).min(1.0);
-            let saved = st.clone();
-            match self.newton(h, st, trial, true) {
-                Ok(s) => {
-                    total.iterations += s.iterations;
-                    total.residual = s.residual;
-                    total.substeps += 1;
-                    lambda = trial;
-                    dl *= 1.5;
-                }
-                Err(e) => {
-                    st.clone_from(&saved);
-                    dl *= 0.5;
-                    if dl < self.opts.min_load_step {
-                        return Err(e);
-                    }
-                }
-            }
-        }
-        Ok(total)
+        let min_step = self.opts.min_load_step;
+        continue_load(st, total, min_step, |st, load| {
+            self.newton(h, st, load, true)
+        })
     }
 
     /// One step of a sequence of equilibria: from the current state to the clip poses

@@ -6,7 +6,7 @@ use crate::rotation::frame_quaternion;
 use crate::routing::route;
 use crate::statics::NewtonOptions;
 
-fn section() -> Section {
+pub(crate) fn section() -> Section {
     Section {
         shear_stiffness: Vector3::new(2e4, 2e4, 5e4),
         bend_stiffness: Vector3::new(0.02, 0.02, 0.015),
@@ -15,7 +15,7 @@ fn section() -> Section {
     }
 }
 
-fn frame(t: &Vector3<f64>) -> Quat {
+pub(crate) fn frame(t: &Vector3<f64>) -> Quat {
     let n = if t.z.abs() < 0.9 {
         Vector3::z()
     } else {
@@ -24,8 +24,16 @@ fn frame(t: &Vector3<f64>) -> Quat {
     frame_quaternion(t, &n).unwrap()
 }
 
-/// A straight cable from a to b with fixed point clips at both ends (named "a" and "b").
-fn straight(a: [f64; 3], b: [f64; 3], n: usize, loads: Vec<PointLoad>, g: f64) -> Rod {
+/// A straight cable from a to b with fixed point clips at both ends (named "a" and "b"),
+/// shared by the harness statics, dynamics and modal tests.
+pub(crate) fn straight_with(
+    a: [f64; 3],
+    b: [f64; 3],
+    n: usize,
+    section: Section,
+    loads: Vec<PointLoad>,
+    gravity: Vector3<f64>,
+) -> Rod {
     let (a, b) = (Vector3::from(a), Vector3::from(b));
     let l = (b - a).norm();
     let q = frame(&((b - a) / l));
@@ -42,13 +50,18 @@ fn straight(a: [f64; 3], b: [f64; 3], n: usize, loads: Vec<PointLoad>, g: f64) -
     Rod::new(CableSpec {
         length: l,
         segments: n,
-        section: section(),
+        section,
         natural_curvature: Vector3::zeros(),
         clips: vec![clip("a", 0.0, a), clip("b", l, b)],
         loads,
-        gravity: Vector3::new(0.0, 0.0, -g),
+        gravity,
     })
     .unwrap()
+}
+
+/// A straight cable from a to b with fixed point clips at both ends (named "a" and "b").
+fn straight(a: [f64; 3], b: [f64; 3], n: usize, loads: Vec<PointLoad>, g: f64) -> Rod {
+    straight_with(a, b, n, section(), loads, Vector3::new(0.0, 0.0, -g))
 }
 
 fn junction(name: &str, mass: f64, ends: Vec<(usize, usize)>) -> JunctionSpec {

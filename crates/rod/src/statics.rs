@@ -1077,31 +1077,11 @@ impl Statics {
         st: &mut State,
         damped: bool,
     ) -> Result<SolveStats, SolveError> {
-        let mut total = self.newton(rod, st, 0.0, damped)?;
-        total.substeps = 1;
-        let mut lambda = 0.0;
-        let mut dl = 0.25f64;
-        while lambda < 1.0 {
-            let trial = (lambda + dl).min(1.0);
-            let saved = st.clone();
-            match self.newton(rod, st, trial, damped) {
-                Ok(s) => {
-                    total.iterations += s.iterations;
-                    total.residual = s.residual;
-                    total.substeps += 1;
-                    lambda = trial;
-                    dl *= 1.5;
-                }
-                Err(e) => {
-                    st.clone_from(&saved);
-                    dl *= 0.5;
-                    if dl < self.opts.min_load_step {
-                        return Err(e);
-                    }
-                }
-            }
-        }
-        Ok(total)
+        let total = self.newton(rod, st, 0.0, damped)?;
+        let min_step = self.opts.min_load_step;
+        continue_load(st, total, min_step, |st, load| {
+            self.newton(rod, st, load, damped)
+        })
     }
 
     /// One step of a sequence of equilibria: from the current (converged) state to the clip
@@ -1245,4 +1225,40 @@ fn scaled_norm(d: &[Vector6<f64>], length: f64) -> f64 {
         }
     }
     sum.sqrt()
+}
+
+/// Load continuation from a converged state at load factor 0 (`total`: that solve's figures)
+/// to 1: Newton at growing load factors, the increment ×1.5 after a success and ×½ after a
+/// failure (the state restored), until it falls below `min_step`. Shared by the single cable
+/// and the harness.
+pub(crate) fn continue_load<S: Clone, E>(
+    st: &mut S,
+    mut total: SolveStats,
+    min_step: f64,
+    mut newton: impl FnMut(&mut S, f64) -> Result<SolveStats, E>,
+) -> Result<SolveStats, E> {
+    total.substeps = 1;
+    let mut lambda = 0.0;
+    let mut dl = 0.25f64;
+    while lambda < 1.0 {
+        let trial = (lambda + dl).min(1.0);
+        let saved = st.clone();
+        match newton(st, trial) {
+            Ok(s) => {
+                total.iterations += s.iterations;
+                total.residual = s.residual;
+                total.substeps += 1;
+                lambda = trial;
+                dl *= 1.5;
+            }
+            Err(e) => {
+                st.clone_from(&saved);
+                dl *= 0.5;
+                if dl < min_step {
+                    return Err(e);
+                }
+            }
+        }
+    }
+    Ok(total)
 }
