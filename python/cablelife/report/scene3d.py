@@ -83,6 +83,7 @@ def _layout(fig, title: str, box: np.ndarray) -> None:
         f"{a}axis": {"range": [centre[i] - half, centre[i] + half], "title": f"{a} [m]"}
         for i, a in enumerate("xyz")
     }
+    axes["zaxis"]["tickvals"] = _ticks_off_corner(*axes["zaxis"]["range"])
     fig.update_layout(  # the legend left of the scene, not over it
         title=title,
         scene={**axes, "aspectmode": "cube", "domain": {"x": [0.3, 1.0], "y": [0.0, 1.0]}},
@@ -90,6 +91,17 @@ def _layout(fig, title: str, box: np.ndarray) -> None:
         legend={"x": 0.0, "y": 1.0, "xanchor": "left", "font": {"size": 10}},
         height=560,
     )
+
+
+def _ticks_off_corner(lo: float, hi: float) -> list[float]:
+    """Round ticks in [lo, hi] (3–6 of them) but none within 8 % of the range above ``lo``: the
+    lowest tick of the vertical axis sits at the corner where the y axis' ticks are and its
+    label would be drawn over theirs (a duplicated "−0.5" there)."""
+    span = hi - lo
+    step = 10.0 ** np.floor(np.log10(span / 5))
+    step *= next(m for m in (1.0, 2.0, 2.5, 5.0, 10.0) if span / (step * m) <= 6)
+    ticks = np.arange(np.ceil(lo / step), np.floor(hi / step) + 1) * step
+    return [float(round(v, 12)) for v in ticks if v - lo >= 0.08 * span]
 
 
 def _clip_nodes(cable: CableResult) -> dict[str, int]:
