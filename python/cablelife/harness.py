@@ -218,13 +218,17 @@ def run_harness(scene: Scene, times: np.ndarray, mode: str, progress, stop):
     callback = (lambda k, n: progress("harness", k, n)) if progress else None
     extra: dict = {}
     if mode == "dynamic":
-        from cablelife.modal import retardation_times
+        from cablelife.modal import harness_modes, retardation_times
 
         every = output_every(scene)
-        # Default damping from each cable's first mode with its joined ends clamped (the
-        # modes of the harness as one are harness-modal's; docs/harness.md).
-        alone = scene.model_copy(update={"junctions": []})
-        taus = [retardation_times(alone, c) for c in cables]
+        # Default bending damping from the first mode of the whole harness (docs/harness.md).
+        needs_mode = any(
+            c.damping.retardation_time is None and c.damping.bending is None for c in cables
+        )
+        omega1 = None
+        if needs_mode:
+            omega1 = float(next(iter(harness_modes(scene, 1).values())).omega[0])
+        taus = [retardation_times(scene, c, omega1) for c in cables]
         names = ("positions", "quaternions", "velocities", "angular_velocities")
         names += ("accelerations", "angular_accelerations")
         start = _time.perf_counter()

@@ -194,7 +194,9 @@ def lowest_frequencies(cable: Cable) -> dict[str, float]:
     }
 
 
-def retardation_times(scene: Scene, cable: Cable) -> tuple[list[float], list[float], dict]:
+def retardation_times(
+    scene: Scene, cable: Cable, omega1: float | None = None
+) -> tuple[list[float], list[float], dict]:
     """Kelvin–Voigt retardation times (GA₁, GA₂, EA) and (EI₁, EI₂, GJ) of a cable, with how
     they were set.
 
@@ -204,7 +206,8 @@ def retardation_times(scene: Scene, cable: Cable) -> tuple[list[float], list[flo
     τ_i = min(τ, η/ω_i) (``lowest_frequencies``). One τ = 2ζ/ω₁ on all modes would damp
     extension, torsion and shear hundreds of times over-critically and let the viscous forces
     dominate the section loads (docs/dynamics.md). A given ``retardation_time`` applies to all
-    modes. Per-mode values override either."""
+    modes. Per-mode values override either. ``omega1``: the first natural frequency when known
+    (a harness: the whole tree's), else computed."""
     from cablelife.scene import DEFAULT_DAMPING_RATIO
 
     d = cable.damping
@@ -215,7 +218,8 @@ def retardation_times(scene: Scene, cable: Cable) -> tuple[list[float], list[flo
         own = {"extension": tau, "torsion": tau, "shear": tau}
     else:
         zeta = d.ratio if d.ratio is not None else DEFAULT_DAMPING_RATIO
-        omega1 = float(cable_modes(scene, cable, 1).omega[0])
+        if omega1 is None:
+            omega1 = float(cable_modes(scene, cable, 1).omega[0])
         tau = 2 * zeta / omega1 if omega1 > 0 else 0.0
         info.update(source="ratio", ratio=zeta, omega1=omega1)
         own = {k: min(tau, DEFAULT_LOSS_FACTOR / w) for k, w in lowest_frequencies(cable).items()}
