@@ -254,20 +254,10 @@ impl Harness {
         if last.is_some() {
             self.state = last;
         }
-        let d = PyDict::new(py);
-        let cables = PyList::empty(py);
-        for (c, rec) in out.records.into_iter().enumerate() {
-            let rod = &self.tree.cables[c];
-            let cd = rec.into_dict(py, rod.arc.len(), rod.spec.clips.len())?;
-            cd.set_item("error", error.clone())?;
-            cables.append(cd)?;
-        }
         let n = out.steps;
         let shaped =
             |v: Vec<f64>, shape: &[usize]| PyArray1::from_vec(py, v).reshape(shape.to_vec());
-        d.set_item("cables", cables)?;
-        d.set_item("junction_positions", shaped(out.jpos, &[n, nj, 3])?)?;
-        d.set_item("junction_quaternions", shaped(out.jquat, &[n, nj, 4])?)?;
+        let d = junction_outputs(py, &self.tree, out.records, &error, out.jpos, out.jquat, n)?;
         d.set_item("branch_force", shaped(out.force, &[n, ne, 3])?)?;
         d.set_item("branch_moment", shaped(out.moment, &[n, ne, 3])?)?;
         d.set_item(
@@ -621,20 +611,10 @@ impl Harness {
             }
             (out, None)
         });
-        let d = PyDict::new(py);
-        let cables = PyList::empty(py);
-        for (c, rec) in out.records.into_iter().enumerate() {
-            let rod = &self.tree.cables[c];
-            let cd = rec.into_dict(py, rod.arc.len(), rod.spec.clips.len())?;
-            cd.set_item("error", error.clone())?;
-            cables.append(cd)?;
-        }
         let n = out.steps;
         let shaped =
             |v: Vec<f64>, shape: &[usize]| PyArray1::from_vec(py, v).reshape(shape.to_vec());
-        d.set_item("cables", cables)?;
-        d.set_item("junction_positions", shaped(out.jpos, &[n, nj, 3])?)?;
-        d.set_item("junction_quaternions", shaped(out.jquat, &[n, nj, 4])?)?;
+        let d = junction_outputs(py, &self.tree, out.records, &error, out.jpos, out.jquat, n)?;
         d.set_item("junction_velocities", shaped(out.jvel, &[n, nj, 6])?)?;
         d.set_item("branch_force", shaped(out.force, &[n, ne, 3])?)?;
         d.set_item("branch_moment", shaped(out.moment, &[n, ne, 3])?)?;
@@ -650,6 +630,37 @@ impl Harness {
         d.set_item("error", error)?;
         Ok(d)
     }
+}
+
+/// The outputs every harness run returns: one dict per cable (with the run's `error`) and the
+/// junction positions (T, J, 3) and quaternions (T, J, 4, scalar first).
+fn junction_outputs<'py>(
+    py: Python<'py>,
+    tree: &Tree,
+    records: Vec<Record>,
+    error: &Option<String>,
+    jpos: Vec<f64>,
+    jquat: Vec<f64>,
+    n: usize,
+) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    let cables = PyList::empty(py);
+    for (rec, rod) in records.into_iter().zip(&tree.cables) {
+        let cd = rec.into_dict(py, rod.arc.len(), rod.spec.clips.len())?;
+        cd.set_item("error", error.clone())?;
+        cables.append(cd)?;
+    }
+    let nj = tree.junctions.len();
+    d.set_item("cables", cables)?;
+    d.set_item(
+        "junction_positions",
+        PyArray1::from_vec(py, jpos).reshape(vec![n, nj, 3])?,
+    )?;
+    d.set_item(
+        "junction_quaternions",
+        PyArray1::from_vec(py, jquat).reshape(vec![n, nj, 4])?,
+    )?;
+    Ok(d)
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
