@@ -319,7 +319,9 @@ def test_ctrl_c_stops_a_study_quietly_and_keeps_the_finished_variants(tmp_path):
     assert not (out / "summary.csv").exists()
     assert stopped < STOP_BOUND
     finished = _rows(out)
-    assert 1 <= len(finished) < 6 and all(r["status"] == "ok" for r in finished.values())
+    assert len(finished) >= 1, "the finished variant was not kept"
+    assert len(finished) < 6, f"all {len(finished)} variants ran: the interruption was ignored"
+    assert all(r["status"] == "ok" for r in finished.values()), finished
 
 
 @pytest.fixture(scope="module")
