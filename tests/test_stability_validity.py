@@ -196,3 +196,33 @@ def test_a_dynamic_run_starts_from_the_stable_buckled_state():
     assert res.positions[0, -1, 2] == pytest.approx(y_ref, abs=0.02)
     # At rest in a stable equilibrium with the clips at rest: it stays there.
     assert np.abs(res.positions[-1] - res.positions[0]).max() < 1e-6
+
+
+def test_strain_extremes_scan_equals_the_rotation_matrix_formula():
+    """The blocked scan of the strains (no rotation matrices formed) finds the same extremes,
+    values and places as Γ = Rᵀ(x_{n+1} − x_n)/Δs − e₃ with R from the normalised quaternion,
+    also when the extreme lies in a later block and the quaternions are not unit."""
+    from types import SimpleNamespace
+
+    from cablelife.export.frames import rotation_matrices
+    from cablelife.validity import strain_extremes
+
+    rng = np.random.default_rng(3)
+    t, n = 150, 30  # three blocks of the scan
+    q = rng.normal(size=(t, n, 4)) * rng.uniform(0.5, 2.0, size=(t, n, 1))
+    x = np.cumsum(rng.normal(size=(t, n + 1, 3)) * 0.01, axis=1)
+    x[140, 20:] += [0.0, 0.0, 0.5]  # the largest stretch in the last block, at edge 19
+    arc = np.cumsum(rng.uniform(0.5, 1.5, n + 1)) * 0.01
+    c = SimpleNamespace(quaternions=q, positions=x, arc_length=arc, time=np.arange(t) * 1e-3)
+    tangent = np.diff(x, axis=1) / np.diff(arc)[None, :, None]
+    gamma = np.einsum("...ji,...j->...i", rotation_matrices(q), tangent)
+    axial, shear = gamma[..., 2] - 1.0, np.hypot(gamma[..., 0], gamma[..., 1])
+    ext = strain_extremes(c)
+    cases = (("axial", axial, 1), ("compression", -axial, -1), ("shear", shear, 1))
+    for key, values, sign in cases:
+        k, e = np.unravel_index(int(np.argmax(values)), values.shape)
+        assert ext[key]["value"] == pytest.approx(sign * values[k, e], rel=1e-12)
+        assert ext[key]["t"] == c.time[k]
+        assert ext[key]["s"] == pytest.approx(0.5 * (arc[e] + arc[e + 1]))
+    # the set-up puts an extreme in the last block
+    assert 140 in {int(np.argmax(v)) // n for v in (axial, shear)}

@@ -54,37 +54,56 @@ class StabilityWarning(UserWarning):
     """A static state is unstable, or the cable snapped through."""
 
 
-def strains(c: CableResult) -> tuple[np.ndarray, np.ndarray]:
+def strains(c: CableResult, steps: slice = slice(None)) -> tuple[np.ndarray, np.ndarray]:
     """Axial strain Γ₃ and shear strain |(Γ₁, Γ₂)| per step and edge (T, N) from the saved
     configuration, Γ = Rᵀ (x_{n+1} − x_n)/Δs − e₃ (the model's strain; unlike F/EA it holds no
-    damping forces in dynamic runs)."""
-    from cablelife.export.frames import rotation_matrices
-
-    t, n = c.quaternions.shape[:2]
+    damping forces in dynamic runs); of the saved ``steps`` only."""
+    t, n = c.quaternions[steps].shape[:2]
     if t == 0 or n == 0:
         return np.zeros((t, n)), np.zeros((t, n))
-    tangent = np.diff(c.positions, axis=1) / np.diff(c.arc_length)[None, :, None]
-    gamma = np.einsum("...ji,...j->...i", rotation_matrices(c.quaternions), tangent)  # Rᵀ t
-    return gamma[..., 2] - 1.0, np.hypot(gamma[..., 0], gamma[..., 1])
+    x = np.asarray(c.positions[steps], dtype=float)
+    inv_ds = 1.0 / np.diff(c.arc_length)[None, :]
+    # Rᵀ v = v + (2/|p|²)(u × (u × v) − w u × v) for p = (w, u): the rotation matrices of
+    # every step and edge are never formed (a dynamic run saves 1000s of steps: this was 20 %
+    # of simulate() on bench_harness.py).
+    p = np.asarray(c.quaternions[steps], dtype=float)
+    w, ux, uy, uz = (p[..., k] for k in range(4))
+    k = 2.0 / (w * w + ux * ux + uy * uy + uz * uz)
+    vx, vy, vz = ((x[:, 1:, i] - x[:, :-1, i]) * inv_ds for i in range(3))
+    cx, cy, cz = uy * vz - uz * vy, uz * vx - ux * vz, ux * vy - uy * vx  # u × v
+    gx = vx + k * (uy * cz - uz * cy - w * cx)
+    gy = vy + k * (uz * cx - ux * cz - w * cy)
+    gz = vz + k * (ux * cy - uy * cx - w * cz)
+    return gz - 1.0, np.hypot(gx, gy)
 
 
-def _largest(values: np.ndarray, c: CableResult) -> dict:
-    """The largest entry of (T, N) edge values with its time and arc length (edge midpoint)."""
-    if values.size == 0:
-        return {"value": 0.0, "s": float("nan"), "t": float("nan")}
-    k, e = np.unravel_index(int(np.argmax(values)), values.shape)
-    mid = 0.5 * (c.arc_length[e] + c.arc_length[e + 1])
-    return {"value": float(values[k, e]), "s": float(mid), "t": float(c.time[k])}
+#: Saved steps per block of the strain scan (its temporaries stay in the cache).
+_STRAIN_BLOCK = 64
 
 
 def strain_extremes(c: CableResult) -> dict:
     """Largest tensile, compressive and shear strains with where (s) and when (t)."""
-    axial, shear = strains(c)
-    return {
-        "axial": _largest(axial, c),
-        "compression": {**(d := _largest(-axial, c)), "value": -d["value"]},
-        "shear": _largest(shear, c),
-    }
+    t = c.quaternions.shape[0]
+    best: dict[str, tuple[float, int, int]] = {}  # key: (value, step, edge), first largest
+    for start in range(0, t, _STRAIN_BLOCK):
+        axial, shear = strains(c, slice(start, start + _STRAIN_BLOCK))
+        if axial.size == 0:
+            break
+        for key, values in (("axial", axial), ("compression", -axial), ("shear", shear)):
+            k, e = np.unravel_index(int(np.argmax(values)), values.shape)
+            v = values[k, e]  # NaN first, as argmax does
+            if key not in best or v > best[key][0] or (np.isnan(v) and not np.isnan(best[key][0])):
+                best[key] = (float(values[k, e]), start + int(k), int(e))
+    out = {}
+    for key in ("axial", "compression", "shear"):
+        if key not in best:
+            out[key] = {"value": 0.0, "s": float("nan"), "t": float("nan")}
+            continue
+        value, k, e = best[key]
+        mid = 0.5 * (c.arc_length[e] + c.arc_length[e + 1])
+        out[key] = {"value": value, "s": float(mid), "t": float(c.time[k])}
+    out["compression"]["value"] = -out["compression"]["value"]
+    return out
 
 
 def strain_violations(c: CableResult) -> list[str]:
