@@ -418,19 +418,25 @@ impl HarnessDynamics {
         self.jvdot_n.clone_from(&self.jvdot);
         self.ja_n.clone_from(&self.ja);
         self.end_motions(h, st, clips);
+        let restarted = self.cables.iter().any(|d| d.restarted);
         for (c, rod) in h.cables.iter().enumerate() {
             self.cables[c].begin_step(rod, &mut st.cables[c], dt, &self.motions[c]);
         }
-        // The junctions: the cables' predictor and kinematics.
-        let c_a =
-            ((1.0 - ga.alpha_m) * (-(0.5 - ga.beta) / ga.beta) + ga.alpha_m) / (1.0 - ga.alpha_f);
-        let c_v = -ga.alpha_f / (1.0 - ga.alpha_f);
+        // The junctions: the cables' predictor (v̇_{n+1} = v̇_n: jvdot holds it; constant
+        // velocity after a restart) and kinematics.
+        if restarted {
+            let c_a = ((1.0 - ga.alpha_m) * (-(0.5 - ga.beta) / ga.beta) + ga.alpha_m)
+                / (1.0 - ga.alpha_f);
+            let c_v = -ga.alpha_f / (1.0 - ga.alpha_f);
+            for j in 0..self.jv.len() {
+                self.jvdot[j] = c_a * self.ja_n[j] + c_v * self.jvdot_n[j];
+            }
+        }
         let (c_vn, c_an) = (
             ga.alpha_f / (1.0 - ga.alpha_m),
             -ga.alpha_m / (1.0 - ga.alpha_m),
         );
         for j in 0..self.jv.len() {
-            self.jvdot[j] = c_a * self.ja_n[j] + c_v * self.jvdot_n[j];
             let a0 = c_vn * self.jvdot_n[j] + c_an * self.ja_n[j];
             self.ja0[j] = a0;
             self.jdq0[j] = self.jv_n[j] + dt * (0.5 - ga.beta) * self.ja_n[j] + dt * ga.beta * a0;
@@ -482,8 +488,28 @@ impl HarnessDynamics {
     }
 
     /// Advances from t_n to t_n + dt with the clips at their kinematics at t_{n+1}
-    /// (`clips[c]`: every clip of cable c; the held ends' entries are ignored).
+    /// (`clips[c]`: every clip of cable c; the held ends' entries are ignored). A step that
+    /// fails from the constant-acceleration predictor is done again from constant velocity
+    /// (as `Dynamics::step`).
     pub fn step(
+        &mut self,
+        h: &Harness,
+        st: &mut HarnessState,
+        dt: f64,
+        clips: &[Vec<ClipMotion>],
+    ) -> Result<StepStats, HarnessError> {
+        let from_acceleration = !self.cables.iter().any(|d| d.restarted);
+        match self.step_once(h, st, dt, clips) {
+            Err(_) if from_acceleration => {
+                self.rollback(st); // the next try predicts constant velocity
+                self.sync_ends(h, st);
+                self.step_once(h, st, dt, clips)
+            }
+            r => r,
+        }
+    }
+
+    fn step_once(
         &mut self,
         h: &Harness,
         st: &mut HarnessState,
