@@ -74,7 +74,7 @@ def strains(c: CableResult, steps: slice = slice(None)) -> tuple[np.ndarray, np.
     gx = vx + k * (uy * cz - uz * cy - w * cx)
     gy = vy + k * (uz * cx - ux * cz - w * cy)
     gz = vz + k * (ux * cy - uy * cx - w * cz)
-    return gz - 1.0, np.hypot(gx, gy)
+    return gz - 1.0, np.sqrt(gx * gx + gy * gy)  # (np.hypot: 3× slower, guards overflow)
 
 
 #: Saved steps per block of the strain scan (its temporaries stay in the cache).

@@ -1078,11 +1078,13 @@ impl Dynamics {
     /// (in `ws`) and the energies (the dissipated energy is integrated by `step` itself, with
     /// the power at the last Newton iterate).
     pub fn update_outputs(&mut self, rod: &Rod, st: &State) -> Result<(), SolveError> {
-        self.assemble(rod, st, 0.0, 0.0, false, Part::All)
-            .map_err(|k| SolveError::Kink {
-                node: k.node,
-                s: rod.arc[k.node],
-            })?;
+        let keep = std::mem::replace(&mut self.ws.section_outputs, true);
+        let assembled = self.assemble(rod, st, 0.0, 0.0, false, Part::All);
+        self.ws.section_outputs = keep;
+        assembled.map_err(|k| SolveError::Kink {
+            node: k.node,
+            s: rod.arc[k.node],
+        })?;
         self.energies.elastic = self.ws.elastic_energy;
         self.energies.load_potential = self.ws.load_potential;
         self.energies.contact = self.ws.contact_energy;

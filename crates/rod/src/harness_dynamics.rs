@@ -112,6 +112,9 @@ impl HarnessDynamics {
                 &hd.motions[c],
                 opts.clone(),
             ));
+            // Section outputs only in `update_outputs` (the Newton iterations assemble whole
+            // cables).
+            hd.cables[c].ws.section_outputs = false;
         }
         hd
     }
