@@ -180,7 +180,8 @@ class Harness:
         `tau_bend[c]` (3 each). Returns what `run_sequence` returns, the cables' dicts with the
         energies of `Cable.run_dynamic`, and `junction_velocities` (T, J, 6: ẋ global, ω body),
         `kinetic_energy`, `elastic_energy`, `load_potential`, `dissipated_energy` (T,) of the
-        whole harness (junctions included).
+        whole harness (junctions included). Junctions held by a clip follow its motion (given
+        for their first end); sliding clips slide (a cable running out of one stops the run).
         """
         ...
 

@@ -165,7 +165,9 @@ def harness_equilibrium(scene: Scene):
 
 def run_harness(scene: Scene, times: np.ndarray, mode: str, progress, stop):
     """Runs a harness scene (static, quasistatic or dynamic). Returns the cable results (by
-    name), the junction results (by name) and the error message (None: complete)."""
+    name), the junction results (by name), the error message (None: complete) and the
+    harness's total energies (dynamic runs: ``time`` and the energies (T,) of all cables and
+    junctions; else empty)."""
     from cablelife import _core
     from cablelife.scene import SceneError
     from cablelife.simulate import (
@@ -186,20 +188,6 @@ def run_harness(scene: Scene, times: np.ndarray, mode: str, progress, stop):
             "contact with the geometry is not supported yet for harnesses (scenes with "
             "[[junctions]]); remove [contact] or the junctions"
         )
-    if mode == "dynamic":
-        held = [j.name for j in scene.junctions if j.clip is not None]
-        sliding = [(c.name, k.name) for c in scene.cables for k in c.clips if k.type == "sliding"]
-        if held:
-            raise SceneError(
-                f"junction '{held[0]}' is held by a clip: dynamic analysis of harnesses with "
-                "held junctions is not supported yet; allowed: static and quasistatic"
-            )
-        if sliding:
-            raise SceneError(
-                f"cable '{sliding[0][0]}': sliding clip '{sliding[0][1]}' on a harness: dynamic "
-                "analysis of harnesses with sliding clips is not supported yet; allowed: static "
-                "and quasistatic, or a fixed/hinge clip there"
-            )
     cables, specs = harness_cables(scene)
     cores = [build_cable(scene, c) for c in cables]
     try:
@@ -340,7 +328,23 @@ def run_harness(scene: Scene, times: np.ndarray, mode: str, progress, stop):
             if j.clip is None
             else out["junction_reaction_moment"][:, jj].copy(),
         )
-    return results, junctions, out["error"]
+        if mode == "dynamic":
+            v = out["junction_velocities"][:, jj]
+            junctions[j.name].velocity = v[:, :3].copy()
+            junctions[j.name].angular_velocity = rotate(junctions[j.name].quaternion, v[:, 3:])
+    energies: dict[str, np.ndarray] = {}
+    if mode == "dynamic":
+        energies = {"time": saved.copy()}
+        for key in ("kinetic_energy", "elastic_energy", "load_potential", "dissipated_energy"):
+            energies[key] = np.asarray(out[key], float)
+    return results, junctions, out["error"], energies
+
+
+def rotate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Vectors v (T, 3) turned by the unit quaternions q (T, 4, scalar first)."""
+    w, u = q[:, :1], q[:, 1:]
+    t = 2.0 * np.cross(u, v)
+    return v + w * t + np.cross(u, t)
 
 
 def junction_table(result):
