@@ -283,6 +283,8 @@ def run_harness(scene: Scene, times: np.ndarray, mode: str, progress, stop):
                 tau_shear=np.array(tau_shear),
                 tau_bend=np.array(tau_bend),
                 damping_source=info["source"],
+                damping_ratio=info.get("ratio", float("nan")),
+                omega1=info.get("omega1", float("nan")),  # the whole harness's first mode
                 viscous_peak=np.asarray(o["viscous_peak"]),
             )
             energies.update(
