@@ -8,7 +8,7 @@ import pytest
 from cablelife.results import load_result
 from cablelife.scene import SceneError, scene_from_dict
 from cablelife.simulate import simulate
-from test_harness import C30, S30, y_scene
+from test_harness import C30, MATERIAL, S30, SECTION, y_scene
 
 
 def test_sliding_clip_on_a_branch_slides_and_its_slid_length_is_saved(tmp_path):
@@ -217,3 +217,92 @@ def test_the_example_harness_runs_dynamically_with_its_sliding_guide_and_a_held_
     np.testing.assert_allclose(j.velocity, 0.0, atol=1e-15)
     for cable in result.cables.values():
         assert np.isfinite(cable.positions).all() and len(cable.time) == 11
+
+
+def collinear_pair(normals=None) -> dict:
+    """Two straight cables along x joined at the origin, clamped at their far ends with the
+    normal z; no gravity: the stress-free state, if the junction imposes no twist."""
+
+    def cable(name, s, x):
+        clip = {"name": f"{name}-clamp", "s": s, "position": [x, 0.0, 0.0]}
+        clip.update(direction=[1.0, 0.0, 0.0], normal=[0.0, 0.0, 1.0])
+        return {
+            "name": name,
+            "length": 0.5,
+            "segments": 20,
+            "section": SECTION,
+            "material": MATERIAL,
+            "clips": [clip],
+        }
+
+    junction = {"name": "j", "ends": ["a:end", "b:start"], "position": [0.0, 0.0, 0.0]}
+    junction["directions"] = [[-1.0, 0.0, 0.0], [1.0, 0.0, 0.0]]
+    if normals is not None:
+        junction["normals"] = normals
+    return {
+        "simulation": {"mode": "static", "gravity": [0.0, 0.0, 0.0]},
+        "cables": [cable("a", 0.0, -0.5), cable("b", 0.5, 0.5)],
+        "junctions": [junction],
+    }
+
+
+def test_default_junction_normals_come_from_the_routed_geometry():
+    from cablelife.harness import end_clip_name, harness_cables
+
+    scene = scene_from_dict(collinear_pair())
+    cables, _ = harness_cables(scene)
+    name = end_clip_name(scene.junctions[0])
+    for c in cables:
+        (end,) = [k for k in c.clips if k.name == name]
+        # The clamps' normal z carried along the straight cable: z (the clip rule would give
+        # y, the axis least aligned with x: a quarter turn of twist at the junction).
+        np.testing.assert_allclose(end.normal, [0.0, 0.0, 1.0], atol=1e-12)
+    result = simulate(scene)
+    for c in result.cables.values():
+        assert np.abs(c.moments).max() < 1e-9 and np.abs(c.forces).max() < 1e-9
+    # Given normals are kept: y on one end and z on the other twist the pair by a quarter
+    # turn at the junction.
+    twisted = simulate(scene_from_dict(collinear_pair([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0]])))
+    gj = np.abs(twisted.cables["a"].moments[..., 2]).max()
+    assert gj > 1e-3, gj
+
+
+def test_workbench_keeps_default_junction_normals_when_clips_move(tmp_path):
+    """The default normals follow the routed geometry, which moves with the clips: the
+    workbench keeps the ones in effect as opened (drags, rebuilds) and writes them on save, so
+    that the saved scene solves to what the workbench shows."""
+    import re
+    from pathlib import Path
+
+    from cablelife.scene import load_scene
+    from cablelife.workbench.session import Session
+
+    text = (Path(__file__).parents[1] / "examples/harness/scene.toml").read_text()
+    text = re.sub(r"(?m)^normals = .*\n", "", text)
+    path = tmp_path / "harness.toml"
+    path.write_text(text)
+    session = Session.open(path)
+    opened = session.junction_pins["breakout"]
+    p0 = np.array([0.8, 0.15, -0.05])
+    for k in range(1, 11):
+        p = p0 + 0.003 * k * np.array([0.0, 1.0, 1.0])
+        errors = session.move_clips(
+            [{"cable": "engine", "clip": "engine-bracket", "position": p.tolist()}]
+        )
+        assert errors == {"engine": ""}
+    out = session.save(tmp_path / "saved.toml")
+    saved = load_scene(out)
+    np.testing.assert_array_equal(np.array(saved.junctions[0].normals), np.array(opened))
+    # The moved scene without the pins would get other normals (the engine branch's route
+    # changed): the pins matter.
+    from cablelife.harness import junction_normals
+
+    moved = junction_normals(
+        saved.model_copy(
+            update={"junctions": [saved.junctions[0].model_copy(update={"normals": None})]}
+        )
+    )["breakout"]
+    assert np.abs(np.array(moved) - np.array(opened)).max() > 1e-6
+    batch = simulate(saved, mode="static")
+    for name, live in session.cables.items():
+        assert np.abs(live.state.positions - batch.cables[name].positions[0]).max() < 1e-9, name

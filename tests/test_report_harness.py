@@ -71,7 +71,7 @@ def test_example_has_every_clip_type_and_its_results(example):
     from cablelife.simulate import clip_kinematics, simulate
 
     scene = result_scene(res.scene_toml)
-    sim = scene.simulation.model_copy(update={"mode": "quasistatic", "time_step": 0.025})
+    sim = scene.simulation.model_copy(update={"mode": "quasistatic", "time_step": 0.005})
     scene = scene.model_copy(update={"simulation": sim})
     engine = simulate(scene).cables["engine"]
     spec = next(c for c in scene.cables if c.name == "engine")

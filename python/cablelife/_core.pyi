@@ -49,6 +49,12 @@ class Cable:
         ...
     @property
     def node_mass(self) -> Any: ...
+    def transported_normal(self, from_clip, to_clip) -> Any:
+        """The normal (d1, global) of clip `to_clip` when the frame of clip `from_clip` is
+        carried along the routed reference centreline to it without twist (parallel
+        transport): the default normal of a junction's end (docs/harness.md).
+        """
+        ...
     def run_dynamic(
         self,
         time_step,

@@ -136,7 +136,54 @@ def harness_cables(scene: Scene) -> tuple[list[Cable], list[tuple]]:
         c.model_copy(update={"clips": [*c.clips, *extra[c.name]]}) if extra[c.name] else c
         for c in scene.cables
     ]
+    given = {end_clip_name(j) for j in scene.junctions if j.normals is not None}
+    for k, c in enumerate(cables):
+        open_ends = [
+            e
+            for e, clip in enumerate(c.clips)
+            if e >= len(scene.cables[k].clips) and clip.name not in given
+        ]
+        if open_ends:
+            cables[k] = default_normals(scene, c, len(scene.cables[k].clips), given, open_ends)
     return cables, specs
+
+
+def junction_normals(scene: Scene) -> dict[str, list[list[float]]]:
+    """The normals in effect (d1 of each end, global) of the junctions without ``normals``,
+    by name: what a tool that edits the scene writes into it to keep the junctions'
+    stress-free twist when it moves clips (the workbench)."""
+    from cablelife.simulate import frame_matrix
+
+    cables, _ = harness_cables(scene)
+    clips = {(c.name, k.name): k for c in cables for k in c.clips}
+    out = {}
+    for j in scene.junctions:
+        if j.normals is None:
+            ends = [clips[(j.end(i)[0], end_clip_name(j))] for i in range(len(j.ends))]
+            out[j.name] = [
+                [float(v) for v in frame_matrix(e.direction, e.normal)[:, 0]] for e in ends
+            ]
+    return out
+
+
+def default_normals(scene: Scene, cable: Cable, n_own: int, given: set, ends: list[int]) -> Cable:
+    """``cable`` with the normals of its joined-end clips ``ends`` (junctions without
+    ``normals``) taken from the routed reference geometry: the frame of the nearest clip of
+    the cable whose frame is given (its own clips, or ends of junctions with ``normals``)
+    carried along the routed centreline without twist (parallel transport). Without such a
+    clip (a cable held only at junctions without normals) the clip rule stays."""
+    from cablelife.simulate import build_cable
+
+    sources = [k for k, clip in enumerate(cable.clips) if k < n_own or clip.name in given]
+    if not sources:
+        return cable
+    core = build_cable(scene, cable)
+    clips = list(cable.clips)
+    for e in ends:
+        src = min(sources, key=lambda k: abs(cable.clips[k].s - cable.clips[e].s))
+        normal = core.transported_normal(src, e)
+        clips[e] = clips[e].model_copy(update={"normal": tuple(float(v) for v in normal)})
+    return cable.model_copy(update={"clips": clips})
 
 
 def harness_equilibrium(scene: Scene):
