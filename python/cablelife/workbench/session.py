@@ -576,16 +576,16 @@ class Session:
         if not target.parent.is_dir():
             raise WorkbenchError(f"save to {str(target)!r}: the folder does not exist")
         with self.lock:
-            text = self.doc.as_string()
-            if self.junction_pins:
+            doc = self.doc
+            if self.junction_pins:  # written into a copy (undo keeps the document as opened)
                 import tomlkit
 
-                doc = tomlkit.parse(text)
+                doc = tomlkit.parse(doc.as_string())
                 for entry in doc["junctions"]:
                     if "normals" not in entry and str(entry["name"]) in self.junction_pins:
                         entry["normals"] = self.junction_pins[str(entry["name"])]
-                text = doc.as_string()
-            scene_from_dict(tomlkit_loads(text), base_dir=target.parent.resolve())
+            text = doc.as_string()
+            scene_from_dict(doc.unwrap(), base_dir=target.parent.resolve())
             write_text_atomic(target, text)
         load_scene(target)  # round trip
         return target
@@ -864,10 +864,3 @@ def pinned(scene: Scene, pins: dict) -> Scene:
         for j in scene.junctions
     ]
     return scene.model_copy(update={"junctions": junctions})
-
-
-def tomlkit_loads(text: str) -> dict:
-    """The plain data of a TOML text."""
-    import tomllib
-
-    return tomllib.loads(text)
