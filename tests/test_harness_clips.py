@@ -8,7 +8,7 @@ import pytest
 from cablelife.results import load_result
 from cablelife.scene import SceneError, scene_from_dict
 from cablelife.simulate import simulate
-from test_harness import C30, S30, y_scene
+from test_harness import C30, MATERIAL, S30, SECTION, y_scene
 
 
 def test_sliding_clip_on_a_branch_slides_and_its_slid_length_is_saved(tmp_path):
@@ -130,24 +130,179 @@ def test_a_junction_clip_holds_a_harness_without_other_clips():
     np.testing.assert_allclose(j.reaction_force[0], [0, 0, w], rtol=1e-8, atol=1e-9 * w)
 
 
-def test_dynamic_harness_with_sliding_clips_or_held_junctions_is_a_clear_error():
-    """Dynamic harness runs have no sliding term and no held junctions yet: named errors."""
+def test_dynamic_harness_with_a_sliding_clip_and_a_held_junction(tmp_path):
+    """The junction follows its clip's body (2 mm at 10 Hz along z), its velocity and the
+    harness energies are saved; the clip accelerates the junction against its branch loads
+    and weight; branch a slides through a frictionless guide."""
+    scene = held_y("dynamic", duration=0.05, time_step=0.001)
+    w = 2 * np.pi * 10.0
+    scene["bodies"][0]["motion"] = [
+        {"channel": "z", "signal": {"type": "sine", "amplitude": 0.002, "frequency": 10.0}}
+    ]
+    scene["cables"][1]["clips"].append(
+        {
+            "name": "guide",
+            "type": "sliding",
+            "s": 0.2,
+            "length": 0.06,
+            "position": [0.2 * C30, 0.2 * S30, 0.0],
+            "direction": [C30, S30, 0.0],
+            "normal": [0.0, 0.0, 1.0],
+        }
+    )
+    result = simulate(scene_from_dict(scene))
+    assert result.complete, result.message
+    j = result.junctions["y"]
+    t = j.time
+    assert t.size == 51
+    np.testing.assert_allclose(j.position[:, 2], 0.002 * np.sin(w * t), atol=1e-12)
+    np.testing.assert_allclose(j.velocity[:, 2], 0.002 * w * np.cos(w * t), atol=1e-9)
+    np.testing.assert_allclose(j.velocity[:, :2], 0.0, atol=1e-12)
+    np.testing.assert_allclose(j.angular_velocity, 0.0, atol=1e-12)
+    # The junction (0.02 kg): clip reaction + branch forces + weight = m a.
+    mass = 0.02
+    acc = np.zeros((t.size, 3))
+    acc[:, 2] = -0.002 * w * w * np.sin(w * t)
+    fj = sum(j.branch_force.values()) + j.reaction_force + [0.0, 0.0, -9.81 * mass]
+    scale = np.abs(j.reaction_force).max()
+    assert scale > 0.01
+    np.testing.assert_allclose(fj, mass * acc, atol=1e-8 * scale)
+    mj = sum(j.branch_moment.values()) + j.reaction_moment
+    np.testing.assert_allclose(mj, 0.0, atol=1e-8 * scale)
+    slid = result.cables["a"].clips["guide"].slid_length
+    assert slid.shape == (51,) and np.isfinite(slid).all() and np.abs(slid).max() > 0.0
+    e = result.harness_energies
+    assert set(e) == {
+        "time",
+        "kinetic_energy",
+        "elastic_energy",
+        "load_potential",
+        "dissipated_energy",
+    }
+    np.testing.assert_array_equal(e["time"], t)
+    assert e["kinetic_energy"].max() > 0.0 and np.isfinite(e["elastic_energy"]).all()
+    # The harness's kinetic energy covers its cables (whose ends move with the junction) and
+    # the junction's own mass.
+    cables = sum(c.energies["kinetic_energy"] for c in result.cables.values())
+    np.testing.assert_allclose(
+        e["kinetic_energy"], cables + 0.5 * mass * (j.velocity**2).sum(axis=1), rtol=1e-12
+    )
+    back = load_result(result.save(tmp_path / "dyn.h5"))
+    bj = back.junctions["y"]
+    np.testing.assert_array_equal(bj.velocity, j.velocity)
+    np.testing.assert_array_equal(bj.angular_velocity, j.angular_velocity)
+    np.testing.assert_array_equal(bj.reaction_force, j.reaction_force)
+    for key, value in e.items():
+        np.testing.assert_array_equal(back.harness_energies[key], value)
+    static = simulate(scene_from_dict(held_y()))
+    assert static.harness_energies == {} and static.junctions["y"].velocity is None
+
+
+def test_the_example_harness_runs_dynamically_with_its_sliding_guide_and_a_held_breakout():
     import tomllib
     from pathlib import Path
 
     d = tomllib.loads((Path(__file__).parents[1] / "examples/harness/scene.toml").read_text())
     d["simulation"].update(mode="dynamic", duration=0.01, time_step=0.001)
-    with pytest.raises(SceneError, match=r"sliding clip '.*' on a harness: dynamic analysis"):
-        simulate(scene_from_dict(d))
-    for c in d["cables"]:
-        for k in c["clips"]:
-            k.pop("friction", None)
-            if k.get("type") == "sliding":
-                k["type"], k["length"] = "fixed", 0.0
+    motion = d["bodies"][0]["motion"]
+    motion[:] = [m for m in motion if m["signal"]["type"] != "psd"]  # needs ≥ 0.2 s
+    result = simulate(scene_from_dict(d))
+    assert result.complete, result.message
+    assert np.isfinite(result.cables["trunk"].clips["trunk-guide"].slid_length).all()
     d["junctions"][0]["clip"] = {"body": "world", "name": "tape"}
-    with pytest.raises(SceneError, match="junction 'breakout' is held by a clip: dynamic"):
-        simulate(scene_from_dict(d))
-    del d["junctions"][0]["clip"]
-    result = simulate(scene_from_dict(d))  # without them the example runs dynamically
+    result = simulate(scene_from_dict(d))
+    assert result.complete, result.message
+    j = result.junctions["breakout"]
+    np.testing.assert_allclose(j.position, [[0.4, 0.0, 0.0]] * 11, atol=1e-15)
+    np.testing.assert_allclose(j.velocity, 0.0, atol=1e-15)
     for cable in result.cables.values():
         assert np.isfinite(cable.positions).all() and len(cable.time) == 11
+
+
+def collinear_pair(normals=None) -> dict:
+    """Two straight cables along x joined at the origin, clamped at their far ends with the
+    normal z; no gravity: the stress-free state, if the junction imposes no twist."""
+
+    def cable(name, s, x):
+        clip = {"name": f"{name}-clamp", "s": s, "position": [x, 0.0, 0.0]}
+        clip.update(direction=[1.0, 0.0, 0.0], normal=[0.0, 0.0, 1.0])
+        return {
+            "name": name,
+            "length": 0.5,
+            "segments": 20,
+            "section": SECTION,
+            "material": MATERIAL,
+            "clips": [clip],
+        }
+
+    junction = {"name": "j", "ends": ["a:end", "b:start"], "position": [0.0, 0.0, 0.0]}
+    junction["directions"] = [[-1.0, 0.0, 0.0], [1.0, 0.0, 0.0]]
+    if normals is not None:
+        junction["normals"] = normals
+    return {
+        "simulation": {"mode": "static", "gravity": [0.0, 0.0, 0.0]},
+        "cables": [cable("a", 0.0, -0.5), cable("b", 0.5, 0.5)],
+        "junctions": [junction],
+    }
+
+
+def test_default_junction_normals_come_from_the_routed_geometry():
+    from cablelife.harness import end_clip_name, harness_cables
+
+    scene = scene_from_dict(collinear_pair())
+    cables, _ = harness_cables(scene)
+    name = end_clip_name(scene.junctions[0])
+    for c in cables:
+        (end,) = [k for k in c.clips if k.name == name]
+        # The clamps' normal z carried along the straight cable: z (the clip rule would give
+        # y, the axis least aligned with x: a quarter turn of twist at the junction).
+        np.testing.assert_allclose(end.normal, [0.0, 0.0, 1.0], atol=1e-12)
+    result = simulate(scene)
+    for c in result.cables.values():
+        assert np.abs(c.moments).max() < 1e-9 and np.abs(c.forces).max() < 1e-9
+    # Given normals are kept: y on one end and z on the other twist the pair by a quarter
+    # turn at the junction.
+    twisted = simulate(scene_from_dict(collinear_pair([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0]])))
+    gj = np.abs(twisted.cables["a"].moments[..., 2]).max()
+    assert gj > 1e-3, gj
+
+
+def test_workbench_keeps_default_junction_normals_when_clips_move(tmp_path):
+    """The default normals follow the routed geometry, which moves with the clips: the
+    workbench keeps the ones in effect as opened (drags, rebuilds) and writes them on save, so
+    that the saved scene solves to what the workbench shows."""
+    import re
+    from pathlib import Path
+
+    from cablelife.scene import load_scene
+    from cablelife.workbench.session import Session
+
+    text = (Path(__file__).parents[1] / "examples/harness/scene.toml").read_text()
+    text = re.sub(r"(?m)^normals = .*\n", "", text)
+    path = tmp_path / "harness.toml"
+    path.write_text(text)
+    session = Session.open(path)
+    opened = session.junction_pins["breakout"]
+    p0 = np.array([0.8, 0.15, -0.05])
+    for k in range(1, 11):
+        p = p0 + 0.003 * k * np.array([0.0, 1.0, 1.0])
+        errors = session.move_clips(
+            [{"cable": "engine", "clip": "engine-bracket", "position": p.tolist()}]
+        )
+        assert errors == {"engine": ""}
+    out = session.save(tmp_path / "saved.toml")
+    saved = load_scene(out)
+    np.testing.assert_array_equal(np.array(saved.junctions[0].normals), np.array(opened))
+    # The moved scene without the pins would get other normals (the engine branch's route
+    # changed): the pins matter.
+    from cablelife.harness import junction_normals
+
+    moved = junction_normals(
+        saved.model_copy(
+            update={"junctions": [saved.junctions[0].model_copy(update={"normals": None})]}
+        )
+    )["breakout"]
+    assert np.abs(np.array(moved) - np.array(opened)).max() > 1e-6
+    batch = simulate(saved, mode="static")
+    for name, live in session.cables.items():
+        assert np.abs(live.state.positions - batch.cables[name].positions[0]).max() < 1e-9, name

@@ -49,6 +49,12 @@ class Cable:
         ...
     @property
     def node_mass(self) -> Any: ...
+    def transported_normal(self, from_clip, to_clip) -> Any:
+        """The normal (d1, global) of clip `to_clip` when the frame of clip `from_clip` is
+        carried along the routed reference centreline to it without twist (parallel
+        transport): the default normal of a junction's end (docs/harness.md).
+        """
+        ...
     def run_dynamic(
         self,
         time_step,
@@ -180,7 +186,8 @@ class Harness:
         `tau_bend[c]` (3 each). Returns what `run_sequence` returns, the cables' dicts with the
         energies of `Cable.run_dynamic`, and `junction_velocities` (T, J, 6: ẋ global, ω body),
         `kinetic_energy`, `elastic_energy`, `load_potential`, `dissipated_energy` (T,) of the
-        whole harness (junctions included).
+        whole harness (junctions included). Junctions held by a clip follow its motion (given
+        for their first end); sliding clips slide (a cable running out of one stops the run).
         """
         ...
 

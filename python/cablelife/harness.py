@@ -136,7 +136,54 @@ def harness_cables(scene: Scene) -> tuple[list[Cable], list[tuple]]:
         c.model_copy(update={"clips": [*c.clips, *extra[c.name]]}) if extra[c.name] else c
         for c in scene.cables
     ]
+    given = {end_clip_name(j) for j in scene.junctions if j.normals is not None}
+    for k, c in enumerate(cables):
+        open_ends = [
+            e
+            for e, clip in enumerate(c.clips)
+            if e >= len(scene.cables[k].clips) and clip.name not in given
+        ]
+        if open_ends:
+            cables[k] = default_normals(scene, c, len(scene.cables[k].clips), given, open_ends)
     return cables, specs
+
+
+def junction_normals(scene: Scene) -> dict[str, list[list[float]]]:
+    """The normals in effect (d1 of each end, global) of the junctions without ``normals``,
+    by name: what a tool that edits the scene writes into it to keep the junctions'
+    stress-free twist when it moves clips (the workbench)."""
+    from cablelife.simulate import frame_matrix
+
+    cables, _ = harness_cables(scene)
+    clips = {(c.name, k.name): k for c in cables for k in c.clips}
+    out = {}
+    for j in scene.junctions:
+        if j.normals is None:
+            ends = [clips[(j.end(i)[0], end_clip_name(j))] for i in range(len(j.ends))]
+            out[j.name] = [
+                [float(v) for v in frame_matrix(e.direction, e.normal)[:, 0]] for e in ends
+            ]
+    return out
+
+
+def default_normals(scene: Scene, cable: Cable, n_own: int, given: set, ends: list[int]) -> Cable:
+    """``cable`` with the normals of its joined-end clips ``ends`` (junctions without
+    ``normals``) taken from the routed reference geometry: the frame of the nearest clip of
+    the cable whose frame is given (its own clips, or ends of junctions with ``normals``)
+    carried along the routed centreline without twist (parallel transport). Without such a
+    clip (a cable held only at junctions without normals) the clip rule stays."""
+    from cablelife.simulate import build_cable
+
+    sources = [k for k, clip in enumerate(cable.clips) if k < n_own or clip.name in given]
+    if not sources:
+        return cable
+    core = build_cable(scene, cable)
+    clips = list(cable.clips)
+    for e in ends:
+        src = min(sources, key=lambda k: abs(cable.clips[k].s - cable.clips[e].s))
+        normal = core.transported_normal(src, e)
+        clips[e] = clips[e].model_copy(update={"normal": tuple(float(v) for v in normal)})
+    return cable.model_copy(update={"clips": clips})
 
 
 def harness_equilibrium(scene: Scene):
@@ -165,7 +212,9 @@ def harness_equilibrium(scene: Scene):
 
 def run_harness(scene: Scene, times: np.ndarray, mode: str, progress, stop):
     """Runs a harness scene (static, quasistatic or dynamic). Returns the cable results (by
-    name), the junction results (by name) and the error message (None: complete)."""
+    name), the junction results (by name), the error message (None: complete) and the
+    harness's total energies (dynamic runs: ``time`` and the energies (T,) of all cables and
+    junctions; else empty)."""
     from cablelife import _core
     from cablelife.scene import SceneError
     from cablelife.simulate import (
@@ -186,20 +235,6 @@ def run_harness(scene: Scene, times: np.ndarray, mode: str, progress, stop):
             "contact with the geometry is not supported yet for harnesses (scenes with "
             "[[junctions]]); remove [contact] or the junctions"
         )
-    if mode == "dynamic":
-        held = [j.name for j in scene.junctions if j.clip is not None]
-        sliding = [(c.name, k.name) for c in scene.cables for k in c.clips if k.type == "sliding"]
-        if held:
-            raise SceneError(
-                f"junction '{held[0]}' is held by a clip: dynamic analysis of harnesses with "
-                "held junctions is not supported yet; allowed: static and quasistatic"
-            )
-        if sliding:
-            raise SceneError(
-                f"cable '{sliding[0][0]}': sliding clip '{sliding[0][1]}' on a harness: dynamic "
-                "analysis of harnesses with sliding clips is not supported yet; allowed: static "
-                "and quasistatic, or a fixed/hinge clip there"
-            )
     cables, specs = harness_cables(scene)
     cores = [build_cable(scene, c) for c in cables]
     try:
@@ -301,6 +336,8 @@ def run_harness(scene: Scene, times: np.ndarray, mode: str, progress, stop):
                 tau_shear=np.array(tau_shear),
                 tau_bend=np.array(tau_bend),
                 damping_source=info["source"],
+                damping_ratio=info.get("ratio", float("nan")),
+                omega1=info.get("omega1", float("nan")),  # the whole harness's first mode
                 viscous_peak=np.asarray(o["viscous_peak"]),
             )
             energies.update(
@@ -346,7 +383,23 @@ def run_harness(scene: Scene, times: np.ndarray, mode: str, progress, stop):
             if j.clip is None
             else out["junction_reaction_moment"][:, jj].copy(),
         )
-    return results, junctions, out["error"]
+        if mode == "dynamic":
+            v = out["junction_velocities"][:, jj]
+            junctions[j.name].velocity = v[:, :3].copy()
+            junctions[j.name].angular_velocity = rotate(junctions[j.name].quaternion, v[:, 3:])
+    energies: dict[str, np.ndarray] = {}
+    if mode == "dynamic":
+        energies = {"time": saved.copy()}
+        for key in ("kinetic_energy", "elastic_energy", "load_potential", "dissipated_energy"):
+            energies[key] = np.asarray(out[key], float)
+    return results, junctions, out["error"], energies
+
+
+def rotate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Vectors v (T, 3) turned by the unit quaternions q (T, 4, scalar first)."""
+    w, u = q[:, :1], q[:, 1:]
+    t = 2.0 * np.cross(u, v)
+    return v + w * t + np.cross(u, t)
 
 
 def junction_table(result):

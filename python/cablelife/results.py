@@ -23,6 +23,9 @@ HDF5 layout (every dataset carries a ``unit`` attribute)::
                                  applies to the junction (global, about the junction point)
     /junctions/<name>/clip/force, moment  (T, 3) N, N m: a junction held by a clip: the clip's
                                  force and moment on it (global, about the junction point)
+    /junctions/<name>/velocity, angular_velocity  (T, 3) m/s, rad/s, global: dynamic runs
+    /harness/time, kinetic_energy, elastic_energy, load_potential, dissipated_energy  (T,) s, J:
+                                 dynamic harness runs, totals of all cables and junctions
 
 Datasets are chunked and compressed (gzip level 1 with the shuffle filter: lossless, readable by
 any HDF5 tool); the histories (positions … clip reactions) are float64, or float32 when the
@@ -240,6 +243,9 @@ class JunctionResult:
     # junction point); None for a free junction.
     reaction_force: np.ndarray | None = None  # (T, 3) N
     reaction_moment: np.ndarray | None = None  # (T, 3) N m
+    # Dynamic runs: the junction's velocity and angular velocity, global; None otherwise.
+    velocity: np.ndarray | None = None  # (T, 3) m/s
+    angular_velocity: np.ndarray | None = None  # (T, 3) rad/s
 
     def __repr__(self) -> str:
         return f"JunctionResult({self.name!r}, branches {list(self.branch_force)})"
@@ -258,6 +264,9 @@ class Result:
     precision: str = "float64"
     surroundings: SurroundingsGeometry | None = None  # body geometry and poses, for pictures
     junctions: dict[str, JunctionResult] = field(default_factory=dict)  # harnesses only
+    #: Dynamic harness runs: ``time`` and the total ``kinetic_energy``, ``elastic_energy``,
+    #: ``load_potential``, ``dissipated_energy`` (T,) of all cables and junctions (J).
+    harness_energies: dict[str, np.ndarray] = field(default_factory=dict)
 
     @property
     def cable(self) -> CableResult:
@@ -348,6 +357,10 @@ def save_result(result: Result, path: str | os.PathLike, precision: str | None =
             result.surroundings.write(f)
         if result.junctions:
             _write_junctions(f, result.junctions, hist)
+        if result.harness_energies:
+            g = f.create_group("harness")
+            for key, value in result.harness_energies.items():
+                _put(g, key, value, "s" if key == "time" else "J")
     return path
 
 
@@ -367,6 +380,9 @@ def _write_junctions(f, junctions: dict[str, JunctionResult], hist: str | None) 
             clip = g.create_group("clip")
             _put(clip, "force", j.reaction_force, "N", hist)
             _put(clip, "moment", j.reaction_moment, "N m", hist)
+        if j.velocity is not None:
+            _put(g, "velocity", j.velocity, "m/s", hist)
+            _put(g, "angular_velocity", j.angular_velocity, "rad/s", hist)
 
 
 def _read_junctions(f) -> dict[str, JunctionResult]:
@@ -388,8 +404,16 @@ def _read_junctions(f) -> dict[str, JunctionResult]:
             branch_moment={e: get(b["moment"]) for e, b in br.items()},
             reaction_force=get(g["clip/force"]) if "clip" in g else None,
             reaction_moment=get(g["clip/moment"]) if "clip" in g else None,
+            velocity=get(g["velocity"]) if "velocity" in g else None,
+            angular_velocity=get(g["angular_velocity"]) if "angular_velocity" in g else None,
         )
     return out
+
+
+def _read_harness_energies(f) -> dict[str, np.ndarray]:
+    if "harness" not in f:
+        return {}
+    return {k: np.asarray(ds[()], dtype=np.float64) for k, ds in f["harness"].items()}
 
 
 def load_result(path: str | os.PathLike, lazy: bool = True) -> Result:
@@ -445,6 +469,7 @@ def load_result(path: str | os.PathLike, lazy: bool = True) -> Result:
             precision=str(f.attrs.get("precision", "float64")),
             surroundings=SurroundingsGeometry.read(f),
             junctions=_read_junctions(f),
+            harness_energies=_read_harness_energies(f),
         )
     check_result_values(result, path)  # no NaN into reports, VTK files, damage maps
     warn_partial(result, path)

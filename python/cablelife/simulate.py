@@ -468,7 +468,7 @@ def _simulate_harness(scene: Scene, mode: str, times: np.ndarray, env, progress)
     from cablelife.harness import run_harness
 
     with interrupt.stop_flag() as stop:
-        cables, junctions, error = run_harness(scene, times, mode, progress, stop)
+        cables, junctions, error, energies = run_harness(scene, times, mode, progress, stop)
     errors = [f"harness: {error}"] if error else []
     stopped = error == interrupt.INTERRUPTED
     errors += _check_strains(scene, cables.values())
@@ -480,6 +480,7 @@ def _simulate_harness(scene: Scene, mode: str, times: np.ndarray, env, progress)
         message=interrupt.INTERRUPTED if stopped else "; ".join(errors),
         precision=scene.simulation.output_precision,
         junctions=junctions,
+        harness_energies=energies,
     )
     if env is not None:
         add_clearance(env, scene, result, times, output_every(scene) if mode == "dynamic" else 1)

@@ -584,6 +584,21 @@ impl Cable {
         PyArray1::from_vec(py, self.rod.arc.clone())
     }
 
+    /// The normal (d1, global) of clip `to_clip` when the frame of clip `from_clip` is
+    /// carried along the routed reference centreline to it without twist (parallel
+    /// transport): the default normal of a junction's end (docs/harness.md).
+    fn transported_normal(&self, from_clip: usize, to_clip: usize) -> PyResult<[f64; 3]> {
+        let n = self.rod.spec.clips.len();
+        if from_clip >= n || to_clip >= n {
+            return Err(PyValueError::new_err(format!(
+                "clip indices {from_clip}, {to_clip}: the cable has {n} clips"
+            )));
+        }
+        let d1 = rod::routing::transported_normal(&self.rod, from_clip, to_clip)
+            .map_err(|e| PyValueError::new_err(e.0))?;
+        Ok([d1.x, d1.y, d1.z])
+    }
+
     /// Lumped nodal masses (N+1,).
     #[getter]
     fn node_mass<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {

@@ -365,7 +365,8 @@ impl Harness {
     /// `tau_bend[c]` (3 each). Returns what `run_sequence` returns, the cables' dicts with the
     /// energies of `Cable.run_dynamic`, and `junction_velocities` (T, J, 6: ẋ global, ω body),
     /// `kinetic_energy`, `elastic_energy`, `load_potential`, `dissipated_energy` (T,) of the
-    /// whole harness (junctions included).
+    /// whole harness (junctions included). Junctions held by a clip follow its motion (given
+    /// for their first end); sliding clips slide (a cable running out of one stops the run).
     #[pyo3(signature = (time_step, kinematics, output_every, tau_shear, tau_bend,
         spectral_radius=0.9, newton_tolerance=DynamicOptions::default().tolerance, progress=None,
         progress_every=100, stop=None))]
@@ -500,6 +501,7 @@ impl Harness {
             jpos: Vec<f64>,
             jquat: Vec<f64>,
             jvel: Vec<f64>,
+            react: [Vec<f64>; 2],
             force: Vec<f64>,
             moment: Vec<f64>,
             energies: [Vec<f64>; 4],
@@ -519,6 +521,7 @@ impl Harness {
                 jpos: Vec::with_capacity(saved * nj * 3),
                 jquat: Vec::with_capacity(saved * nj * 4),
                 jvel: Vec::with_capacity(saved * nj * 6),
+                react: std::array::from_fn(|_| Vec::with_capacity(saved * nj * 3)),
                 force: Vec::with_capacity(saved * ne * 3),
                 moment: Vec::with_capacity(saved * ne * 3),
                 energies: std::array::from_fn(|_| Vec::with_capacity(saved)),
@@ -553,7 +556,7 @@ impl Harness {
                         let dy = &hd.cables[c];
                         let rec = &mut out.records[c];
                         rec.push(rod, &st.cables[c], &dy.ws, s);
-                        rec.push_sliding(rod, None);
+                        rec.push_sliding(rod, dy.sliding.as_ref());
                         rec.push_viscous(&dy.ws);
                         rec.push_energies(&dy.energies);
                     }
@@ -566,6 +569,10 @@ impl Harness {
                     for (f, m) in hd.branch_loads(tree, st) {
                         out.force.extend_from_slice(f.as_slice());
                         out.moment.extend_from_slice(m.as_slice());
+                    }
+                    for (f, m) in hd.junction_reactions(tree, st) {
+                        out.react[0].extend_from_slice(f.as_slice());
+                        out.react[1].extend_from_slice(m.as_slice());
                     }
                     let e = &hd.energies;
                     for (v, x) in out.energies.iter_mut().zip([
@@ -616,6 +623,9 @@ impl Harness {
             |v: Vec<f64>, shape: &[usize]| PyArray1::from_vec(py, v).reshape(shape.to_vec());
         let d = junction_outputs(py, &self.tree, out.records, &error, out.jpos, out.jquat, n)?;
         d.set_item("junction_velocities", shaped(out.jvel, &[n, nj, 6])?)?;
+        let [rf, rm] = out.react;
+        d.set_item("junction_reaction_force", shaped(rf, &[n, nj, 3])?)?;
+        d.set_item("junction_reaction_moment", shaped(rm, &[n, nj, 3])?)?;
         d.set_item("branch_force", shaped(out.force, &[n, ne, 3])?)?;
         d.set_item("branch_moment", shaped(out.moment, &[n, ne, 3])?)?;
         let [kin, ela, pot, dis] = out.energies;

@@ -32,6 +32,9 @@ fn bottom(v: &Vector6<f64>) -> Vector3<f64> {
     v.fixed_rows::<3>(3).into()
 }
 
+/// A held junction's prescribed pose, velocity and v̇ (ω, ω̇ in its body frame).
+type HeldKinematics = (Pose, Vector6<f64>, Vector6<f64>);
+
 /// The generalized-α integrator of a harness.
 pub struct HarnessDynamics {
     /// One single-cable integrator per cable (its workspace, rates and kinematics).
@@ -61,6 +64,8 @@ pub struct HarnessDynamics {
     length: f64,
     /// Harness totals (cables and junctions) after the last step or `update_outputs`.
     pub energies: Energies,
+    /// Per junction held by a clip: its prescribed pose, velocity and v̇ at the step's end.
+    held_kin: Vec<Option<HeldKinematics>>,
 }
 
 impl HarnessDynamics {
@@ -103,7 +108,9 @@ impl HarnessDynamics {
                 .map(|r| r.spec.length)
                 .fold(f64::INFINITY, f64::min),
             energies: Energies::default(),
+            held_kin: vec![None; nj],
         };
+        hd.prescribe_held(h, clips);
         hd.end_motions(h, st, clips);
         for (c, rod) in h.cables.iter().enumerate() {
             hd.cables.push(Dynamics::new(
@@ -306,6 +313,9 @@ impl HarnessDynamics {
     fn junction_error(&self, h: &Harness, dt: f64) -> f64 {
         let mut e = 0.0f64;
         for (j, js) in h.junctions.iter().enumerate() {
+            if h.held[j] {
+                continue; // prescribed
+            }
             let d = self.jvdot[j] - self.jvdot_n[j];
             e = e.max(top(&d).amax() / self.length);
             if js.rotary_inertia.iter().all(|&v| v > 0.0) {
@@ -339,6 +349,7 @@ impl HarnessDynamics {
             }
             self.jvdot[j] = vd;
         }
+        self.impose_held(st);
         self.jvdot_n.clone_from(&self.jvdot);
         self.ja.clone_from(&self.jvdot);
         self.sync_ends(h, st);
@@ -401,6 +412,86 @@ impl HarnessDynamics {
             .collect()
     }
 
+    /// The prescribed kinematics of the junctions held by a clip at the clip motions `clips`
+    /// (their first end's entry gives the clip's; ω and ω̇ in the junction's body frame); sets
+    /// their velocities and v̇.
+    fn prescribe_held(&mut self, h: &Harness, clips: &[Vec<ClipMotion>]) {
+        for (j, &held) in h.held.iter().enumerate() {
+            if !held {
+                continue;
+            }
+            let e = &h.ends[h.junction_ends[j][0]];
+            let m = &clips[e.cable][e.topo.clip];
+            let pose = h.junction_pose_from_end(j, &m.pose);
+            let qt = rotation_matrix(&pose.orientation).transpose();
+            let (w, wdot) = (qt * m.angular_velocity, qt * m.angular_acceleration);
+            let (v, a) = (m.velocity, m.acceleration);
+            let vel = Vector6::new(v.x, v.y, v.z, w.x, w.y, w.z);
+            let acc = Vector6::new(a.x, a.y, a.z, wdot.x, wdot.y, wdot.z);
+            self.jv[j] = vel;
+            self.jvdot[j] = acc;
+            self.held_kin[j] = Some((pose, vel, acc));
+        }
+    }
+
+    /// Puts the held junctions back to their prescribed kinematics (after the integrator's
+    /// update of all junctions).
+    fn impose_held(&mut self, st: &mut HarnessState) {
+        for (j, k) in self.held_kin.iter().enumerate() {
+            if let Some((pose, v, a)) = k {
+                st.junctions[j] = *pose;
+                self.jv[j] = *v;
+                self.jvdot[j] = *a;
+            }
+        }
+    }
+
+    /// Fails naming the cable and the clip if a sliding clip's guide reaches beyond a cable
+    /// end at `st` (after a step).
+    pub fn check_sliding(&mut self, h: &Harness, st: &HarnessState) -> Result<(), HarnessError> {
+        for (c, rod) in h.cables.iter().enumerate() {
+            if let Some(Err(k)) = self.cables[c]
+                .sliding
+                .as_mut()
+                .map(|s| s.check(rod, &st.cables[c]))
+            {
+                let e = SolveError::SlidOff {
+                    clip: rod.spec.clips[k].name.clone(),
+                };
+                return Err(Self::cable_err(h, c, e));
+            }
+        }
+        Ok(())
+    }
+
+    /// Force and moment (about the junction point, global) of the clip on each junction held
+    /// by a clip (zero on the others), after `update_outputs`: what accelerates the junction's
+    /// own mass and rotary inertia against its weight and its branch loads.
+    pub fn junction_reactions(
+        &self,
+        h: &Harness,
+        st: &HarnessState,
+    ) -> Vec<(Vector3<f64>, Vector3<f64>)> {
+        let mut out = vec![(Vector3::zeros(), Vector3::zeros()); h.junctions.len()];
+        for (e, (f, m)) in h.ends.iter().zip(self.branch_loads(h, st)) {
+            if h.held[e.junction] {
+                out[e.junction].0 -= f;
+                out[e.junction].1 -= m;
+            }
+        }
+        for (j, js) in h.junctions.iter().enumerate() {
+            if !h.held[j] {
+                continue;
+            }
+            let (w, wdot) = (bottom(&self.jv[j]), bottom(&self.jvdot[j]));
+            let jw = js.rotary_inertia;
+            let body = jw.component_mul(&wdot) + w.cross(&jw.component_mul(&w));
+            out[j].0 += js.mass * (top(&self.jvdot[j]) - h.gravity);
+            out[j].1 += rotation_matrix(&st.junctions[j].orientation) * body;
+        }
+        out
+    }
+
     /// Junction velocities (ẋ global, ω body).
     pub fn junction_velocities(&self) -> &[Vector6<f64>] {
         &self.jv
@@ -420,6 +511,7 @@ impl HarnessDynamics {
         self.jv_n.clone_from(&self.jv);
         self.jvdot_n.clone_from(&self.jvdot);
         self.ja_n.clone_from(&self.ja);
+        self.prescribe_held(h, clips);
         self.end_motions(h, st, clips);
         let restarted = self.cables.iter().any(|d| d.restarted);
         for (c, rod) in h.cables.iter().enumerate() {
@@ -446,6 +538,7 @@ impl HarnessDynamics {
             self.jv0[j] = self.jv_n[j] + dt * (1.0 - ga.gamma) * self.ja_n[j] + dt * ga.gamma * a0;
         }
         let mut inc = self.junction_kinematics(st, dt, true);
+        self.impose_held(st);
         let mut err = self.junction_error(h, dt);
         for (c, rod) in h.cables.iter().enumerate() {
             let dy = &mut self.cables[c];
@@ -485,6 +578,7 @@ impl HarnessDynamics {
             st.junctions[j].orientation = rotate_body(&st.junctions[j].orientation, &bottom(&d));
         }
         inc = inc.max(self.junction_kinematics(st, dt, false));
+        self.impose_held(st);
         err = err.max(self.junction_error(h, dt));
         self.sync_ends(h, st);
         (inc, err)
@@ -643,7 +737,7 @@ impl HarnessDynamics {
         max_depth: usize,
     ) -> Result<StepStats, HarnessError> {
         match self.step(h, st, dt, to) {
-            Ok(s) => Ok(s),
+            Ok(s) => self.check_sliding(h, st).map(|_| s),
             Err(e) if max_depth == 0 => Err(e),
             Err(_) => {
                 self.rollback(st);
@@ -713,7 +807,14 @@ impl HarnessDynamics {
                 }
             }
         }
-        for r in &self.tree.junction_residual {
+        // A held junction's residual is its clip's reaction, not an equation.
+        for (r, _) in self
+            .tree
+            .junction_residual
+            .iter()
+            .zip(&h.held)
+            .filter(|(_, &held)| !held)
+        {
             for k in 0..6 {
                 out.push((r[k], k / 3));
             }
@@ -725,3 +826,7 @@ impl HarnessDynamics {
 #[cfg(test)]
 #[path = "harness_dynamics_tests.rs"]
 mod tests;
+
+#[cfg(test)]
+#[path = "harness_dynamics_clip_tests.rs"]
+mod clip_tests;

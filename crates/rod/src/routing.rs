@@ -323,3 +323,130 @@ fn natural_shape_backward(
         x[e] = x[e + 1] - rotation_matrix(&frame) * Vector3::z() * rod.ds_edge[e];
     }
 }
+
+/// The normal (d1) that clip `to` gets when the frame of clip `from` is parallel-transported
+/// along the routed reference centreline to it (no twist about the curve on the way): the
+/// default normal of a junction's end (docs/harness.md). Orthogonal to `to`'s tangent.
+pub fn transported_normal(rod: &Rod, from: usize, to: usize) -> Result<Vector3<f64>, SpecError> {
+    let st = route(rod, None)?;
+    let node = |c: usize| {
+        let s = rod.spec.clips[c].s;
+        (0..rod.arc.len())
+            .min_by(|&a, &b| (rod.arc[a] - s).abs().total_cmp(&(rod.arc[b] - s).abs()))
+            .unwrap_or(0)
+    };
+    let (a, b) = (node(from), node(to));
+    let q_from = rotation_matrix(&rod.spec.clips[from].pose.orientation);
+    let (mut d1, mut t) = (q_from * Vector3::x(), q_from * Vector3::z());
+    let carry = |t_next: Vector3<f64>, d1: &mut Vector3<f64>, t: &mut Vector3<f64>| {
+        *d1 = rotation_matrix(&min_rotation(t, &t_next)) * *d1;
+        *t = t_next;
+    };
+    let edges: Vec<usize> = if a <= b {
+        (a..b).collect()
+    } else {
+        (b..a).rev().collect()
+    };
+    for e in edges {
+        if let Some(te) = (st.x[e + 1] - st.x[e]).try_normalize(1e-300) {
+            carry(te, &mut d1, &mut t);
+        }
+    }
+    let t_to = rotation_matrix(&rod.spec.clips[to].pose.orientation) * Vector3::z();
+    carry(t_to, &mut d1, &mut t);
+    (d1 - t_to * d1.dot(&t_to))
+        .try_normalize(1e-12)
+        .ok_or_else(|| SpecError(format!("clip {to}: no normal transported from clip {from}")))
+}
+
+#[cfg(test)]
+mod transport_tests {
+    use super::*;
+    use crate::model::{CableSpec, ClipKind, ClipSpec};
+    use crate::rotation::frame_quaternion;
+
+    fn clip(s: f64, p: [f64; 3], t: [f64; 3], n: [f64; 3]) -> ClipSpec {
+        ClipSpec {
+            name: format!("c{s}"),
+            s,
+            length: 0.0,
+            kind: ClipKind::Fixed,
+            pose: Pose {
+                position: Vector3::from(p),
+                orientation: frame_quaternion(&Vector3::from(t), &Vector3::from(n)).unwrap(),
+            },
+        }
+    }
+
+    fn rod(clips: Vec<ClipSpec>, length: f64) -> Rod {
+        Rod::new(CableSpec {
+            length,
+            segments: 64,
+            section: crate::harness::tests::section(),
+            natural_curvature: Vector3::zeros(),
+            clips,
+            loads: vec![],
+            gravity: Vector3::zeros(),
+        })
+        .unwrap()
+    }
+
+    #[test]
+    fn transport_along_a_plane_bend_keeps_the_binormal_and_along_a_straight_line_the_normal() {
+        // A quarter circle in the x–y plane (tangent x at the start, y at the end, radius 0.3):
+        // a normal along z (the binormal) stays z; a normal in the plane turns with the
+        // tangent (x-tangent with normal y ends as the y-tangent with normal −x).
+        let l = 0.3 * std::f64::consts::FRAC_PI_2;
+        for (n0, n1) in [
+            ([0.0, 0.0, 1.0], Vector3::z()),
+            ([0.0, 1.0, 0.0], -Vector3::x()),
+        ] {
+            let r = rod(
+                vec![
+                    clip(0.0, [0.0, 0.0, 0.0], [1.0, 0.0, 0.0], n0),
+                    // The end's own normal (any): the transport ignores it.
+                    clip(l, [0.3, 0.3, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]),
+                ],
+                l,
+            );
+            let d1 = transported_normal(&r, 0, 1).unwrap();
+            assert!((d1 - n1).norm() < 1e-9, "{d1:?} for {n0:?}");
+            // And back.
+            let back = transported_normal(&r, 1, 0).unwrap();
+            assert!(back.z.abs() > 1.0 - 1e-9, "{back:?}");
+        }
+        // Straight: the normal stays.
+        let r = rod(
+            vec![
+                clip(0.0, [0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.6, 0.8]),
+                clip(0.5, [0.5, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]),
+            ],
+            0.5,
+        );
+        let d1 = transported_normal(&r, 0, 1).unwrap();
+        assert!((d1 - Vector3::new(0.0, 0.6, 0.8)).norm() < 1e-12, "{d1:?}");
+    }
+
+    #[test]
+    fn transport_out_of_the_plane_is_orthogonal_and_reversible() {
+        // Out of the plane: the end's normal from the route must be orthogonal to the end
+        // tangent and the routed frame twist-free: the transported normal differs from the
+        // endpoint clip rule in general, and transporting back returns the start normal.
+        let r = rod(
+            vec![
+                clip(0.0, [0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]),
+                clip(0.6, [0.3, 0.25, 0.2], [0.0, 0.6, 0.8], [1.0, 0.0, 0.0]),
+            ],
+            0.6,
+        );
+        let d1 = transported_normal(&r, 0, 1).unwrap();
+        let t1 = Vector3::new(0.0, 0.6, 0.8);
+        assert!(d1.dot(&t1).abs() < 1e-12 && (d1.norm() - 1.0).abs() < 1e-12);
+        // Put that normal on the end clip and transport back: z again.
+        let mut spec = r.spec.clone();
+        spec.clips[1].pose.orientation = frame_quaternion(&t1, &d1).unwrap();
+        let r2 = Rod::new(spec).unwrap();
+        let back = transported_normal(&r2, 1, 0).unwrap();
+        assert!((back - Vector3::z()).norm() < 1e-9, "{back:?}");
+    }
+}

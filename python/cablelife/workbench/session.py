@@ -110,6 +110,9 @@ class Session:
     solves: int = 0
     harness: object = None  # harness_live.LiveHarness when the scene has [[junctions]]
     opened: Scene | None = None  # the scene as opened (bodies' rest poses of the geometry)
+    # The default junction normals in effect as opened (they follow the routed geometry, which
+    # moves with the clips): kept for every rebuild and written on save (docs/harness.md).
+    junction_pins: dict = field(default_factory=dict)
 
     # ------------------------------------------------------------------ opening
     @classmethod
@@ -122,8 +125,10 @@ class Session:
         path = Path(path)
         scene = load_scene(path)
         doc = tomlkit.parse(path.read_text(encoding="utf-8"))
+        pins = junction_pins(scene)
+        scene = pinned(scene, pins)
         session = cls(path=path, scene=scene, doc=doc, bend_factor=bend_factor,
-                      opened=scene.model_copy(deep=True))  # fmt: skip
+                      opened=scene.model_copy(deep=True), junction_pins=pins)  # fmt: skip
         session.env = load_surroundings(scene)
         session.pool = ThreadPoolExecutor(max_workers=max(1, min(len(scene.cables), 4)))
         session._rebuild_all()
@@ -484,6 +489,7 @@ class Session:
         scene = scene_from_dict(
             self.doc.unwrap(), base_dir=self.path.parent.resolve(), source=str(self.path)
         )
+        scene = pinned(scene, self.junction_pins)
         keep_scene, keep_cables = self.scene, dict(self.cables)
         # clip poses edited by dragging live in the document too: the new scene has them
         keep_harness = self.harness
@@ -524,6 +530,7 @@ class Session:
         scene = scene_from_dict(
             self.doc.unwrap(), base_dir=self.path.parent.resolve(), source=str(self.path)
         )
+        scene = pinned(scene, self.junction_pins)
         if _without_poses(scene) != _without_poses(self.scene):
             return False
         targets = {}
@@ -569,8 +576,16 @@ class Session:
         if not target.parent.is_dir():
             raise WorkbenchError(f"save to {str(target)!r}: the folder does not exist")
         with self.lock:
-            text = self.doc.as_string()
-            scene_from_dict(self.doc.unwrap(), base_dir=target.parent.resolve())
+            doc = self.doc
+            if self.junction_pins:  # written into a copy (undo keeps the document as opened)
+                import tomlkit
+
+                doc = tomlkit.parse(doc.as_string())
+                for entry in doc["junctions"]:
+                    if "normals" not in entry and str(entry["name"]) in self.junction_pins:
+                        entry["normals"] = self.junction_pins[str(entry["name"])]
+            text = doc.as_string()
+            scene_from_dict(doc.unwrap(), base_dir=target.parent.resolve())
             write_text_atomic(target, text)
         load_scene(target)  # round trip
         return target
@@ -827,3 +842,25 @@ def batch_equilibrium(scene: Scene, cable: str) -> np.ndarray:
     from cablelife.simulate import simulate
 
     return simulate(at_rest(scene), mode="static").cables[cable].positions[0]
+
+
+def junction_pins(scene: Scene) -> dict:
+    """The normals in effect of the scene's junctions without ``normals`` (by name)."""
+    if not scene.junctions:
+        return {}
+    from cablelife.harness import junction_normals
+
+    return junction_normals(scene)
+
+
+def pinned(scene: Scene, pins: dict) -> Scene:
+    """``scene`` with the pinned normals on its junctions that give none."""
+    if not pins:
+        return scene
+    junctions = [
+        j.model_copy(update={"normals": [tuple(n) for n in pins[j.name]]})
+        if j.normals is None and j.name in pins
+        else j
+        for j in scene.junctions
+    ]
+    return scene.model_copy(update={"junctions": junctions})
