@@ -851,19 +851,131 @@ def test_body_drag_translation_equals_a_cold_batch_solve(harness_copy, tmp_path)
         assert np.abs(live.state.positions - cables[name]).max() < 1e-9, name
 
 
-def test_bodies_that_cannot_be_dragged_say_why():
+NEAR_ENGINE = ROOT / "examples" / "surroundings" / "hose-near-engine.toml"
+
+
+@pytest.fixture
+def near_engine_copy(tmp_path):
+    """The surroundings example (CAD meshes in global coordinates) in a scratch folder."""
     pytest.importorskip("trimesh")
-    scene = ROOT / "examples" / "surroundings" / "hose-near-engine.toml"
-    if not (scene.parent / "engine.stl").exists():
+    if not (NEAR_ENGINE.parent / "engine.stl").exists():
         pytest.skip("example meshes not generated")
-    session = Session.open(scene)
-    st = session.state()["bodies"]
-    assert "global coordinates" in st["engine"]["refused"]
-    with pytest.raises(WorkbenchError, match="body 'engine' cannot be dragged: its geometry"):
-        session.move_body("engine", [0.0, 0.0, 0.0])
+    for f in ("hose-near-engine.toml", "engine.stl", "bracket.stl"):
+        shutil.copy(NEAR_ENGINE.parent / f, tmp_path / f)
+    return tmp_path / "hose-near-engine.toml"
+
+
+def engine_pose_at(k: int, n: int = 10):
+    """The engine's drag: origin and quaternion [w, x, y, z] at step k of n (up 2 cm, turned
+    0.05 rad about z)."""
+    from scipy.spatial.transform import Rotation
+
+    origin = (np.array([0.6, 0.2, 0.0]) + k / n * np.array([0.0, -0.01, 0.02])).tolist()
+    q = Rotation.from_euler("z", 0.05 * k / n).as_quat(scalar_first=True)
+    return origin, q
+
+
+def test_dragging_a_cad_mesh_body_saves_its_placement(near_engine_copy, tmp_path):
+    """The engine block is a CAD mesh in global coordinates: dragged (moved and turned), its
+    mesh moves by the new ``placement``; the saved scene loads back, keeps its comments, and
+    its batch static solve and clearance equal the workbench's (1e-9 m)."""
+    from cablelife.simulate import simulate
+    from cablelife.surroundings.build import load_surroundings
+    from cablelife.workbench.session import at_rest
+
+    session = Session.open(near_engine_copy)
+    for k in range(1, 11):
+        origin, q = engine_pose_at(k)
+        assert session.move_body("engine", origin, q.tolist()) == {"hose": ""}
+    shown = np.array(session.state()["cables"]["hose"]["values"]["clearance"]) / 1e3
+    out = session.save(tmp_path / "moved.toml")
+    text = out.read_text()
+    assert text.startswith("# The hose of hose-three-clips.toml routed near its surroundings")
+    assert "placement = {" in text
+    saved = load_scene(out)
+    body = saved.body("engine")
+    np.testing.assert_allclose(body.placement.orientation, [0.0, 0.0, 0.05], atol=1e-12)
+    # placement x ↦ p + R x equals the drag x ↦ o1 + R (x − o0)
+    o0, o1 = np.array([0.6, 0.2, 0.0]), np.array(engine_pose_at(10)[0])
+    rz = np.array([[np.cos(0.05), -np.sin(0.05), 0], [np.sin(0.05), np.cos(0.05), 0], [0, 0, 1]])
+    np.testing.assert_allclose(body.placement.position, o1 - rz @ o0, atol=1e-12)
+    # the saved scene's engine mesh is the opened one moved as drawn by the page
+    before, after = load_surroundings(load_scene(NEAR_ENGINE)), load_surroundings(saved)
+    k = before.bodies.index("engine")
+    (v0, f0), (v1, f1) = before.display_meshes()[k], after.display_meshes()[k]
+    ab = session.body_map("engine")
+    np.testing.assert_array_equal(f0, f1)
+    np.testing.assert_allclose(v1, v0 @ ab[:, :3].T + ab[:, 3], atol=1e-9)
+    assert np.abs(v1 - v0).max() > 0.01
+    ref = simulate(at_rest(saved), mode="static").cables["hose"]
+    assert np.abs(session.cables["hose"].state.positions - ref.positions[0]).max() < 1e-9
+    np.testing.assert_allclose(shown, ref.clearance[0], atol=1e-9)
+    assert all(session.undo() for _ in range(10)) and not session.undo()  # one step a move
+    assert session.scene_text() == NEAR_ENGINE.read_text()  # no placement any more
     with pytest.raises(WorkbenchError, match="body 'motor' is not in the scene; allowed: "):
         session.move_body("motor", [0.0, 0.0, 0.0])
-    assert session.undo_stack == []
+
+
+def test_page_drags_a_cad_mesh_body_with_the_mouse(near_engine_copy, tmp_path):
+    """The engine block (an STL in global coordinates) dragged by its handle with the mouse:
+    the mesh and the clip follow, the cable answers; the saved scene (with the engine's new
+    placement) solves to what the page shows, and its mesh is where the page draws it."""
+    _browser()
+    from cablelife.surroundings.build import load_surroundings
+    from cablelife.workbench.drive import run_page, workbench_process
+    from cablelife.workbench.session import at_rest
+
+    shots = Path(os.environ.get("CABLELIFE_SCREENSHOTS", tmp_path))
+    saved_path = tmp_path / "dragged.toml"
+
+    async def script(page):
+        x0 = await page.call("state()")
+        await page.call("setQuantity('clearance')")
+        await page.call("selectBody('engine')")
+        x, y = await page.call("bodyOnScreen('engine')")
+        mouse = page.cdp.call
+        await mouse("Input.dispatchMouseEvent", type="mouseMoved", x=x, y=y)
+        await mouse("Input.dispatchMouseEvent", type="mousePressed", x=x, y=y, button="left",
+                    clickCount=1)  # fmt: skip
+        for k in range(1, 16):
+            await mouse("Input.dispatchMouseEvent", type="mouseMoved", x=x + 2 * k, y=y - 3 * k,
+                        button="left", buttons=1)  # fmt: skip
+            await page.call("settled()")
+        await mouse("Input.dispatchMouseEvent", type="mouseReleased", x=x + 30, y=y - 45,
+                    button="left", clickCount=1)  # fmt: skip
+        await page.call("settled()")
+        dragged = await page.call("state()")
+        pose = await page.call("bodyPose('engine')")
+        shot = await page.screenshot(shots / "workbench-body-mesh.png")
+        saved = await page.call(f"save({str(saved_path)!r})")
+        return x0, dragged, pose, shot, saved
+
+    with workbench_process(near_engine_copy) as (_, url):
+        x0, dragged, pose, shot, saved = run_page(url, script)
+    assert saved["ok"]
+    a0, a1 = np.array(x0["cables"]["hose"]["positions"]), dragged["cables"]["hose"]["positions"]
+    assert np.abs(a0 - np.array(a1)).max() > 1e-3  # the body moved, the cable answered
+    scene = load_scene(saved_path)
+    body = scene.body("engine")
+    assert body.placement is not None and body.origin == tuple(
+        pytest.approx(v, abs=1e-12) for v in pose["position"]
+    )
+    ref = simulate_static(at_rest(scene))
+    assert np.abs(np.array(a1) - ref.positions[0]).max() < 1e-9
+    # the saved mesh is the opened one moved by the map the page draws it with
+    before, after = load_surroundings(load_scene(NEAR_ENGINE)), load_surroundings(scene)
+    k = before.bodies.index("engine")
+    v0, v1 = before.display_meshes()[k][0], after.display_meshes()[k][0]
+    ab = np.array(pose["map"])
+    np.testing.assert_allclose(v1, v0 @ ab[:, :3].T + ab[:, 3], atol=1e-6)  # float32 on the page
+    assert np.abs(v1 - v0).max() > 1e-3
+    assert shot.stat().st_size > 20_000
+
+
+def simulate_static(scene):
+    from cablelife.simulate import simulate
+
+    return simulate(scene, mode="static").cables["hose"]
 
 
 def test_page_drags_a_body(harness_copy, tmp_path):
@@ -1004,3 +1116,58 @@ def test_dragged_body_carries_its_geometry_for_clearance(tmp_path):
     np.testing.assert_allclose(after, ref.clearance[0], atol=1e-9)
     assert np.abs(after - before / 1e3).max() > 1e-3  # the sphere moved (and the cable)
     assert np.abs(session.cables["hose"].state.positions - ref.positions[0]).max() < 1e-9
+
+
+def test_time_slider_is_the_quasistatic_run(scene_copy, tmp_path):
+    """The bodies' motion at the steps of the quasistatic grid, each solved as a static
+    equilibrium warm from the last one shown: the same as a quasistatic run at those times
+    within the Newton tolerance (1e-9 of the cable length), stepping through or jumping."""
+    from cablelife.simulate import simulate
+
+    session = Session.open(scene_copy)
+    rest = session.cables["hose"].state.positions.copy()
+    info = session.motion_info()
+    assert info["steps"] == 101 and info["times"][-1] == pytest.approx(2.0)
+    ref = simulate(load_scene(scene_copy), mode="quasistatic").cables["hose"].positions
+    assert np.abs(ref[25] - ref[0]).max() > 1e-3  # the engine does move the cable
+    for k in range(0, 101, 2):
+        assert session.show_time(k) == {"hose": ""}
+        assert np.abs(session.cables["hose"].state.positions - ref[k]).max() < 1e-9, k
+    for k in (70, 5, 100, 33):  # jumps, also backwards
+        assert session.show_time(k) == {"hose": ""}
+        assert np.abs(session.cables["hose"].state.positions - ref[k]).max() < 1e-9, k
+    st = session.state()
+    assert st["time"] == {"step": 33, "t": pytest.approx(0.66)}
+    m = np.array(st["bodies"]["engine"]["map"])  # the engine body drawn at its pose at t
+    clip = np.array(st["cables"]["hose"]["clipPositions"][2])
+    np.testing.assert_allclose(m[:, :3] @ [0.75, 0.25, 0.0] + m[:, 3], clip, atol=1e-12)
+    with pytest.raises(WorkbenchError, match=r"motion is shown \(t = 0.66 s\): go back to rest"):
+        session.move_clips([{"cable": "hose", "clip": CLIP, "position": [0.7, 0.2, 0.0]}])
+    with pytest.raises(WorkbenchError, match="time step 101: allowed: an integer 0 … 100"):
+        session.show_time(101)
+    assert session.back_to_rest() == {"hose": ""}
+    assert session.state()["time"] is None
+    assert np.abs(session.cables["hose"].state.positions - rest).max() < 1e-9
+    assert session.move_clips([{"cable": "hose", "clip": CLIP, "position": [0.7, 0.2, 0.0]}])
+    # a scene without a duration has no slider, and says why
+    path = tmp_path / "static.toml"
+    path.write_text(scene_copy.read_text().replace("duration = 2.0", ""))
+    why = Session.open(path).motion_info()
+    assert why["steps"] == 0 and "no simulation.duration" in why["why"]
+
+
+def test_time_slider_on_a_harness(harness_copy):
+    """The harness example's powertrain motion scrubbed: every cable and the junction equal
+    the quasistatic run at the same steps (1e-9 m)."""
+    from cablelife.simulate import simulate
+
+    session = Session.open(harness_copy)
+    res = simulate(load_scene(harness_copy), mode="quasistatic")
+    steps = session.motion_info()["steps"]
+    assert steps == res.cables["trunk"].positions.shape[0]
+    for k in list(range(steps)) + [3, steps - 1, 0]:
+        assert not any(session.show_time(k).values())
+        for name, live in session.cables.items():
+            assert np.abs(live.state.positions - res.cables[name].positions[k]).max() < 1e-9, k
+    session.back_to_rest()
+    assert session.state()["time"] is None

@@ -23,7 +23,15 @@ import numpy as np
 
 from cablelife.limits import LIMITS
 from cablelife.rotations import matrix_quaternions
-from cablelife.scene import Cable, Clip, Scene, SceneError, load_scene, scene_from_dict
+from cablelife.scene import (
+    Cable,
+    Clip,
+    Placement,
+    Scene,
+    SceneError,
+    load_scene,
+    scene_from_dict,
+)
 from cablelife.simulate import build_cable, euler_matrix
 
 #: Colour quantities: key → (label, unit). Values per node.
@@ -110,6 +118,9 @@ class Session:
     solves: int = 0
     harness: object = None  # harness_live.LiveHarness when the scene has [[junctions]]
     opened: Scene | None = None  # the scene as opened (bodies' rest poses of the geometry)
+    track: object = None  # motion.MotionTrack while the bodies' motion is shown, else None
+    time_index: int | None = None  # the step of ``track`` shown
+    rest: dict | None = None  # clip poses at rest (and a harness's end clips) while moving
 
     # ------------------------------------------------------------------ opening
     @classmethod
@@ -258,6 +269,7 @@ class Session:
         clips where they were. ``mark``: an undo step starts here (the first move of a drag;
         later moves of the same drag pass False)."""
         with self.lock:
+            self._check_at_rest()
             targets: dict[str, tuple[np.ndarray, np.ndarray, list]] = {}
             for m in moves:
                 cable = self.cable_spec(str(m.get("cable")))
@@ -309,20 +321,18 @@ class Session:
         ``quaternion`` [w, x, y, z], a new orientation of its axes: its clips (in every cable)
         and geometry follow rigidly, the cables concerned are re-solved. All or nothing: when a
         cable has no equilibrium, the body, its clips and every cable stay as they were.
-        Returns {cable: error message or ""}; raises WorkbenchError for an unknown body or one
-        whose move could not be saved (geometry in global coordinates)."""
-        from cablelife.workbench.bodies import body_pose, matrix_euler, unsaveable_geometry
+        Geometry in global coordinates moves by the body's ``placement``. Returns {cable: error
+        message or ""}; raises WorkbenchError for an unknown body or a bad pose."""
+        from cablelife.workbench.bodies import body_pose, matrix_euler, moved_placement
 
         with self.lock:
+            self._check_at_rest()
             spec = self.scene.body(str(body))
             if spec is None:
                 raise WorkbenchError(
                     f"body {body!r} is not in the scene; allowed: "
                     + (", ".join(repr(b.name) for b in self.scene.bodies) or "none")
                 )
-            why = unsaveable_geometry(spec)
-            if why:
-                raise WorkbenchError(why)
             o0, r0 = body_pose(spec)
             o1 = self._check_point(f"body '{spec.name}' origin", position)
             r1 = r0
@@ -370,6 +380,11 @@ class Session:
             if mark:
                 self._push_undo()
             entry = self._toml_body(spec.name)
+            placed = moved_placement(spec, a, o0, o1)
+            if placed is not None:
+                placed = {k: [_tidy(v) for v in x] for k, x in placed.items()}
+                spec.placement = Placement(**placed)
+                entry["placement"] = _inline(placed)
             spec.origin = tuple(_tidy(v) for v in o1)
             entry["origin"] = list(spec.origin)
             if quaternion is not None:
@@ -392,7 +407,92 @@ class Session:
         from cablelife.workbench.bodies import rigid_map
 
         a, b = rigid_map(self.opened.body(name), self.scene.body(name))
+        if self.track is not None:  # then the body's motion at the time shown
+            m = self.track.body_map(name, self.time_index)
+            a, b = m[:, :3] @ a, m[:, :3] @ b + m[:, 3]
         return np.column_stack([a, b])
+
+    # ------------------------------------------------------------------ body motion
+    def _check_at_rest(self) -> None:
+        if self.track is not None:
+            raise WorkbenchError(
+                f"the bodies' motion is shown (t = {self.track.times[self.time_index]:g} s): go "
+                "back to rest to move or edit"
+            )
+
+    def motion_info(self) -> dict:
+        """The quasistatic grid the time slider runs on, or why there is none."""
+        from cablelife.workbench.motion import MotionError, motion_track
+
+        with self.lock:
+            try:
+                track = self.track or motion_track(self.scene)
+            except MotionError as err:
+                return {"steps": 0, "why": str(err)}
+            return {"steps": int(track.times.size), "times": track.times.tolist()}
+
+    def show_time(self, k) -> dict:
+        """The static equilibrium with the bodies at their motion's pose at step ``k`` of the
+        quasistatic grid, warm-started from the equilibrium shown (the first call starts from
+        rest). Returns {cable: error message or ""}; on a failed solve the last time shown
+        stays. Moves and edits are refused until :meth:`back_to_rest`."""
+        from cablelife.workbench.motion import MotionError, motion_track
+
+        with self.lock:
+            track = self.track
+            if track is None:
+                try:
+                    track = motion_track(self.scene)
+                except MotionError as err:
+                    raise WorkbenchError(str(err)) from None
+            if isinstance(k, bool) or not isinstance(k, int) or not 0 <= k < track.times.size:
+                raise WorkbenchError(
+                    f"time step {k!r}: allowed: an integer 0 … {track.times.size - 1} (t = 0 … "
+                    f"{track.times[-1]:g} s)"
+                )
+            h = self.harness
+            rest = self.rest
+            if self.track is None:
+                rest = {n: (c.clip_positions.copy(), c.clip_quaternions.copy())
+                        for n, c in self.cables.items()}  # fmt: skip
+                if h is not None:
+                    rest["ends"] = ([p.copy() for p in h.end_positions],
+                                    [q.copy() for q in h.end_quaternions])  # fmt: skip
+            targets = {}
+            for cable in self.scene.cables:
+                pos, quat = track.poses[cable.name]
+                n = len(cable.clips)
+                targets[cable.name] = (pos[k, :n].copy(), quat[k, :n].copy())
+            keep_ends = None
+            if h is not None:
+                keep_ends = (h.end_positions, h.end_quaternions)
+                h.end_positions = [track.poses[n][0][k, m:].copy()
+                                   for n, m in zip(h.names, h.own, strict=True)]  # fmt: skip
+                h.end_quaternions = [track.poses[n][1][k, m:].copy()
+                                     for n, m in zip(h.names, h.own, strict=True)]  # fmt: skip
+            results = self._solve_targets(targets)
+            if not all(results) and h is not None:
+                h.end_positions, h.end_quaternions = keep_ends
+            if all(results) or self.track is not None:
+                self.track, self.rest = track, rest
+                if all(results):
+                    self.time_index = k
+            return {n: self.cables[n].message for n in targets}
+
+    def back_to_rest(self) -> dict:
+        """Leaves the motion view: the cables are solved warm back to the clips' rest poses
+        (rebuilt from the scene if that fails)."""
+        with self.lock:
+            if self.track is None:
+                return {}
+            rest, h = self.rest, self.harness
+            if h is not None:
+                h.end_positions, h.end_quaternions = rest["ends"]
+            targets = {n: rest[n] for n in self.cables}
+            self.track, self.time_index, self.rest = None, None, None
+            if not all(self._solve_targets(targets)):
+                self._reload()
+            return {n: self.cables[n].message for n in targets}
 
     def _set_clip_pose(self, cable: Cable, j: int, p: np.ndarray, frame) -> None:
         """Writes a clip's new global pose into the scene (and its TOML), in the clip's frame."""
@@ -421,6 +521,7 @@ class Session:
         point; a type without them drops axis and friction. On an invalid value or a failed
         solve nothing changes."""
         with self.lock:
+            self._check_at_rest()
             spec = self.cable_spec(cable)
             if item:
                 clip = spec.clips[self.clip_index(spec, item)]
@@ -507,6 +608,7 @@ class Session:
         import tomlkit
 
         with self.lock:
+            self._check_at_rest()
             if not self.undo_stack:
                 return False
             self.doc = tomlkit.parse(self.undo_stack.pop())
@@ -680,6 +782,11 @@ class Session:
                     "message": live.message,
                 }
             out = {"cables": cables, "solves": self.solves, "undo": len(self.undo_stack)}
+            out["time"] = (
+                None
+                if self.track is None
+                else {"step": self.time_index, "t": float(self.track.times[self.time_index])}
+            )
             out["bodies"] = {b.name: self._body_view(b) for b in self.scene.bodies}
             h = self.harness
             if h is not None and h.junction_positions is not None:
@@ -691,16 +798,18 @@ class Session:
             return out
 
     def _body_view(self, body) -> dict:
-        from cablelife.workbench.bodies import body_pose, unsaveable_geometry
+        from cablelife.workbench.bodies import body_pose
 
         o, r = body_pose(body)
+        if self.track is not None:  # at the time shown
+            m = self.track.body_map(body.name, self.time_index)
+            o, r = m[:, :3] @ o + m[:, 3], m[:, :3] @ r
         clips = sum(c.body == body.name for cable in self.scene.cables for c in cable.clips)
         return {
             "origin": o.tolist(),
             "frame": r.T.tolist(),  # rows: the body's axes
             "map": self.body_map(body.name).tolist(),
             "clips": int(clips),
-            "refused": unsaveable_geometry(body),
         }
 
     def geometry(self) -> dict:
@@ -749,11 +858,21 @@ def _without_poses(scene: Scene) -> dict:
     for body in data.get("bodies", []):
         body.pop("origin", None)
         body.pop("orientation", None)
+        body.pop("placement", None)
     for cable in data.get("cables", []):
         for clip in cable.get("clips", []):
             for key in ("position", "direction", "normal"):
                 clip.pop(key, None)
     return data
+
+
+def _inline(values: dict):
+    """A TOML inline table ``{ key = value, … }`` (a placement on one line)."""
+    import tomlkit
+
+    table = tomlkit.inline_table()
+    table.update(values)
+    return table
 
 
 def _type_needs(entry, kind: str, cable: Cable) -> None:

@@ -378,7 +378,6 @@
         var b = state.bodies[n], sel = selected && selected.body === n;
         html += '<tr class="body' + (sel ? " sel" : "") + '" data-body="' + esc(n) + '"><td>' + esc(n) + '</td><td class="num">origin [' +
           b.origin.map(function (v) { return fmt(v, 4); }).join(", ") + "] m, " + b.clips + " clip(s)</td></tr>";
-        if (b.refused) html += '<tr><td colspan="2" class="bad">' + esc(b.refused) + "</td></tr>";
       });
       html += "</table>";
     }
@@ -447,7 +446,6 @@
   }
   function selectBody(name) {
     var b = live.bodies[name];
-    if (b.refused) { showMessage(b.refused, true); return; }
     selected = {body: name};
     gizmo.attach(bodyObjects[name]);
     panel(live);
