@@ -1171,3 +1171,57 @@ def test_time_slider_on_a_harness(harness_copy):
             assert np.abs(live.state.positions - res.cables[name].positions[k]).max() < 1e-9, k
     session.back_to_rest()
     assert session.state()["time"] is None
+
+
+def test_page_scrubs_the_body_motion(scene_copy, tmp_path):
+    """The time slider: the page shows the static equilibrium at steps of the quasistatic grid
+    (the same as the session's, which equals the quasistatic run), labelled as such; moves are
+    refused until *back to rest*, which returns to the rest equilibrium."""
+    _browser()
+    from cablelife.workbench.drive import run_page, workbench_process
+
+    shots = Path(os.environ.get("CABLELIFE_SCREENSHOTS", tmp_path))
+    steps = list(range(0, 101, 10)) + [37]
+
+    async def script(page):
+        x0 = await page.call("state()")
+        info = await page.call("motionInfo()")
+        shown = []
+        for k in steps:
+            t = await page.call(f"showTime({k})")
+            shown.append((t, (await page.call("state()"))["cables"]["hose"]["positions"]))
+        # the slider itself, as a person drags it
+        await page.cdp.evaluate(
+            "(function(){var s=document.getElementById('motion-step');s.value=25;"
+            "s.dispatchEvent(new Event('input'));})()"
+        )
+        await page.call("settled()")
+        slid = await page.call("state()")
+        label = await page.text("motion-time")
+        note = await page.cdp.evaluate("document.querySelector('#motion .note').textContent")
+        note += " | " + await page.text("time-label")
+        refused = await page.call(f"moveClip('hose', '{CLIP}', [0.7, 0.2, 0.0])")
+        shot = await page.screenshot(shots / "workbench-motion.png")
+        await page.call("backToRest()")
+        rest = await page.call("state()")
+        return x0, info, shown, slid, label, note, refused, shot, rest
+
+    with workbench_process(scene_copy) as (_, url):
+        x0, info, shown, slid, label, note, refused, shot, rest = run_page(url, script)
+    assert info["steps"] == 101
+    session = Session.open(scene_copy)
+    for k, (t, positions) in zip(steps, shown, strict=True):
+        assert t["time"]["step"] == k and t["time"]["t"] == pytest.approx(0.02 * k)
+        assert f"t = {0.02 * k:.3f} s (step {k} of 100)" == t["label"]
+        session.show_time(k)
+        np.testing.assert_allclose(positions, session.cables["hose"].state.positions, atol=1e-12)
+    session.show_time(25)
+    np.testing.assert_allclose(slid["cables"]["hose"]["positions"],
+                               session.cables["hose"].state.positions, atol=1e-12)  # fmt: skip
+    assert label == "t = 0.500 s (step 25 of 100)"
+    assert "Static equilibrium at each time" in note and "not dynamics" in note
+    assert note.endswith("| t = 0.500 s: static equilibrium (quasistatic), not dynamics")
+    assert "go back to rest to move or edit" in refused["error"]
+    assert np.abs(np.array(rest["cables"]["hose"]["positions"])
+                  - np.array(x0["cables"]["hose"]["positions"])).max() < 1e-9  # fmt: skip
+    assert shot.stat().st_size > 20_000

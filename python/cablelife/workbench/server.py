@@ -52,6 +52,7 @@ class SceneHandler(_Base):
             "clipTypes": list(CLIP_TYPES),
             "state": s.state(),
             "result": self.app.get("result_info"),
+            "motion": s.motion_info(),
         }
         self.set_header("Content-Type", "application/json")
         self.write(_json(info))
@@ -74,7 +75,8 @@ class ResultStepHandler(_Base):
 
 class SocketHandler(tornado.websocket.WebSocketHandler):
     """Requests {id, op, ...} → replies {id, ok, state | error}. Ops: move (moves: [{cable,
-    clip, position, quaternion?}]), edit (cable, item, key, value), undo, save (path?)."""
+    clip, position, quaternion?}]), moveBody, edit (cable, item, key, value), undo, save (path?),
+    time (step: the bodies' motion at a step of the quasistatic grid), rest, state."""
 
     def initialize(self, app_state):
         self.app = app_state
@@ -146,9 +148,21 @@ class SocketHandler(tornado.websocket.WebSocketHandler):
         if op == "save":
             path = s.save(req.get("path") or None)
             return {"ok": True, "saved": str(path), "state": s.state()}
+        if op == "time":
+            start = time.perf_counter()
+            errors = s.show_time(req.get("step"))
+            ms = (time.perf_counter() - start) * 1e3
+            failed = "; ".join(e for e in errors.values() if e)
+            return {"ok": not failed, "error": failed, "state": s.state(), "solveMs": ms}
+        if op == "rest":
+            errors = s.back_to_rest()
+            failed = "; ".join(e for e in errors.values() if e)
+            return {"ok": not failed, "error": failed, "state": s.state()}
         if op == "state":
             return {"ok": True, "state": s.state()}
-        raise WorkbenchError(f"op = {op!r}; allowed: move, moveBody, edit, undo, save, state")
+        raise WorkbenchError(
+            f"op = {op!r}; allowed: move, moveBody, edit, undo, save, time, rest, state"
+        )
 
 
 def make_app(session: Session, player=None) -> tornado.web.Application:

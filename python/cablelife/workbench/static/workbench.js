@@ -324,6 +324,45 @@
     live = state;
     if (playing === null) draw(state, true);
     panel(state);
+    showTime(state.time);
+  }
+
+  // ---------------------------------------------------------------- body motion
+  // The live view at a time of the quasistatic grid: no handles (back to rest to edit).
+  function showTime(t) {
+    if (!info || !info.motion || !info.motion.steps) return;
+    var moving = t !== null && t !== undefined;
+    if (moving) {
+      if (gizmo.object) gizmo.detach();
+      $("motion-time").textContent = "t = " + Number(t.t).toFixed(3) + " s (step " + t.step + " of " + (info.motion.steps - 1) + ")";
+      $("motion-step").value = t.step;
+      $("motion-rest").disabled = false;
+      $("time-label").textContent = "t = " + Number(t.t).toFixed(3) + " s: static equilibrium (quasistatic), not dynamics";
+      $("time-label").className = "";
+    } else {
+      if (!gizmo.object && selected && playing === null) gizmo.attach(selectedObject());
+      $("motion-time").textContent = "at rest (editable)";
+      $("motion-rest").disabled = true;
+      $("time-label").className = "hidden";
+    }
+    document.body.dataset.time = moving ? t.step : "";
+  }
+  function setupMotion(m) {
+    var box = $("motion");
+    box.className = "";
+    if (!m.steps) {
+      $("motion-step").className = "hidden";
+      $("motion-rest").parentNode.className = "hidden";
+      box.querySelector(".note").textContent = "Not available: " + m.why;
+      return;
+    }
+    var slider = $("motion-step");
+    slider.max = m.steps - 1;
+    slider.value = 0;
+    slider.addEventListener("input", function () { queueMove({op: "time", step: +slider.value}); });
+    $("motion-rest").addEventListener("click", function () {
+      request({op: "rest"}).catch(function (e) { showMessage(e.message, true); });
+    });
   }
 
   function panel(state) {
@@ -428,7 +467,8 @@
   function sendMove(move) {
     inflight = true;
     var mark = dragMark; dragMark = false;
-    var req = move.op === "moveBody" ? {op: "moveBody", body: move.body, position: move.position, quaternion: move.quaternion || null, mark: mark} : {op: "move", moves: [move], mark: mark};
+    var req = move.op === "moveBody" ? {op: "moveBody", body: move.body, position: move.position, quaternion: move.quaternion || null, mark: mark}
+      : move.op === "time" ? {op: "time", step: move.step} : {op: "move", moves: [move], mark: mark};
     request(req).catch(function (e) { showMessage(e.message, true); }).then(function () {
       inflight = false;
       if (pending) { var p = pending; pending = null; sendMove(p); return; }
@@ -439,7 +479,7 @@
 
   function select(cable, clip) {
     selected = {cable: cable, clip: clip};
-    gizmo.attach(clipObjects[cable][clip]);
+    if (!(live && live.time)) gizmo.attach(clipObjects[cable][clip]); // no handles while the motion is shown
     panel(live);
     $("selected").innerHTML = "selected: cable <b>" + esc(cable) + "</b>, clip <b>" + esc(clip) + "</b> — drag the arrows (W: move, E: turn)";
     dirty = true;
@@ -447,7 +487,7 @@
   function selectBody(name) {
     var b = live.bodies[name];
     selected = {body: name};
-    gizmo.attach(bodyObjects[name]);
+    if (!(live && live.time)) gizmo.attach(bodyObjects[name]);
     panel(live);
     $("selected").innerHTML = "selected: body <b>" + esc(name) + "</b> (" + b.clips + " clip(s)) — drag the arrows (W: move, E: turn)";
     dirty = true;
@@ -577,6 +617,7 @@
         if (tr && e.target.tagName !== "INPUT" && e.target.tagName !== "SELECT") select(tr.dataset.cable, tr.dataset.item);
       });
       setupPlayer(d.result);
+      setupMotion(d.motion);
       var first = Object.keys(st.cables)[0];
       var clips = st.cables[first].figures.clips;
       select(first, clips[clips.length - 1].name);
@@ -659,6 +700,15 @@
     stats: function () {
       return {solvesPerSecond: rate(updateTimes), lastSolveMs: lastSolveMs, framesPerSecond: rate(frameTimes)};
     },
+    // the bodies' motion at step k of the quasistatic grid (static equilibrium, warm); resolves when drawn
+    showTime: function (k) {
+      return request({op: "time", step: k}).then(function (msg) {
+        if (msg.ok === false) throw new Error(msg.error);
+        return {time: msg.state.time, label: $("motion-time").textContent};
+      });
+    },
+    backToRest: function () { return request({op: "rest"}); },
+    motionInfo: function () { return info.motion; },
     save: function (path) { return request({op: "save", path: path || null}); },
     undo: undo,
     edit: function (cable, item, key, value) { return request({op: "edit", cable: cable, item: item, key: key, value: value}); },
