@@ -1225,3 +1225,103 @@ def test_page_scrubs_the_body_motion(scene_copy, tmp_path):
     assert np.abs(np.array(rest["cables"]["hose"]["positions"])
                   - np.array(x0["cables"]["hose"]["positions"])).max() < 1e-9  # fmt: skip
     assert shot.stat().st_size > 20_000
+
+
+def test_adding_and_removing_clips(scene_copy, tmp_path):
+    """A clip added at s where the cable is (undoable, saved with the file's comments, the
+    saved scene's batch solve equal to the workbench's); clips removed while the cable stays
+    held; a removal that leaves the statics ill-posed is refused with the solver's reason."""
+    session = Session.open(scene_copy)
+    before = session.cables["hose"].state.positions.copy()
+    name = session.add_clip("hose", 0.25, "fixed")
+    assert name == "clip-1"
+    spec = session.cable_spec("hose")
+    assert [c.name for c in spec.clips] == ["body-clip", "clip-1", "middle", CLIP]
+    arc = np.linspace(0.0, 1.0, 51)
+    where = [np.interp(0.25, arc, before[:, i]) for i in range(3)]
+    np.testing.assert_allclose(spec.clips[1].position, where, atol=1e-12)
+    out = session.save(tmp_path / "added.toml")
+    text = out.read_text()
+    assert "# The engine rocks: 5 mm vertical sine" in text
+    assert text.index('name = "clip-1"') < text.index('name = "middle"')
+    ref = batch_equilibrium(load_scene(out), "hose")
+    assert np.abs(session.cables["hose"].state.positions - ref).max() < 1e-9
+    assert session.undo() and session.scene_text() == scene_copy.read_text()
+    # a sliding clip brings its guide length, a hinge its axis
+    session.add_clip("hose", 0.7, "sliding")
+    assert session.cable_spec("hose").clips[-2].length == pytest.approx(0.08)
+    session.undo()
+    session.remove_clip("hose", "middle")
+    assert [c.name for c in session.cable_spec("hose").clips] == ["body-clip", CLIP]
+    ref = batch_equilibrium(load_scene(session.save(tmp_path / "removed.toml")), "hose")
+    assert np.abs(session.cables["hose"].state.positions - ref).max() < 1e-9
+    assert 'name = "middle"' not in (tmp_path / "removed.toml").read_text()
+    session.undo()
+    session.remove_clip("hose", "body-clip")
+    kept = session.scene_text()
+    with pytest.raises(WorkbenchError, match=r"'engine-bracket' cannot be removed: .*singular"):
+        session.remove_clip("hose", CLIP)  # a single swivel point clip: the cable spins free
+    assert session.scene_text() == kept and len(session.cable_spec("hose").clips) == 2
+    for args, expected in [
+        (("hose", 1.5, "fixed"), r"new clip s = 1.5 m is outside the cable \[0, 1\] m"),
+        (("hose", 0.3, "glued"), "new clip type = 'glued'; allowed: fixed, swivel"),
+        (("hose", 0.3, "fixed", "motor"), "new clip body = 'motor'; allowed: 'world', 'engine'"),
+        (("hose", 0.5, "fixed"), "overlap"),
+        (("pipe", 0.5, "fixed"), "cable 'pipe' is not in the scene"),
+    ]:
+        with pytest.raises((WorkbenchError, SceneError), match=expected):
+            session.add_clip(*args)
+        assert session.scene_text() == kept
+    with pytest.raises(WorkbenchError, match="cable 'hose' has no clip 'nope'"):
+        session.remove_clip("hose", "nope")
+
+
+def test_page_adds_and_removes_clips(scene_copy, tmp_path):
+    """The panel's *add clip* row and a clip's × button, clicked as a person would: the handle
+    appears / goes, the cable is re-solved as the session does, undo restores; a removal that
+    leaves the cable free is refused with the reason on the page."""
+    _browser()
+    from cablelife.workbench.drive import run_page, workbench_process
+
+    shots = Path(os.environ.get("CABLELIFE_SCREENSHOTS", tmp_path))
+
+    def click(selector):
+        return f"document.querySelector({selector!r}).click()"
+
+    async def script(page):
+        ev = page.cdp.evaluate
+        await ev("document.querySelector('.add-clip .add-s').value = '0.3'")
+        await ev("(function(){var t=document.querySelector('.add-clip .add-type');"
+                 "t.value='swivel';})()")  # fmt: skip
+        await ev(click(".add-clip button.add"))
+        await page.call("settled()")
+        added = await page.call("clipNames()")
+        state = await page.call("state()")
+        await page.call("select('hose', 'clip-1')")
+        shot = await page.screenshot(shots / "workbench-clips.png")
+        await ev(click('button.rm[data-item="clip-1"]'))
+        await page.call("settled()")
+        removed = await page.call("clipNames()")
+        await ev(click('button.rm[data-item="body-clip"]'))
+        await page.call("settled()")
+        refused = await page.call("removeClip('hose', 'engine-bracket')")
+        message = await page.text("message")
+        after = await page.call("clipNames()")
+        await page.call("undo()")
+        await page.call("undo()")
+        undone = await page.call("clipNames()")
+        return added, state, shot, removed, refused, message, after, undone
+
+    with workbench_process(scene_copy) as (_, url):
+        added, state, shot, removed, refused, message, after, undone = run_page(url, script)
+    assert sorted(added["hose"]) == sorted(["body-clip", "clip-1", "middle", CLIP])
+    session = Session.open(scene_copy)
+    session.add_clip("hose", 0.3, "swivel")
+    np.testing.assert_allclose(state["cables"]["hose"]["positions"],
+                               session.cables["hose"].state.positions, atol=1e-12)  # fmt: skip
+    assert sorted(removed["hose"]) == sorted(["body-clip", "middle", CLIP])
+    assert "clip 'engine-bracket' cannot be removed" in refused["error"]
+    assert "cannot be removed" in message and "singular" in message
+    assert sorted(after["hose"]) == sorted(["middle", CLIP])
+    assert sorted(undone["hose"]) == sorted(["body-clip", "clip-1", "middle", CLIP])
+    assert shot.stat().st_size > 20_000

@@ -75,7 +75,8 @@ class ResultStepHandler(_Base):
 
 class SocketHandler(tornado.websocket.WebSocketHandler):
     """Requests {id, op, ...} → replies {id, ok, state | error}. Ops: move (moves: [{cable,
-    clip, position, quaternion?}]), moveBody, edit (cable, item, key, value), undo, save (path?),
+    clip, position, quaternion?}]), moveBody, edit (cable, item, key, value), addClip (cable, s,
+    type, body), removeClip (cable, clip), undo, save (path?),
     time (step: the bodies' motion at a step of the quasistatic grid), rest, state."""
 
     def initialize(self, app_state):
@@ -148,6 +149,13 @@ class SocketHandler(tornado.websocket.WebSocketHandler):
         if op == "save":
             path = s.save(req.get("path") or None)
             return {"ok": True, "saved": str(path), "state": s.state()}
+        if op == "addClip":
+            name = s.add_clip(str(req.get("cable")), req.get("s"), str(req.get("type") or "fixed"),
+                              str(req.get("body") or "world"))  # fmt: skip
+            return {"ok": True, "clip": name, "state": s.state()}
+        if op == "removeClip":
+            s.remove_clip(str(req.get("cable")), str(req.get("clip")))
+            return {"ok": True, "state": s.state()}
         if op == "time":
             start = time.perf_counter()
             errors = s.show_time(req.get("step"))
@@ -161,7 +169,8 @@ class SocketHandler(tornado.websocket.WebSocketHandler):
         if op == "state":
             return {"ok": True, "state": s.state()}
         raise WorkbenchError(
-            f"op = {op!r}; allowed: move, moveBody, edit, undo, save, time, rest, state"
+            f"op = {op!r}; allowed: move, moveBody, edit, addClip, removeClip, undo, save, "
+            "time, rest, state"
         )
 
 

@@ -579,6 +579,107 @@ class Session:
                 self._reload(cable)
                 raise
 
+    def add_clip(self, cable: str, s, kind: str = "fixed", body: str = "world") -> str:
+        """Adds a clip of type ``kind`` on ``body`` at arc length ``s`` of ``cable``, posed
+        where the cable is now (its axis point and frame there, global coordinates), with what
+        the type needs (as :meth:`edit`); rebuilds and re-solves the cable (on a harness: the
+        tree). Returns the new clip's name. An invalid clip (beyond the cable, overlapping
+        another, an unknown type or body) or a failed solve changes nothing."""
+        with self.lock:
+            self._check_at_rest()
+            spec = self.cable_spec(cable)
+            if isinstance(s, bool) or not isinstance(s, int | float) or not math.isfinite(s):
+                raise WorkbenchError(f"cable '{cable}': new clip s = {s!r}; give a number in m")
+            if kind not in CLIP_TYPES:
+                raise WorkbenchError(
+                    f"cable '{cable}': new clip type = {kind!r}; allowed: " + ", ".join(CLIP_TYPES)
+                )
+            bodies = ["world", *(b.name for b in self.scene.bodies)]
+            if body not in bodies:
+                raise WorkbenchError(
+                    f"cable '{cable}': new clip body = {body!r}; allowed: "
+                    + ", ".join(repr(b) for b in bodies)
+                )
+            live = self.cables[cable]
+            if not 0.0 <= s <= live.arc_length[-1]:
+                raise WorkbenchError(
+                    f"cable '{cable}': new clip s = {s} m is outside the cable [0, "
+                    f"{live.arc_length[-1]:g}] m"
+                )
+            names = {c.name for c in spec.clips}
+            name = next(f"clip-{k}" for k in range(1, len(names) + 2) if f"clip-{k}" not in names)
+            p, d3, d1 = _cable_frame_at(live, float(s))
+            import tomlkit
+
+            entry = tomlkit.table()
+            entry.update(
+                {
+                    "name": name,
+                    "s": _tidy(s),
+                    "body": body,
+                    "position": [_tidy(v) for v in p],
+                    "direction": [_tidy(v) for v in d3],
+                    "normal": [_tidy(v) for v in d1],
+                    "type": kind,
+                }
+            )
+            _type_needs(entry, kind, spec)
+            entry.add(tomlkit.nl())
+
+            def change(doc):
+                table = next(c for c in doc["cables"] if c.get("name") == cable)
+                if "clips" not in table:
+                    table["clips"] = tomlkit.aot()
+                clips = table["clips"]
+                at = sum(1 for c in clips if float(c.get("s", 0.0)) <= s)
+                clips.insert(at, entry)
+
+            self._change_document(cable, change)
+            return name
+
+    def remove_clip(self, cable: str, clip: str) -> None:
+        """Removes a clip; rebuilds and re-solves the cable. Refused with the reason (and
+        nothing changed) when the cable's statics are no longer well posed: no clip left, a
+        rigid-body motion left free (the solver's singular-matrix message), or no
+        equilibrium."""
+        with self.lock:
+            self._check_at_rest()
+            spec = self.cable_spec(cable)
+            self.clip_index(spec, clip)
+
+            def change(doc):
+                table = next(c for c in doc["cables"] if c.get("name") == cable)
+                clips = table["clips"]
+                k = next(i for i, c in enumerate(clips) if c.get("name") == clip)
+                del clips[k]
+                if not len(clips):
+                    del table["clips"]
+
+            try:
+                self._change_document(cable, change)
+            except (SceneError, WorkbenchError) as err:
+                raise WorkbenchError(
+                    f"cable '{cable}': clip '{clip}' cannot be removed: {err}"
+                ) from None
+
+    def _change_document(self, cable: str, change) -> None:
+        """Applies ``change(document)`` to a copy of the TOML document and rebuilds ``cable``;
+        one undo step. On an invalid scene or a failed solve the document and the cables stay
+        as they were and the error is raised."""
+        import tomlkit
+
+        self._push_undo()
+        old_doc = self.doc
+        self.doc = tomlkit.parse(old_doc.as_string())
+        change(self.doc)
+        try:
+            self._reload(cable)
+        except (SceneError, WorkbenchError):
+            self.doc = old_doc
+            self.undo_stack.pop()
+            self._reload(cable)
+            raise
+
     def _reload(self, changed: str | None = None) -> None:
         """Validates the TOML document as a scene; rebuilds the changed cable's solver (all
         when None). Raises SceneError (nothing rebuilt) for an invalid scene or a failed solve."""
@@ -864,6 +965,16 @@ def _without_poses(scene: Scene) -> dict:
             for key in ("position", "direction", "normal"):
                 clip.pop(key, None)
     return data
+
+
+def _cable_frame_at(live: LiveCable, s: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The cable's axis point, tangent d3 and d1 at arc length ``s`` of its last equilibrium
+    (linear between nodes; the frame of the edge that holds s)."""
+    x, arc = live.state.positions, live.arc_length
+    point = np.array([np.interp(s, arc, x[:, i]) for i in range(3)])
+    e = int(np.clip(np.searchsorted(arc, s, side="right") - 1, 0, len(arc) - 2))
+    frame = quat_matrix(live.state.quaternions[e])
+    return point, frame[:, 2], frame[:, 0]
 
 
 def _inline(values: dict):

@@ -320,7 +320,29 @@
     return maps;
   }
 
+  // Clip handles follow the scene's clips (added or removed in the panel).
+  function syncClips(state) {
+    Object.keys(state.cables).forEach(function (n) {
+      var c = state.cables[n], size = Math.max(c.radius * 2.5, 0.004), names = {};
+      clipObjects[n] = clipObjects[n] || {};
+      c.figures.clips.forEach(function (k) {
+        names[k.name] = true;
+        if (!clipObjects[n][k.name]) clipObjects[n][k.name] = makeClip(n, k.name, size);
+      });
+      Object.keys(clipObjects[n]).forEach(function (k) {
+        if (names[k]) return;
+        var o = clipObjects[n][k];
+        if (gizmo.object === o) gizmo.detach();
+        if (o.userData.axis) scene.remove(o.userData.axis);
+        scene.remove(o);
+        delete clipObjects[n][k];
+        if (selected && selected.cable === n && selected.clip === k) selected = null;
+      });
+    });
+  }
+
   function applyLive(state) {
+    syncClips(state);
     live = state;
     if (playing === null) draw(state, true);
     panel(state);
@@ -383,7 +405,7 @@
       html += '<tr><td>max |torsion|</td><td class="num">' + fmt(f.maxTorsion, 3) + " N m at s = " + fmt(f.maxTorsionS, 3) + " m</td></tr>";
       if (f.minClearance !== undefined) html += '<tr><td>min clearance</td><td class="num' + (f.minClearance < 0 ? " bad" : "") + '">' + fmt(f.minClearance * 1e3, 3) + " mm at s = " + fmt(f.minClearanceS, 3) + " m</td></tr>";
       html += '<tr><td>last solve</td><td class="num">' + fmt(f.solveMs, 2) + " ms, " + f.iterations + " iterations</td></tr>";
-      html += "</table><table><tr><th>clip</th><th>s [m]</th><th>type</th><th>length [m]</th><th>|F| [N]</th><th>|M| [N m]</th></tr>";
+      html += "</table><table><tr><th>clip</th><th>s [m]</th><th>type</th><th>length [m]</th><th>|F| [N]</th><th>|M| [N m]</th><th></th></tr>";
       var extra = [];
       f.clips.forEach(function (k) {
         var sel = selected && selected.cable === n && selected.clip === k.name;
@@ -392,15 +414,21 @@
         var d = ' data-cable="' + esc(n) + '" data-item="' + esc(k.name) + '"';
         html += '<tr class="clip' + (sel ? " sel" : "") + '"' + d + "><td>" + esc(k.name) + "</td>" +
           '<td><input type="number" step="0.01"' + d + ' data-key="s" value="' + k.s + '" style="width:46px"></td>' +
-          "<td><select" + d + ' data-key="type">' + opts + "</select></td>" +
+          "<td><select" + d + ' data-key="type" style="max-width:66px">' + opts + "</select></td>" +
           '<td><input type="number" step="0.005"' + d + ' data-key="length" value="' + k.length + '" style="width:46px"></td>' +
-          '<td class="num">' + fmt(fn, 3) + '</td><td class="num">' + fmt(mn, 3) + "</td></tr>";
+          '<td class="num">' + fmt(fn, 3) + '</td><td class="num">' + fmt(mn, 3) + "</td>" +
+          '<td class="rmcell"><button class="rm"' + d + ' title="remove clip ' + esc(k.name) + '">×</button></td></tr>';
         if (k.type === "hinge" && k.axis) extra.push("<tr" + d + "><td>" + esc(k.name) + '</td><td>hinge axis (d1, d2, d3)</td><td class="num">' +
           k.axis.map(function (a, i) { return '<input type="number" step="0.1" class="axis"' + d + ' data-key="axis" data-index="' + i + '" value="' + a + '" style="width:40px">'; }).join("") + "</td></tr>");
         if (k.type === "sliding") extra.push("<tr" + d + "><td>" + esc(k.name) + '</td><td>slid through</td><td class="num slid">' + (k.slid === null ? "–" : fmt(k.slid * 1e3, 3) + " mm") + "</td></tr>");
       });
       html += "</table>";
       if (extra.length) html += '<table class="clip-extra">' + extra.join("") + "</table>";
+      var bodies = ["world"].concat(Object.keys(state.bodies || {}));
+      html += '<div class="row add-clip" data-cable="' + esc(n) + '">new clip at s <input type="number" step="0.01" min="0" class="add-s" value="' +
+        fmt(f.length / 2, 3) + '" style="width:58px"> m <select class="add-type" style="max-width:66px">' +
+        info.clipTypes.map(function (t) { return "<option>" + t + "</option>"; }).join("") + '</select> on <select class="add-body" style="max-width:80px">' +
+        bodies.map(function (b) { return "<option>" + esc(b) + "</option>"; }).join("") + '</select> <button class="add">add</button></div>';
     });
     if (state.junctions) {
       html += "<h2>junctions</h2><table>";
@@ -611,6 +639,16 @@
         });
       });
       $("cables").addEventListener("click", function (e) {
+        if (e.target.classList.contains("rm")) {
+          request({op: "removeClip", cable: e.target.dataset.cable, clip: e.target.dataset.item}).catch(function (err) { showMessage(err.message, true); });
+          return;
+        }
+        if (e.target.classList.contains("add")) {
+          var row = e.target.closest(".add-clip");
+          request({op: "addClip", cable: row.dataset.cable, s: parseFloat(row.querySelector(".add-s").value),
+            type: row.querySelector(".add-type").value, body: row.querySelector(".add-body").value}).catch(function (err) { showMessage(err.message, true); });
+          return;
+        }
         var tb = e.target.closest("tr.body");
         if (tb) { selectBody(tb.dataset.body); return; }
         var tr = e.target.closest("tr.clip");
@@ -709,6 +747,15 @@
     },
     backToRest: function () { return request({op: "rest"}); },
     motionInfo: function () { return info.motion; },
+    // a clip added at arc length s (type, body) / removed, as the panel's controls; resolve when drawn
+    addClip: function (cable, s, type, body) { return request({op: "addClip", cable: cable, s: s, type: type || "fixed", body: body || "world"}); },
+    removeClip: function (cable, clip) { return request({op: "removeClip", cable: cable, clip: clip}); },
+    // the clip handles drawn, per cable
+    clipNames: function () {
+      var out = {};
+      Object.keys(clipObjects).forEach(function (n) { out[n] = Object.keys(clipObjects[n]).filter(function (k) { return clipObjects[n][k].parent === scene; }); });
+      return out;
+    },
     save: function (path) { return request({op: "save", path: path || null}); },
     undo: undo,
     edit: function (cable, item, key, value) { return request({op: "edit", cable: cable, item: item, key: key, value: value}); },
