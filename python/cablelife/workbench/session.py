@@ -188,7 +188,6 @@ class Session:
 
     def _rebuild(self, cable: Cable) -> LiveCable:
         """A fresh solver for ``cable`` (its mesh follows the clips), solved from its route."""
-        from cablelife.contact_settings import set_contact
         from cablelife.simulate import clip_poses
 
         if self.scene.junctions:
@@ -196,15 +195,28 @@ class Session:
             return self.cables[cable.name]
         core = build_cable(self.scene, cable)
         if self.scene.contact is not None and self.scene.contact.enabled:
-            try:
-                set_contact(core, self.scene, cable, np.array([0.0]))
-            except ValueError as err:
-                raise SceneError(f"cable '{cable.name}': {err}") from None
+            self._set_contact(core, self.scene, cable)
         pos, quat = clip_poses(self.scene, cable, np.array([0.0]), with_motion=False)
         live = self._live_cable(cable, core, pos[0].copy(), quat[0].copy())
         self.cables[cable.name] = live
         self._solve(live, live.clip_positions, live.clip_quaternions)
         return live
+
+    def _contact_on(self, body) -> bool:
+        """Contact is solved and ``body`` carries obstacles."""
+        c = self.scene.contact
+        return c is not None and c.enabled and bool(body.geometry) and self.harness is None
+
+    @staticmethod
+    def _set_contact(core, scene: Scene, cable: Cable) -> None:
+        """The contact term of ``core`` with the obstacles of ``scene``'s bodies at rest (their
+        motion not applied, as the clips)."""
+        from cablelife.contact_settings import set_contact
+
+        try:
+            set_contact(core, at_rest(scene), cable, np.array([0.0]))
+        except ValueError as err:
+            raise SceneError(f"cable '{cable.name}': {err}") from None
 
     # ------------------------------------------------------------------ lookups
     def cable_spec(self, name: str) -> Cable:
@@ -360,6 +372,27 @@ class Session:
                     pos[j] = p
                     quat[j] = matrix_quaternions(frame[None])[0]
                     edits.append((j, p, frame))
+            placed = moved_placement(spec, a, o0, o1)
+            if placed is not None:
+                placed = {k: [_tidy(v) for v in x] for k, x in placed.items()}
+            new_origin = tuple(_tidy(v) for v in o1)
+            new_orientation = (
+                spec.orientation
+                if quaternion is None
+                else tuple(_tidy(v) for v in matrix_euler(r1))
+            )
+            contact = self._contact_on(spec)
+            if contact:  # the obstacles of the body's geometry move with it: every cable
+                moved = self.scene.model_copy(deep=True)
+                b = moved.body(spec.name)
+                b.origin, b.orientation = new_origin, new_orientation
+                b.placement = None if placed is None else Placement(**placed)
+                for cable in self.scene.cables:
+                    live = self.cables[cable.name]
+                    targets.setdefault(
+                        cable.name, (live.clip_positions.copy(), live.clip_quaternions.copy(), [])
+                    )
+                    self._set_contact(live.core, moved, cable)
             keep = {n: (c.state, c.clip_positions, c.clip_quaternions, c.message)
                     for n, c in self.cables.items()}  # fmt: skip
             keep_junctions = None
@@ -376,19 +409,20 @@ class Session:
                     self.harness.junction_positions, self.harness.junction_quaternions = (
                         keep_junctions
                     )
+                if contact:
+                    for cable in self.scene.cables:
+                        self._set_contact(self.cables[cable.name].core, self.scene, cable)
                 return errors
             if mark:
                 self._push_undo()
             entry = self._toml_body(spec.name)
-            placed = moved_placement(spec, a, o0, o1)
             if placed is not None:
-                placed = {k: [_tidy(v) for v in x] for k, x in placed.items()}
                 spec.placement = Placement(**placed)
                 entry["placement"] = _inline(placed)
-            spec.origin = tuple(_tidy(v) for v in o1)
+            spec.origin = new_origin
             entry["origin"] = list(spec.origin)
             if quaternion is not None:
-                spec.orientation = tuple(_tidy(v) for v in matrix_euler(r1))
+                spec.orientation = new_orientation
                 entry["orientation"] = list(spec.orientation)
             for name, (_, _, edits) in targets.items():
                 for j, p, frame in edits:
@@ -730,12 +764,16 @@ class Session:
         if _without_poses(scene) != _without_poses(self.scene):
             return False
         targets = {}
+        moved = [b for b in scene.bodies if b != self.scene.body(b.name)]
+        contact = any(self._contact_on(b) for b in moved)  # obstacles back: every cable
         for cable in scene.cables:
             pos, quat = clip_poses(scene, cable, np.array([0.0]), with_motion=False)
             live = self.cables[cable.name]
-            if not (np.array_equal(pos[0], live.clip_positions)
-                    and np.array_equal(quat[0], live.clip_quaternions)):  # fmt: skip
+            if contact or not (np.array_equal(pos[0], live.clip_positions)
+                               and np.array_equal(quat[0], live.clip_quaternions)):  # fmt: skip
                 targets[cable.name] = (pos[0], quat[0])
+                if contact:
+                    self._set_contact(live.core, scene, cable)
         if not all(self._solve_targets(targets)):
             return False
         self.scene = scene
