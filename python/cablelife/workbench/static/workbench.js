@@ -405,7 +405,7 @@
       html += '<tr><td>max |torsion|</td><td class="num">' + fmt(f.maxTorsion, 3) + " N m at s = " + fmt(f.maxTorsionS, 3) + " m</td></tr>";
       if (f.minClearance !== undefined) html += '<tr><td>min clearance</td><td class="num' + (f.minClearance < 0 ? " bad" : "") + '">' + fmt(f.minClearance * 1e3, 3) + " mm at s = " + fmt(f.minClearanceS, 3) + " m</td></tr>";
       html += '<tr><td>last solve</td><td class="num">' + fmt(f.solveMs, 2) + " ms, " + f.iterations + " iterations</td></tr>";
-      html += "</table><table><tr><th>clip</th><th>s [m]</th><th>type</th><th>length [m]</th><th>|F| [N]</th><th>|M| [N m]</th><th></th></tr>";
+      html += "</table><table><tr><th>clip</th><th>s [m]</th><th>type</th><th>length [m]</th><th>|F| [N]</th><th>|M| [N&nbsp;m]</th><th></th></tr>";
       var extra = [];
       f.clips.forEach(function (k) {
         var sel = selected && selected.cable === n && selected.clip === k.name;
