@@ -742,7 +742,7 @@
     showTime: function (k) {
       return request({op: "time", step: k}).then(function (msg) {
         if (msg.ok === false) throw new Error(msg.error);
-        return {time: msg.state.time, label: $("motion-time").textContent};
+        return {time: msg.state.time, label: $("motion-time").textContent, solveMs: msg.solveMs};
       });
     },
     backToRest: function () { return request({op: "rest"}); },
