@@ -1399,3 +1399,19 @@ normal = [0.0, 0.0, 1.0]
     assert np.abs(after - ref[-1]).max() < 1e-9
     assert all(session.undo() for _ in range(10))
     assert np.abs(session.cables["hose"].state.positions - before).max() < 1e-9
+
+
+def test_time_slider_moves_the_geometry_for_clearance(near_engine_copy):
+    """With the motion shown, the clearance is to the bodies' geometry at that time: equal to
+    the quasistatic run's clearance at the same steps."""
+    from cablelife.simulate import simulate
+
+    session = Session.open(near_engine_copy)
+    ref = simulate(load_scene(near_engine_copy), mode="quasistatic").cables["hose"]
+    for k in (0, 12, 25, 60, 100):
+        assert session.show_time(k) == {"hose": ""}
+        live = session.cables["hose"]
+        assert np.abs(live.state.positions - ref.positions[k]).max() < 1e-9
+        clearance = np.array(session.state()["cables"]["hose"]["values"]["clearance"]) / 1e3
+        np.testing.assert_allclose(clearance, ref.clearance[k], atol=1e-9)
+    assert np.abs(ref.clearance - ref.clearance[0]).max() > 1e-3  # the engine does move
