@@ -1149,7 +1149,11 @@ def test_time_slider_is_the_quasistatic_run(scene_copy, tmp_path):
     assert session.state()["time"] is None
     assert np.abs(session.cables["hose"].state.positions - rest).max() < 1e-9
     assert session.move_clips([{"cable": "hose", "clip": CLIP, "position": [0.7, 0.2, 0.0]}])
-    # a scene without a duration has no slider, and says why
+    # a grid too fine for a slider, and a scene without a duration: no slider, and why
+    path = tmp_path / "fine.toml"
+    path.write_text(scene_copy.read_text().replace("time_step = 0.02 ", "time_step = 1e-5 "))
+    why = Session.open(path).motion_info()
+    assert why["steps"] == 0 and "has 200001 steps" in why["why"]
     path = tmp_path / "static.toml"
     path.write_text(scene_copy.read_text().replace("duration = 2.0", ""))
     why = Session.open(path).motion_info()

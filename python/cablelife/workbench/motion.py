@@ -12,6 +12,9 @@ import numpy as np
 
 from cablelife.scene import Scene, SceneError
 
+#: Steps of the time slider at most (a finer grid is no use on a slider; memory stays small).
+MAX_STEPS = 100_001
+
 
 class MotionError(ValueError):
     """The scene's motion cannot be shown (no duration, contact); the message says why."""
@@ -47,6 +50,12 @@ def motion_track(scene: Scene) -> MotionTrack:
             "only; run `cablelife run` (quasistatic) to see the motion with contact"
         )
     times = output_times(scene, "quasistatic")
+    if times.size > MAX_STEPS:
+        raise MotionError(
+            f"the quasistatic grid has {times.size} steps (duration "
+            f"{scene.simulation.duration:g} s, step {times[1] - times[0]:g} s); the slider offers "
+            f"at most {MAX_STEPS}: give a larger time_step (or output_step)"
+        )
     try:
         motions = body_motions(scene, times)
         cables = scene.cables

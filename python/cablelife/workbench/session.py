@@ -121,6 +121,7 @@ class Session:
     track: object = None  # motion.MotionTrack while the bodies' motion is shown, else None
     time_index: int | None = None  # the step of ``track`` shown
     rest: dict | None = None  # clip poses at rest (and a harness's end clips) while moving
+    track_cache: tuple | None = None  # (scene text, MotionTrack) last computed
 
     # ------------------------------------------------------------------ opening
     @classmethod
@@ -456,27 +457,36 @@ class Session:
 
     def motion_info(self) -> dict:
         """The quasistatic grid the time slider runs on, or why there is none."""
-        from cablelife.workbench.motion import MotionError, motion_track
+        from cablelife.workbench.motion import MotionError
 
         with self.lock:
             try:
-                track = self.track or motion_track(self.scene)
+                track = self.track or self._motion_track()
             except MotionError as err:
                 return {"steps": 0, "why": str(err)}
             return {"steps": int(track.times.size), "times": track.times.tolist()}
+
+    def _motion_track(self):
+        """The motion track of the scene as it is now (kept until the scene changes)."""
+        from cablelife.workbench.motion import motion_track
+
+        text = self.doc.as_string()
+        if self.track_cache is None or self.track_cache[0] != text:
+            self.track_cache = (text, motion_track(self.scene))
+        return self.track_cache[1]
 
     def show_time(self, k) -> dict:
         """The static equilibrium with the bodies at their motion's pose at step ``k`` of the
         quasistatic grid, warm-started from the equilibrium shown (the first call starts from
         rest). Returns {cable: error message or ""}; on a failed solve the last time shown
         stays. Moves and edits are refused until :meth:`back_to_rest`."""
-        from cablelife.workbench.motion import MotionError, motion_track
+        from cablelife.workbench.motion import MotionError
 
         with self.lock:
             track = self.track
             if track is None:
                 try:
-                    track = motion_track(self.scene)
+                    track = self._motion_track()
                 except MotionError as err:
                     raise WorkbenchError(str(err)) from None
             if isinstance(k, bool) or not isinstance(k, int) or not 0 <= k < track.times.size:
