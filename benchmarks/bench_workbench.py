@@ -4,7 +4,8 @@ the new equilibrium is drawn: page → websocket → warm static solve (Rust) �
 rebuilt and rendered. Targets (issue 17): ≥ 25 updates/s for a 100-segment cable, ≥ 10 for
 five cables moved together and ≥ 10 for a harness (examples/harness/scene.toml: four cables,
 150 segments, one junction; its engine-bracket clip dragged, the whole tree re-solved). Also
-the solve alone (Session.move_clips, no server).
+the solve alone (Session.move_clips, no server), and the body-motion slider (showTime: the
+bodies' motion at the steps of the quasistatic grid, one warm static equilibrium each).
 
     python benchmarks/bench_workbench.py [--updates 200]
 """
@@ -65,16 +66,22 @@ def path(i: int, k: int, n: int) -> list[float]:
     return [0.75, float(0.25 + 0.1 * i + 0.04 * np.sin(a)), float(0.04 * (1 - np.cos(a)))]
 
 
-def end_to_end(scene_file: Path, cables: int, updates: int) -> dict:
+def end_to_end(scene_file: Path, cables: int, updates: int, motion: bool = False) -> dict:
+    """Updates per second through the page: clip moves, or (``motion``) time-slider steps
+    running forwards through the quasistatic grid (and round again)."""
     from cablelife.workbench.drive import run_page, workbench_process
 
     async def script(page):
         lat, solve = [], []
+        steps = (await page.call("motionInfo()"))["steps"] if motion else 0
         t0 = time.perf_counter()
         for k in range(updates):
-            moves = moves_of(scene_file, cables, k, updates)
             t = time.perf_counter()
-            r = await page.call(f"moveClips({json.dumps(moves)})")
+            if motion:
+                r = await page.call(f"showTime({k % steps})")
+            else:
+                moves = moves_of(scene_file, cables, k, updates)
+                r = await page.call(f"moveClips({json.dumps(moves)})")
             if "error" in r:
                 raise RuntimeError(r["error"])
             lat.append(time.perf_counter() - t)
@@ -117,12 +124,24 @@ def main() -> None:
                 f"{name:<34}{e2e['rate']:>9.1f} up/s{e2e['latency_ms']:>13.2f} ms"
                 f"{e2e['solve_ms']:>11.2f} ms{only:>9.0f} up/s   (target >= {target} up/s)"
             )
+        e2e = end_to_end(Path(tmp) / "bench1.toml", 1, args.updates, motion=True)
+        name = "motion slider, 1 cable"
+        print(
+            f"{name:<34}{e2e['rate']:>9.1f} up/s{e2e['latency_ms']:>13.2f} ms"
+            f"{e2e['solve_ms']:>11.2f} ms{'':>14}   (target >= 25 up/s)"
+        )
     e2e = end_to_end(HARNESS, 1, args.updates)
     only = solve_only(HARNESS, 1, args.updates)
     name = "harness 4 cables, 150 segments"
     print(
         f"{name:<34}{e2e['rate']:>9.1f} up/s{e2e['latency_ms']:>13.2f} ms"
         f"{e2e['solve_ms']:>11.2f} ms{only:>9.0f} up/s   (target >= 10 up/s)"
+    )
+    e2e = end_to_end(HARNESS, 1, args.updates, motion=True)
+    name = "motion slider, harness"
+    print(
+        f"{name:<34}{e2e['rate']:>9.1f} up/s{e2e['latency_ms']:>13.2f} ms"
+        f"{e2e['solve_ms']:>11.2f} ms{'':>14}   (target >= 10 up/s)"
     )
 
 

@@ -491,7 +491,7 @@ def test_server_listens_on_loopback_and_refuses_foreign_pages(scene_copy):
     assert info["state"]["cables"]["hose"]["figures"]["clips"][2]["name"] == CLIP
     assert reply["id"] == 7 and reply["ok"] and reply["solveMs"] > 0
     assert reply["state"]["cables"]["hose"]["positions"][-1] == [0.75, 0.27, 0.01]
-    allowed = "move, moveBody, edit, undo, save, state"
+    allowed = "move, moveBody, edit, addClip, removeClip, undo, save, time, rest, state"
     assert bad == {"id": 8, "ok": False, "error": f"op = 'fly'; allowed: {allowed}"}
     assert bad_moves["ok"] is False
     assert bad_moves["error"] == "move: moves = [1]; give [{cable, clip, position}, ...]"
@@ -851,19 +851,131 @@ def test_body_drag_translation_equals_a_cold_batch_solve(harness_copy, tmp_path)
         assert np.abs(live.state.positions - cables[name]).max() < 1e-9, name
 
 
-def test_bodies_that_cannot_be_dragged_say_why():
+NEAR_ENGINE = ROOT / "examples" / "surroundings" / "hose-near-engine.toml"
+
+
+@pytest.fixture
+def near_engine_copy(tmp_path):
+    """The surroundings example (CAD meshes in global coordinates) in a scratch folder."""
     pytest.importorskip("trimesh")
-    scene = ROOT / "examples" / "surroundings" / "hose-near-engine.toml"
-    if not (scene.parent / "engine.stl").exists():
+    if not (NEAR_ENGINE.parent / "engine.stl").exists():
         pytest.skip("example meshes not generated")
-    session = Session.open(scene)
-    st = session.state()["bodies"]
-    assert "global coordinates" in st["engine"]["refused"]
-    with pytest.raises(WorkbenchError, match="body 'engine' cannot be dragged: its geometry"):
-        session.move_body("engine", [0.0, 0.0, 0.0])
+    for f in ("hose-near-engine.toml", "engine.stl", "bracket.stl"):
+        shutil.copy(NEAR_ENGINE.parent / f, tmp_path / f)
+    return tmp_path / "hose-near-engine.toml"
+
+
+def engine_pose_at(k: int, n: int = 10):
+    """The engine's drag: origin and quaternion [w, x, y, z] at step k of n (up 2 cm, turned
+    0.05 rad about z)."""
+    from scipy.spatial.transform import Rotation
+
+    origin = (np.array([0.6, 0.2, 0.0]) + k / n * np.array([0.0, -0.01, 0.02])).tolist()
+    q = Rotation.from_euler("z", 0.05 * k / n).as_quat(scalar_first=True)
+    return origin, q
+
+
+def test_dragging_a_cad_mesh_body_saves_its_placement(near_engine_copy, tmp_path):
+    """The engine block is a CAD mesh in global coordinates: dragged (moved and turned), its
+    mesh moves by the new ``placement``; the saved scene loads back, keeps its comments, and
+    its batch static solve and clearance equal the workbench's (1e-9 m)."""
+    from cablelife.simulate import simulate
+    from cablelife.surroundings.build import load_surroundings
+    from cablelife.workbench.session import at_rest
+
+    session = Session.open(near_engine_copy)
+    for k in range(1, 11):
+        origin, q = engine_pose_at(k)
+        assert session.move_body("engine", origin, q.tolist()) == {"hose": ""}
+    shown = np.array(session.state()["cables"]["hose"]["values"]["clearance"]) / 1e3
+    out = session.save(tmp_path / "moved.toml")
+    text = out.read_text()
+    assert text.startswith("# The hose of hose-three-clips.toml routed near its surroundings")
+    assert "placement = {" in text
+    saved = load_scene(out)
+    body = saved.body("engine")
+    np.testing.assert_allclose(body.placement.orientation, [0.0, 0.0, 0.05], atol=1e-12)
+    # placement x ↦ p + R x equals the drag x ↦ o1 + R (x − o0)
+    o0, o1 = np.array([0.6, 0.2, 0.0]), np.array(engine_pose_at(10)[0])
+    rz = np.array([[np.cos(0.05), -np.sin(0.05), 0], [np.sin(0.05), np.cos(0.05), 0], [0, 0, 1]])
+    np.testing.assert_allclose(body.placement.position, o1 - rz @ o0, atol=1e-12)
+    # the saved scene's engine mesh is the opened one moved as drawn by the page
+    before, after = load_surroundings(load_scene(NEAR_ENGINE)), load_surroundings(saved)
+    k = before.bodies.index("engine")
+    (v0, f0), (v1, f1) = before.display_meshes()[k], after.display_meshes()[k]
+    ab = session.body_map("engine")
+    np.testing.assert_array_equal(f0, f1)
+    np.testing.assert_allclose(v1, v0 @ ab[:, :3].T + ab[:, 3], atol=1e-9)
+    assert np.abs(v1 - v0).max() > 0.01
+    ref = simulate(at_rest(saved), mode="static").cables["hose"]
+    assert np.abs(session.cables["hose"].state.positions - ref.positions[0]).max() < 1e-9
+    np.testing.assert_allclose(shown, ref.clearance[0], atol=1e-9)
+    assert all(session.undo() for _ in range(10)) and not session.undo()  # one step a move
+    assert session.scene_text() == NEAR_ENGINE.read_text()  # no placement any more
     with pytest.raises(WorkbenchError, match="body 'motor' is not in the scene; allowed: "):
         session.move_body("motor", [0.0, 0.0, 0.0])
-    assert session.undo_stack == []
+
+
+def test_page_drags_a_cad_mesh_body_with_the_mouse(near_engine_copy, tmp_path):
+    """The engine block (an STL in global coordinates) dragged by its handle with the mouse:
+    the mesh and the clip follow, the cable answers; the saved scene (with the engine's new
+    placement) solves to what the page shows, and its mesh is where the page draws it."""
+    _browser()
+    from cablelife.surroundings.build import load_surroundings
+    from cablelife.workbench.drive import run_page, workbench_process
+    from cablelife.workbench.session import at_rest
+
+    shots = Path(os.environ.get("CABLELIFE_SCREENSHOTS", tmp_path))
+    saved_path = tmp_path / "dragged.toml"
+
+    async def script(page):
+        x0 = await page.call("state()")
+        await page.call("setQuantity('clearance')")
+        await page.call("selectBody('engine')")
+        x, y = await page.call("bodyOnScreen('engine')")
+        mouse = page.cdp.call
+        await mouse("Input.dispatchMouseEvent", type="mouseMoved", x=x, y=y)
+        await mouse("Input.dispatchMouseEvent", type="mousePressed", x=x, y=y, button="left",
+                    clickCount=1)  # fmt: skip
+        for k in range(1, 16):
+            await mouse("Input.dispatchMouseEvent", type="mouseMoved", x=x + 2 * k, y=y - 3 * k,
+                        button="left", buttons=1)  # fmt: skip
+            await page.call("settled()")
+        await mouse("Input.dispatchMouseEvent", type="mouseReleased", x=x + 30, y=y - 45,
+                    button="left", clickCount=1)  # fmt: skip
+        await page.call("settled()")
+        dragged = await page.call("state()")
+        pose = await page.call("bodyPose('engine')")
+        shot = await page.screenshot(shots / "workbench-body-mesh.png")
+        saved = await page.call(f"save({str(saved_path)!r})")
+        return x0, dragged, pose, shot, saved
+
+    with workbench_process(near_engine_copy) as (_, url):
+        x0, dragged, pose, shot, saved = run_page(url, script)
+    assert saved["ok"]
+    a0, a1 = np.array(x0["cables"]["hose"]["positions"]), dragged["cables"]["hose"]["positions"]
+    assert np.abs(a0 - np.array(a1)).max() > 1e-3  # the body moved, the cable answered
+    scene = load_scene(saved_path)
+    body = scene.body("engine")
+    assert body.placement is not None and body.origin == tuple(
+        pytest.approx(v, abs=1e-12) for v in pose["position"]
+    )
+    ref = simulate_static(at_rest(scene))
+    assert np.abs(np.array(a1) - ref.positions[0]).max() < 1e-9
+    # the saved mesh is the opened one moved by the map the page draws it with
+    before, after = load_surroundings(load_scene(NEAR_ENGINE)), load_surroundings(scene)
+    k = before.bodies.index("engine")
+    v0, v1 = before.display_meshes()[k][0], after.display_meshes()[k][0]
+    ab = np.array(pose["map"])
+    np.testing.assert_allclose(v1, v0 @ ab[:, :3].T + ab[:, 3], atol=1e-6)  # float32 on the page
+    assert np.abs(v1 - v0).max() > 1e-3
+    assert shot.stat().st_size > 20_000
+
+
+def simulate_static(scene):
+    from cablelife.simulate import simulate
+
+    return simulate(scene, mode="static").cables["hose"]
 
 
 def test_page_drags_a_body(harness_copy, tmp_path):
@@ -1004,3 +1116,306 @@ def test_dragged_body_carries_its_geometry_for_clearance(tmp_path):
     np.testing.assert_allclose(after, ref.clearance[0], atol=1e-9)
     assert np.abs(after - before / 1e3).max() > 1e-3  # the sphere moved (and the cable)
     assert np.abs(session.cables["hose"].state.positions - ref.positions[0]).max() < 1e-9
+
+
+def test_time_slider_is_the_quasistatic_run(scene_copy, tmp_path):
+    """The bodies' motion at the steps of the quasistatic grid, each solved as a static
+    equilibrium warm from the last one shown: the same as a quasistatic run at those times
+    within the Newton tolerance (1e-9 of the cable length), stepping through or jumping."""
+    from cablelife.simulate import simulate
+
+    session = Session.open(scene_copy)
+    rest = session.cables["hose"].state.positions.copy()
+    info = session.motion_info()
+    assert info["steps"] == 101 and info["times"][-1] == pytest.approx(2.0)
+    ref = simulate(load_scene(scene_copy), mode="quasistatic").cables["hose"].positions
+    assert np.abs(ref[25] - ref[0]).max() > 1e-3  # the engine does move the cable
+    for k in range(0, 101, 2):
+        assert session.show_time(k) == {"hose": ""}
+        assert np.abs(session.cables["hose"].state.positions - ref[k]).max() < 1e-9, k
+    for k in (70, 5, 100, 33):  # jumps, also backwards
+        assert session.show_time(k) == {"hose": ""}
+        assert np.abs(session.cables["hose"].state.positions - ref[k]).max() < 1e-9, k
+    st = session.state()
+    assert st["time"] == {"step": 33, "t": pytest.approx(0.66)}
+    m = np.array(st["bodies"]["engine"]["map"])  # the engine body drawn at its pose at t
+    clip = np.array(st["cables"]["hose"]["clipPositions"][2])
+    np.testing.assert_allclose(m[:, :3] @ [0.75, 0.25, 0.0] + m[:, 3], clip, atol=1e-12)
+    with pytest.raises(WorkbenchError, match=r"motion is shown \(t = 0.66 s\): go back to rest"):
+        session.move_clips([{"cable": "hose", "clip": CLIP, "position": [0.7, 0.2, 0.0]}])
+    with pytest.raises(WorkbenchError, match="time step 101: allowed: an integer 0 … 100"):
+        session.show_time(101)
+    assert session.back_to_rest() == {"hose": ""}
+    assert session.state()["time"] is None
+    assert np.abs(session.cables["hose"].state.positions - rest).max() < 1e-9
+    assert session.move_clips([{"cable": "hose", "clip": CLIP, "position": [0.7, 0.2, 0.0]}])
+    # a grid too fine for a slider, and a scene without a duration: no slider, and why
+    path = tmp_path / "fine.toml"
+    path.write_text(scene_copy.read_text().replace("time_step = 0.02 ", "time_step = 1e-5 "))
+    why = Session.open(path).motion_info()
+    assert why["steps"] == 0 and "has 200001 steps" in why["why"]
+    path = tmp_path / "static.toml"
+    path.write_text(scene_copy.read_text().replace("duration = 2.0", ""))
+    why = Session.open(path).motion_info()
+    assert why["steps"] == 0 and "no simulation.duration" in why["why"]
+
+
+def test_time_slider_on_a_harness(harness_copy):
+    """The harness example's powertrain motion scrubbed: every cable and the junction equal
+    the quasistatic run at the same steps (1e-9 m)."""
+    from cablelife.simulate import simulate
+
+    session = Session.open(harness_copy)
+    res = simulate(load_scene(harness_copy), mode="quasistatic")
+    steps = session.motion_info()["steps"]
+    assert steps == res.cables["trunk"].positions.shape[0]
+    for k in list(range(steps)) + [3, steps - 1, 0]:
+        assert not any(session.show_time(k).values())
+        for name, live in session.cables.items():
+            assert np.abs(live.state.positions - res.cables[name].positions[k]).max() < 1e-9, k
+    session.back_to_rest()
+    assert session.state()["time"] is None
+
+
+def test_page_scrubs_the_body_motion(scene_copy, tmp_path):
+    """The time slider: the page shows the static equilibrium at steps of the quasistatic grid
+    (the same as the session's, which equals the quasistatic run), labelled as such; moves are
+    refused until *back to rest*, which returns to the rest equilibrium."""
+    _browser()
+    from cablelife.workbench.drive import run_page, workbench_process
+
+    shots = Path(os.environ.get("CABLELIFE_SCREENSHOTS", tmp_path))
+    steps = list(range(0, 101, 10)) + [37]
+
+    async def script(page):
+        x0 = await page.call("state()")
+        info = await page.call("motionInfo()")
+        shown = []
+        for k in steps:
+            t = await page.call(f"showTime({k})")
+            shown.append((t, (await page.call("state()"))["cables"]["hose"]["positions"]))
+        # the slider itself, as a person drags it
+        await page.cdp.evaluate(
+            "(function(){var s=document.getElementById('motion-step');s.value=25;"
+            "s.dispatchEvent(new Event('input'));})()"
+        )
+        await page.call("settled()")
+        slid = await page.call("state()")
+        label = await page.text("motion-time")
+        note = await page.cdp.evaluate("document.querySelector('#motion .note').textContent")
+        note += " | " + await page.text("time-label")
+        refused = await page.call(f"moveClip('hose', '{CLIP}', [0.7, 0.2, 0.0])")
+        shot = await page.screenshot(shots / "workbench-motion.png")
+        await page.call("backToRest()")
+        rest = await page.call("state()")
+        return x0, info, shown, slid, label, note, refused, shot, rest
+
+    with workbench_process(scene_copy) as (_, url):
+        x0, info, shown, slid, label, note, refused, shot, rest = run_page(url, script)
+    assert info["steps"] == 101
+    session = Session.open(scene_copy)
+    for k, (t, positions) in zip(steps, shown, strict=True):
+        assert t["time"]["step"] == k and t["time"]["t"] == pytest.approx(0.02 * k)
+        assert f"t = {0.02 * k:.3f} s (step {k} of 100)" == t["label"]
+        session.show_time(k)
+        np.testing.assert_allclose(positions, session.cables["hose"].state.positions, atol=1e-12)
+    session.show_time(25)
+    np.testing.assert_allclose(slid["cables"]["hose"]["positions"],
+                               session.cables["hose"].state.positions, atol=1e-12)  # fmt: skip
+    assert label == "t = 0.500 s (step 25 of 100)"
+    assert "Static equilibrium at each time" in note and "not dynamics" in note
+    assert note.endswith("| t = 0.500 s: static equilibrium (quasistatic), not dynamics")
+    assert "go back to rest to move or edit" in refused["error"]
+    assert np.abs(np.array(rest["cables"]["hose"]["positions"])
+                  - np.array(x0["cables"]["hose"]["positions"])).max() < 1e-9  # fmt: skip
+    assert shot.stat().st_size > 20_000
+
+
+def test_adding_and_removing_clips(scene_copy, tmp_path):
+    """A clip added at s where the cable is (undoable, saved with the file's comments, the
+    saved scene's batch solve equal to the workbench's); clips removed while the cable stays
+    held; a removal that leaves the statics ill-posed is refused with the solver's reason."""
+    session = Session.open(scene_copy)
+    before = session.cables["hose"].state.positions.copy()
+    name = session.add_clip("hose", 0.25, "fixed")
+    assert name == "clip-1"
+    spec = session.cable_spec("hose")
+    assert [c.name for c in spec.clips] == ["body-clip", "clip-1", "middle", CLIP]
+    arc = np.linspace(0.0, 1.0, 51)
+    where = [np.interp(0.25, arc, before[:, i]) for i in range(3)]
+    np.testing.assert_allclose(spec.clips[1].position, where, atol=1e-12)
+    out = session.save(tmp_path / "added.toml")
+    text = out.read_text()
+    assert "# The engine rocks: 5 mm vertical sine" in text
+    assert text.index('name = "clip-1"') < text.index('name = "middle"')
+    ref = batch_equilibrium(load_scene(out), "hose")
+    assert np.abs(session.cables["hose"].state.positions - ref).max() < 1e-9
+    assert session.undo() and session.scene_text() == scene_copy.read_text()
+    # a sliding clip brings its guide length, a hinge its axis
+    session.add_clip("hose", 0.7, "sliding")
+    assert session.cable_spec("hose").clips[-2].length == pytest.approx(0.08)
+    session.undo()
+    session.remove_clip("hose", "middle")
+    assert [c.name for c in session.cable_spec("hose").clips] == ["body-clip", CLIP]
+    ref = batch_equilibrium(load_scene(session.save(tmp_path / "removed.toml")), "hose")
+    assert np.abs(session.cables["hose"].state.positions - ref).max() < 1e-9
+    assert 'name = "middle"' not in (tmp_path / "removed.toml").read_text()
+    session.undo()
+    session.remove_clip("hose", "body-clip")
+    kept = session.scene_text()
+    with pytest.raises(WorkbenchError, match=r"'engine-bracket' cannot be removed: .*singular"):
+        session.remove_clip("hose", CLIP)  # a single swivel point clip: the cable spins free
+    assert session.scene_text() == kept and len(session.cable_spec("hose").clips) == 2
+    for args, expected in [
+        (("hose", 1.5, "fixed"), r"new clip s = 1.5 m is outside the cable \[0, 1\] m"),
+        (("hose", 0.3, "glued"), "new clip type = 'glued'; allowed: fixed, swivel"),
+        (("hose", 0.3, "fixed", "motor"), "new clip body = 'motor'; allowed: 'world', 'engine'"),
+        (("hose", 0.5, "fixed"), "overlap"),
+        (("pipe", 0.5, "fixed"), "cable 'pipe' is not in the scene"),
+    ]:
+        with pytest.raises((WorkbenchError, SceneError), match=expected):
+            session.add_clip(*args)
+        assert session.scene_text() == kept
+    with pytest.raises(WorkbenchError, match="cable 'hose' has no clip 'nope'"):
+        session.remove_clip("hose", "nope")
+
+
+def test_page_adds_and_removes_clips(scene_copy, tmp_path):
+    """The panel's *add clip* row and a clip's × button, clicked as a person would: the handle
+    appears / goes, the cable is re-solved as the session does, undo restores; a removal that
+    leaves the cable free is refused with the reason on the page."""
+    _browser()
+    from cablelife.workbench.drive import run_page, workbench_process
+
+    shots = Path(os.environ.get("CABLELIFE_SCREENSHOTS", tmp_path))
+
+    def click(selector):
+        return f"document.querySelector({selector!r}).click()"
+
+    async def script(page):
+        ev = page.cdp.evaluate
+        await ev("document.querySelector('.add-clip .add-s').value = '0.3'")
+        await ev("(function(){var t=document.querySelector('.add-clip .add-type');"
+                 "t.value='swivel';})()")  # fmt: skip
+        await ev(click(".add-clip button.add"))
+        await page.call("settled()")
+        added = await page.call("clipNames()")
+        state = await page.call("state()")
+        await page.call("select('hose', 'clip-1')")
+        shot = await page.screenshot(shots / "workbench-clips.png")
+        await ev(click('button.rm[data-item="clip-1"]'))
+        await page.call("settled()")
+        removed = await page.call("clipNames()")
+        await ev(click('button.rm[data-item="body-clip"]'))
+        await page.call("settled()")
+        refused = await page.call("removeClip('hose', 'engine-bracket')")
+        message = await page.text("message")
+        after = await page.call("clipNames()")
+        await page.call("undo()")
+        await page.call("undo()")
+        undone = await page.call("clipNames()")
+        return added, state, shot, removed, refused, message, after, undone
+
+    with workbench_process(scene_copy) as (_, url):
+        added, state, shot, removed, refused, message, after, undone = run_page(url, script)
+    assert sorted(added["hose"]) == sorted(["body-clip", "clip-1", "middle", CLIP])
+    session = Session.open(scene_copy)
+    session.add_clip("hose", 0.3, "swivel")
+    np.testing.assert_allclose(state["cables"]["hose"]["positions"],
+                               session.cables["hose"].state.positions, atol=1e-12)  # fmt: skip
+    assert sorted(removed["hose"]) == sorted(["body-clip", "middle", CLIP])
+    assert "clip 'engine-bracket' cannot be removed" in refused["error"]
+    assert "cannot be removed" in message and "singular" in message
+    assert sorted(after["hose"]) == sorted(["middle", CLIP])
+    assert sorted(undone["hose"]) == sorted(["body-clip", "clip-1", "middle", CLIP])
+    assert shot.stat().st_size > 20_000
+
+
+def test_dragged_body_moves_its_contact_obstacles(tmp_path):
+    """With contact, the obstacles of a dragged body move with it: a table (a CAD mesh in
+    global coordinates, no clips) under a sagging hose lifted by 5.4 cm pushes the hose up; the
+    saved scene has the table where it was dragged (its placement), and the equilibrium is the
+    quasistatic run's that lifts the table through the same poses (frictionless)."""
+    trimesh = pytest.importorskip("trimesh")
+
+    box = trimesh.creation.box(extents=[0.6, 0.4, 0.05])
+    box.apply_translation([0.4, 0.1, -0.325])
+    box.export(tmp_path / "table.stl")
+    path = tmp_path / "table.toml"
+    path.write_text(
+        """# a hose hanging above a table
+[simulation]
+mode = "static"
+
+[contact]
+enabled = true
+friction = 0.0
+
+[[bodies]]
+name = "table"
+origin = [0.4, 0.1, -0.3]
+geometry = [{ mesh = "table.stl", name = "top" }]
+
+[[cables]]
+name = "hose"
+length = 1.0
+segments = 40
+section = { shape = "circle", radius = 0.005 }
+material = { youngs_modulus = 5.0e7, poisson_ratio = 0.45, density = 1500.0 }
+
+[[cables.clips]]
+name = "a"
+s = 0.0
+position = [0.0, 0.0, 0.0]
+direction = [1.0, 0.0, 0.0]
+normal = [0.0, 0.0, 1.0]
+
+[[cables.clips]]
+name = "b"
+s = 1.0
+position = [0.8, 0.2, 0.0]
+direction = [1.0, 0.0, 0.0]
+normal = [0.0, 0.0, 1.0]
+"""
+    )
+    session = Session.open(path)
+    before = session.cables["hose"].state.positions.copy()
+    for k in range(1, 11):
+        assert session.move_body("table", [0.4, 0.1, -0.3 + 0.0054 * k]) == {"hose": ""}
+    after = session.cables["hose"].state.positions
+    assert after[:, 2].min() - before[:, 2].min() > 2e-3  # the table holds the hose up
+    from cablelife.contact_settings import obstacles
+    from cablelife.simulate import simulate
+
+    scene = load_scene(session.save(tmp_path / "lifted.toml"))
+    np.testing.assert_allclose(scene.body("table").placement.position, [0, 0, 0.054], atol=1e-12)
+    (_, f1, m1), (_, f0, m0) = obstacles(scene), obstacles(load_scene(path))
+    np.testing.assert_allclose(f1[0][0], f0[0][0] + [0, 0, 0.054], atol=1e-12)  # the saved table
+    np.testing.assert_allclose(m1[0][0], m0[0][0], atol=1e-12)
+    # a cold batch solve cannot start with the route through the lifted table: the reference
+    # is the quasistatic run lifting it through the same ten poses
+    data = load_scene(path).model_dump(mode="json", exclude_none=True)
+    data["bodies"][0]["motion"] = [
+        {"channel": "z", "signal": {"type": "table", "t": [0.0, 1.0], "value": [0.0, 0.054]}}
+    ]
+    data["simulation"].update(mode="quasistatic", duration=1.0, time_step=0.1)
+    ref = simulate(scene_from_dict(data, base_dir=tmp_path)).cables["hose"].positions
+    assert np.abs(after - ref[-1]).max() < 1e-9
+    assert all(session.undo() for _ in range(10))
+    assert np.abs(session.cables["hose"].state.positions - before).max() < 1e-9
+
+
+def test_time_slider_moves_the_geometry_for_clearance(near_engine_copy):
+    """With the motion shown, the clearance is to the bodies' geometry at that time: equal to
+    the quasistatic run's clearance at the same steps."""
+    from cablelife.simulate import simulate
+
+    session = Session.open(near_engine_copy)
+    ref = simulate(load_scene(near_engine_copy), mode="quasistatic").cables["hose"]
+    for k in (0, 12, 25, 60, 100):
+        assert session.show_time(k) == {"hose": ""}
+        live = session.cables["hose"]
+        assert np.abs(live.state.positions - ref.positions[k]).max() < 1e-9
+        clearance = np.array(session.state()["cables"]["hose"]["values"]["clearance"]) / 1e3
+        np.testing.assert_allclose(clearance, ref.clearance[k], atol=1e-9)
+    assert np.abs(ref.clearance - ref.clearance[0]).max() > 1e-3  # the engine does move

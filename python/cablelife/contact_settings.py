@@ -81,11 +81,9 @@ def obstacles(scene) -> tuple[list, list, list[tuple[np.ndarray, np.ndarray]]]:
     tuples, frames, meshes = [], [], []
     size = None
     for bi, body in enumerate(scene.bodies):
-        origin = np.asarray(body.origin, float)
-        r0 = euler_matrix(body.orientation)
         for k, part in enumerate(body.geometry):
             name = part_label(body.name, k, part)
-            o, rot0 = (origin, r0) if part.frame == "body" else (np.zeros(3), np.eye(3))
+            o, rot0 = body.part_frame(part)  # body frame or placement → global at rest
             friction = mu if part.friction is None else part.friction
             if isinstance(part, MeshPart):
                 size = scene_size(scene) if size is None else size

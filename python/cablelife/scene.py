@@ -26,6 +26,7 @@ from cablelife import _core
 from cablelife.contact_settings import ContactSettings, check_geometry
 from cablelife.limits import LIMITS, MAX_SEGMENTS, MIN_SEGMENTS, check_name
 from cablelife.paths import SceneFileError, resolve_scene_file, shown_names
+from cablelife.rotations import euler_matrix
 from cablelife.sections import SectionProperties, from_material, from_measured
 from cablelife.signals.spec import ChannelMotion, TableSignal
 from cablelife.surroundings.models import ClearanceSettings, GeometryPart
@@ -334,6 +335,16 @@ class Cable(_Model):
         return from_material(sec.shape, outer, inner, mat.youngs_modulus, mat.nu, mat.density)
 
 
+class Placement(_Model):
+    """Where a body's geometry given in global coordinates (``frame = "global"``: meshes as CAD
+    exports them, primitives) is put: a point x of such a part goes to ``position + R x``,
+    R = Rz Ry Rx of ``orientation`` (rad). The identity (the default) leaves the parts where
+    their coordinates say (docs/scene.md, Body placement)."""
+
+    position: Point = (0.0, 0.0, 0.0)  # m
+    orientation: Vec3 = (0.0, 0.0, 0.0)  # rx, ry, rz (rad)
+
+
 class Body(_Model):
     """A rigid body carrying clips; its motion is a list of channel signals, or a CSV table
     ``motion_file`` with columns t, x, y, z, rx, ry, rz (m, rad; global frame)."""
@@ -344,12 +355,32 @@ class Body(_Model):
     motion: list[ChannelMotion] = []
     motion_file: Path | None = None
     geometry: list[GeometryPart] = []  # shapes moving with the body (docs/environment.md)
+    placement: Placement | None = None  # of the geometry in global coordinates (identity)
 
     @model_validator(mode="after")
     def _one_motion(self):
         if self.motion and self.motion_file is not None:
             raise ValueError("give motion (channels) or motion_file, not both")
+        if self.placement is not None and all(p.frame == "body" for p in self.geometry):
+            raise ValueError(
+                f"placement = {self.placement.model_dump()} is given, but body '{self.name}' "
+                "has no geometry in global coordinates (the placement moves only parts with "
+                'frame = "global"); allowed: a placement with such parts, or none'
+            )
         return self
+
+    def part_frame(self, part) -> tuple[np.ndarray, np.ndarray]:
+        """(o, R): a point p of a geometry ``part`` given in its own coordinates is at
+        o + R p globally with the body at rest — the body's origin and axes for
+        ``frame = "body"`` parts, the ``placement`` for parts in global coordinates."""
+        if part.frame == "body":
+            return np.asarray(self.origin, float), euler_matrix(self.orientation)
+        if self.placement is None:
+            return np.zeros(3), np.eye(3)
+        return (
+            np.asarray(self.placement.position, float),
+            euler_matrix(self.placement.orientation),
+        )
 
     def channel_motions(
         self, base_dir: Path | None = None, allow_outside: bool = False

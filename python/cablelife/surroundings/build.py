@@ -78,12 +78,10 @@ def load_surroundings(scene: Scene) -> Surroundings | None:
             continue
         b = len(bodies)
         bodies.append(body.name)
-        origin = np.asarray(body.origin, float)
-        r0 = euler_matrix(body.orientation)
         for k, part in enumerate(body.geometry):
             what = f"bodies[{bi}].geometry[{k}] ('{part_label(body.name, k, part)}')"
-            # parts in the body frame go to global coordinates at rest: X = o + R0 p
-            o, rot0 = (origin, r0) if part.frame == "body" else (np.zeros(3), np.eye(3))
+            # each part to global coordinates at rest: X = o + R0 p (body frame or placement)
+            o, rot0 = body.part_frame(part)
             try:
                 if isinstance(part, MeshPart):
                     path = resolve_scene_file(scene.base_dir, part.mesh)
@@ -123,7 +121,7 @@ def load_surroundings(scene: Scene) -> Surroundings | None:
                 from cablelife.surroundings.display import primitive_mesh
 
                 # a plane is drawn as a square of the scene's size under the clips
-                near = None if part.frame == "body" else centre
+                near = None if part.frame == "body" or centre is None else rot0.T @ (centre - o)
                 pv, pf = primitive_mesh(part, 1.5 * size, near)
                 meshes.append((b, pv @ rot0.T + o, pf))
             labels.append(part_label(body.name, k, part))

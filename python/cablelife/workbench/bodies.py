@@ -1,6 +1,6 @@
 """Dragging a body in the workbench: the rigid map of a body from its pose in the scene as
-opened to its pose now, the check that a moved body can be saved, and Euler angles back from a
-rotation matrix (the scene's ``orientation``: R = Rz Ry Rx)."""
+opened to its pose now, the new ``placement`` of its geometry in global coordinates, and Euler
+angles back from a rotation matrix (the scene's ``orientation``: R = Rz Ry Rx)."""
 
 from __future__ import annotations
 
@@ -37,20 +37,18 @@ def rigid_map(before: Body, after: Body) -> tuple[np.ndarray, np.ndarray]:
     return a, o1 - a @ o0
 
 
-def unsaveable_geometry(body: Body) -> str:
-    """Why a drag of ``body`` could not be saved ("" when it can): the scene format moves a
-    body's geometry with its ``origin``/``orientation`` only for parts given in the body frame
-    (``frame = "body"``); parts in global coordinates (meshes as CAD exports them) have no
-    placement to write."""
-    fixed = [p for p in body.geometry if getattr(p, "frame", "global") != "body"]
-    if not fixed:
-        return ""
-    names = ", ".join(
-        repr(getattr(p, "name", None) or str(getattr(p, "mesh", None) or p.shape))
-        for p in fixed[:3]
-    )
-    return (
-        f"body '{body.name}' cannot be dragged: its geometry part(s) {names} are in global "
-        "coordinates, and the scene format has no placement for them (a moved body could not "
-        'be saved); give them frame = "body" (coordinates in the body\'s axes) to drag it'
-    )
+def global_parts(body: Body) -> list:
+    """The body's geometry parts given in global coordinates (placed by ``placement``)."""
+    return [p for p in body.geometry if p.frame != "body"]
+
+
+def moved_placement(body: Body, a: np.ndarray, o0: np.ndarray, o1: np.ndarray) -> dict | None:
+    """The body's ``placement`` after the drag x ↦ o1 + a (x − o0), as written to the scene:
+    {"position", "orientation"}; None when the body has no parts in global coordinates."""
+    if not global_parts(body):
+        return None
+    p, rp = body.part_frame(global_parts(body)[0])
+    return {
+        "position": (o1 + a @ (p - o0)).tolist(),
+        "orientation": matrix_euler(a @ rp),
+    }

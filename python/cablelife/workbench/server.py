@@ -52,6 +52,7 @@ class SceneHandler(_Base):
             "clipTypes": list(CLIP_TYPES),
             "state": s.state(),
             "result": self.app.get("result_info"),
+            "motion": s.motion_info(),
         }
         self.set_header("Content-Type", "application/json")
         self.write(_json(info))
@@ -74,7 +75,9 @@ class ResultStepHandler(_Base):
 
 class SocketHandler(tornado.websocket.WebSocketHandler):
     """Requests {id, op, ...} → replies {id, ok, state | error}. Ops: move (moves: [{cable,
-    clip, position, quaternion?}]), edit (cable, item, key, value), undo, save (path?)."""
+    clip, position, quaternion?}]), moveBody, edit (cable, item, key, value), addClip (cable, s,
+    type, body), removeClip (cable, clip), undo, save (path?),
+    time (step: the bodies' motion at a step of the quasistatic grid), rest, state."""
 
     def initialize(self, app_state):
         self.app = app_state
@@ -146,9 +149,29 @@ class SocketHandler(tornado.websocket.WebSocketHandler):
         if op == "save":
             path = s.save(req.get("path") or None)
             return {"ok": True, "saved": str(path), "state": s.state()}
+        if op == "addClip":
+            name = s.add_clip(str(req.get("cable")), req.get("s"), str(req.get("type") or "fixed"),
+                              str(req.get("body") or "world"))  # fmt: skip
+            return {"ok": True, "clip": name, "state": s.state()}
+        if op == "removeClip":
+            s.remove_clip(str(req.get("cable")), str(req.get("clip")))
+            return {"ok": True, "state": s.state()}
+        if op == "time":
+            start = time.perf_counter()
+            errors = s.show_time(req.get("step"))
+            ms = (time.perf_counter() - start) * 1e3
+            failed = "; ".join(e for e in errors.values() if e)
+            return {"ok": not failed, "error": failed, "state": s.state(), "solveMs": ms}
+        if op == "rest":
+            errors = s.back_to_rest()
+            failed = "; ".join(e for e in errors.values() if e)
+            return {"ok": not failed, "error": failed, "state": s.state()}
         if op == "state":
             return {"ok": True, "state": s.state()}
-        raise WorkbenchError(f"op = {op!r}; allowed: move, moveBody, edit, undo, save, state")
+        raise WorkbenchError(
+            f"op = {op!r}; allowed: move, moveBody, edit, addClip, removeClip, undo, save, "
+            "time, rest, state"
+        )
 
 
 def make_app(session: Session, player=None) -> tornado.web.Application:

@@ -23,7 +23,15 @@ import numpy as np
 
 from cablelife.limits import LIMITS
 from cablelife.rotations import matrix_quaternions
-from cablelife.scene import Cable, Clip, Scene, SceneError, load_scene, scene_from_dict
+from cablelife.scene import (
+    Cable,
+    Clip,
+    Placement,
+    Scene,
+    SceneError,
+    load_scene,
+    scene_from_dict,
+)
 from cablelife.simulate import build_cable, euler_matrix
 
 #: Colour quantities: key → (label, unit). Values per node.
@@ -113,6 +121,10 @@ class Session:
     # The default junction normals in effect as opened (they follow the routed geometry, which
     # moves with the clips): kept for every rebuild and written on save (docs/harness.md).
     junction_pins: dict = field(default_factory=dict)
+    track: object = None  # motion.MotionTrack while the bodies' motion is shown, else None
+    time_index: int | None = None  # the step of ``track`` shown
+    rest: dict | None = None  # clip poses at rest (and a harness's end clips) while moving
+    track_cache: tuple | None = None  # (scene text, MotionTrack) last computed
 
     # ------------------------------------------------------------------ opening
     @classmethod
@@ -182,7 +194,6 @@ class Session:
 
     def _rebuild(self, cable: Cable) -> LiveCable:
         """A fresh solver for ``cable`` (its mesh follows the clips), solved from its route."""
-        from cablelife.contact_settings import set_contact
         from cablelife.simulate import clip_poses
 
         if self.scene.junctions:
@@ -190,15 +201,28 @@ class Session:
             return self.cables[cable.name]
         core = build_cable(self.scene, cable)
         if self.scene.contact is not None and self.scene.contact.enabled:
-            try:
-                set_contact(core, self.scene, cable, np.array([0.0]))
-            except ValueError as err:
-                raise SceneError(f"cable '{cable.name}': {err}") from None
+            self._set_contact(core, self.scene, cable)
         pos, quat = clip_poses(self.scene, cable, np.array([0.0]), with_motion=False)
         live = self._live_cable(cable, core, pos[0].copy(), quat[0].copy())
         self.cables[cable.name] = live
         self._solve(live, live.clip_positions, live.clip_quaternions)
         return live
+
+    def _contact_on(self, body) -> bool:
+        """Contact is solved and ``body`` carries obstacles."""
+        c = self.scene.contact
+        return c is not None and c.enabled and bool(body.geometry) and self.harness is None
+
+    @staticmethod
+    def _set_contact(core, scene: Scene, cable: Cable) -> None:
+        """The contact term of ``core`` with the obstacles of ``scene``'s bodies at rest (their
+        motion not applied, as the clips)."""
+        from cablelife.contact_settings import set_contact
+
+        try:
+            set_contact(core, at_rest(scene), cable, np.array([0.0]))
+        except ValueError as err:
+            raise SceneError(f"cable '{cable.name}': {err}") from None
 
     # ------------------------------------------------------------------ lookups
     def cable_spec(self, name: str) -> Cable:
@@ -263,6 +287,7 @@ class Session:
         clips where they were. ``mark``: an undo step starts here (the first move of a drag;
         later moves of the same drag pass False)."""
         with self.lock:
+            self._check_at_rest()
             targets: dict[str, tuple[np.ndarray, np.ndarray, list]] = {}
             for m in moves:
                 cable = self.cable_spec(str(m.get("cable")))
@@ -314,20 +339,18 @@ class Session:
         ``quaternion`` [w, x, y, z], a new orientation of its axes: its clips (in every cable)
         and geometry follow rigidly, the cables concerned are re-solved. All or nothing: when a
         cable has no equilibrium, the body, its clips and every cable stay as they were.
-        Returns {cable: error message or ""}; raises WorkbenchError for an unknown body or one
-        whose move could not be saved (geometry in global coordinates)."""
-        from cablelife.workbench.bodies import body_pose, matrix_euler, unsaveable_geometry
+        Geometry in global coordinates moves by the body's ``placement``. Returns {cable: error
+        message or ""}; raises WorkbenchError for an unknown body or a bad pose."""
+        from cablelife.workbench.bodies import body_pose, matrix_euler, moved_placement
 
         with self.lock:
+            self._check_at_rest()
             spec = self.scene.body(str(body))
             if spec is None:
                 raise WorkbenchError(
                     f"body {body!r} is not in the scene; allowed: "
                     + (", ".join(repr(b.name) for b in self.scene.bodies) or "none")
                 )
-            why = unsaveable_geometry(spec)
-            if why:
-                raise WorkbenchError(why)
             o0, r0 = body_pose(spec)
             o1 = self._check_point(f"body '{spec.name}' origin", position)
             r1 = r0
@@ -355,6 +378,27 @@ class Session:
                     pos[j] = p
                     quat[j] = matrix_quaternions(frame[None])[0]
                     edits.append((j, p, frame))
+            placed = moved_placement(spec, a, o0, o1)
+            if placed is not None:
+                placed = {k: [_tidy(v) for v in x] for k, x in placed.items()}
+            new_origin = tuple(_tidy(v) for v in o1)
+            new_orientation = (
+                spec.orientation
+                if quaternion is None
+                else tuple(_tidy(v) for v in matrix_euler(r1))
+            )
+            contact = self._contact_on(spec)
+            if contact:  # the obstacles of the body's geometry move with it: every cable
+                moved = self.scene.model_copy(deep=True)
+                b = moved.body(spec.name)
+                b.origin, b.orientation = new_origin, new_orientation
+                b.placement = None if placed is None else Placement(**placed)
+                for cable in self.scene.cables:
+                    live = self.cables[cable.name]
+                    targets.setdefault(
+                        cable.name, (live.clip_positions.copy(), live.clip_quaternions.copy(), [])
+                    )
+                    self._set_contact(live.core, moved, cable)
             keep = {n: (c.state, c.clip_positions, c.clip_quaternions, c.message)
                     for n, c in self.cables.items()}  # fmt: skip
             keep_junctions = None
@@ -371,14 +415,20 @@ class Session:
                     self.harness.junction_positions, self.harness.junction_quaternions = (
                         keep_junctions
                     )
+                if contact:
+                    for cable in self.scene.cables:
+                        self._set_contact(self.cables[cable.name].core, self.scene, cable)
                 return errors
             if mark:
                 self._push_undo()
             entry = self._toml_body(spec.name)
-            spec.origin = tuple(_tidy(v) for v in o1)
+            if placed is not None:
+                spec.placement = Placement(**placed)
+                entry["placement"] = _inline(placed)
+            spec.origin = new_origin
             entry["origin"] = list(spec.origin)
             if quaternion is not None:
-                spec.orientation = tuple(_tidy(v) for v in matrix_euler(r1))
+                spec.orientation = new_orientation
                 entry["orientation"] = list(spec.orientation)
             for name, (_, _, edits) in targets.items():
                 for j, p, frame in edits:
@@ -397,7 +447,101 @@ class Session:
         from cablelife.workbench.bodies import rigid_map
 
         a, b = rigid_map(self.opened.body(name), self.scene.body(name))
+        if self.track is not None:  # then the body's motion at the time shown
+            m = self.track.body_map(name, self.time_index)
+            a, b = m[:, :3] @ a, m[:, :3] @ b + m[:, 3]
         return np.column_stack([a, b])
+
+    # ------------------------------------------------------------------ body motion
+    def _check_at_rest(self) -> None:
+        if self.track is not None:
+            raise WorkbenchError(
+                f"the bodies' motion is shown (t = {self.track.times[self.time_index]:g} s): go "
+                "back to rest to move or edit"
+            )
+
+    def motion_info(self) -> dict:
+        """The quasistatic grid the time slider runs on, or why there is none."""
+        from cablelife.workbench.motion import MotionError
+
+        with self.lock:
+            try:
+                track = self.track or self._motion_track()
+            except MotionError as err:
+                return {"steps": 0, "why": str(err)}
+            return {"steps": int(track.times.size), "times": track.times.tolist()}
+
+    def _motion_track(self):
+        """The motion track of the scene as it is now (kept until the scene changes)."""
+        from cablelife.workbench.motion import motion_track
+
+        text = self.doc.as_string()
+        if self.track_cache is None or self.track_cache[0] != text:
+            self.track_cache = (text, motion_track(self.scene))
+        return self.track_cache[1]
+
+    def show_time(self, k) -> dict:
+        """The static equilibrium with the bodies at their motion's pose at step ``k`` of the
+        quasistatic grid, warm-started from the equilibrium shown (the first call starts from
+        rest). Returns {cable: error message or ""}; on a failed solve the last time shown
+        stays. Moves and edits are refused until :meth:`back_to_rest`."""
+        from cablelife.workbench.motion import MotionError
+
+        with self.lock:
+            track = self.track
+            if track is None:
+                try:
+                    track = self._motion_track()
+                except MotionError as err:
+                    raise WorkbenchError(str(err)) from None
+            if isinstance(k, bool) or not isinstance(k, int) or not 0 <= k < track.times.size:
+                raise WorkbenchError(
+                    f"time step {k!r}: allowed: an integer 0 … {track.times.size - 1} (t = 0 … "
+                    f"{track.times[-1]:g} s)"
+                )
+            h = self.harness
+            rest = self.rest
+            if self.track is None:
+                rest = {n: (c.clip_positions.copy(), c.clip_quaternions.copy())
+                        for n, c in self.cables.items()}  # fmt: skip
+                if h is not None:
+                    rest["ends"] = ([p.copy() for p in h.end_positions],
+                                    [q.copy() for q in h.end_quaternions])  # fmt: skip
+            targets = {}
+            for cable in self.scene.cables:
+                pos, quat = track.poses[cable.name]
+                n = len(cable.clips)
+                targets[cable.name] = (pos[k, :n].copy(), quat[k, :n].copy())
+            keep_ends = None
+            if h is not None:
+                keep_ends = (h.end_positions, h.end_quaternions)
+                h.end_positions = [track.poses[n][0][k, m:].copy()
+                                   for n, m in zip(h.names, h.own, strict=True)]  # fmt: skip
+                h.end_quaternions = [track.poses[n][1][k, m:].copy()
+                                     for n, m in zip(h.names, h.own, strict=True)]  # fmt: skip
+            results = self._solve_targets(targets)
+            if not all(results) and h is not None:
+                h.end_positions, h.end_quaternions = keep_ends
+            if all(results) or self.track is not None:
+                self.track, self.rest = track, rest
+                if all(results):
+                    self.time_index = k
+            return {n: self.cables[n].message for n in targets}
+
+    def back_to_rest(self) -> dict:
+        """Leaves the motion view: the cables are solved warm back to the clips' rest poses
+        (rebuilt from the scene if that fails)."""
+        with self.lock:
+            if self.track is None:
+                return {}
+            rest, h = self.rest, self.harness
+            if h is not None:
+                h.end_positions, h.end_quaternions = rest["ends"]
+            targets = {n: rest[n] for n in self.cables}
+            self.track, self.time_index, self.rest = None, None, None
+            if not all(self._solve_targets(targets)):
+                self._reload()
+            return {n: self.cables[n].message for n in targets}
 
     def _set_clip_pose(self, cable: Cable, j: int, p: np.ndarray, frame) -> None:
         """Writes a clip's new global pose into the scene (and its TOML), in the clip's frame."""
@@ -426,6 +570,7 @@ class Session:
         point; a type without them drops axis and friction. On an invalid value or a failed
         solve nothing changes."""
         with self.lock:
+            self._check_at_rest()
             spec = self.cable_spec(cable)
             if item:
                 clip = spec.clips[self.clip_index(spec, item)]
@@ -483,6 +628,107 @@ class Session:
                 self._reload(cable)
                 raise
 
+    def add_clip(self, cable: str, s, kind: str = "fixed", body: str = "world") -> str:
+        """Adds a clip of type ``kind`` on ``body`` at arc length ``s`` of ``cable``, posed
+        where the cable is now (its axis point and frame there, global coordinates), with what
+        the type needs (as :meth:`edit`); rebuilds and re-solves the cable (on a harness: the
+        tree). Returns the new clip's name. An invalid clip (beyond the cable, overlapping
+        another, an unknown type or body) or a failed solve changes nothing."""
+        with self.lock:
+            self._check_at_rest()
+            spec = self.cable_spec(cable)
+            if isinstance(s, bool) or not isinstance(s, int | float) or not math.isfinite(s):
+                raise WorkbenchError(f"cable '{cable}': new clip s = {s!r}; give a number in m")
+            if kind not in CLIP_TYPES:
+                raise WorkbenchError(
+                    f"cable '{cable}': new clip type = {kind!r}; allowed: " + ", ".join(CLIP_TYPES)
+                )
+            bodies = ["world", *(b.name for b in self.scene.bodies)]
+            if body not in bodies:
+                raise WorkbenchError(
+                    f"cable '{cable}': new clip body = {body!r}; allowed: "
+                    + ", ".join(repr(b) for b in bodies)
+                )
+            live = self.cables[cable]
+            if not 0.0 <= s <= live.arc_length[-1]:
+                raise WorkbenchError(
+                    f"cable '{cable}': new clip s = {s} m is outside the cable [0, "
+                    f"{live.arc_length[-1]:g}] m"
+                )
+            names = {c.name for c in spec.clips}
+            name = next(f"clip-{k}" for k in range(1, len(names) + 2) if f"clip-{k}" not in names)
+            p, d3, d1 = _cable_frame_at(live, float(s))
+            import tomlkit
+
+            entry = tomlkit.table()
+            entry.update(
+                {
+                    "name": name,
+                    "s": _tidy(s),
+                    "body": body,
+                    "position": [_tidy(v) for v in p],
+                    "direction": [_tidy(v) for v in d3],
+                    "normal": [_tidy(v) for v in d1],
+                    "type": kind,
+                }
+            )
+            _type_needs(entry, kind, spec)
+            entry.add(tomlkit.nl())
+
+            def change(doc):
+                table = next(c for c in doc["cables"] if c.get("name") == cable)
+                if "clips" not in table:
+                    table["clips"] = tomlkit.aot()
+                clips = table["clips"]
+                at = sum(1 for c in clips if float(c.get("s", 0.0)) <= s)
+                clips.insert(at, entry)
+
+            self._change_document(cable, change)
+            return name
+
+    def remove_clip(self, cable: str, clip: str) -> None:
+        """Removes a clip; rebuilds and re-solves the cable. Refused with the reason (and
+        nothing changed) when the cable's statics are no longer well posed: no clip left, a
+        rigid-body motion left free (the solver's singular-matrix message), or no
+        equilibrium."""
+        with self.lock:
+            self._check_at_rest()
+            spec = self.cable_spec(cable)
+            self.clip_index(spec, clip)
+
+            def change(doc):
+                table = next(c for c in doc["cables"] if c.get("name") == cable)
+                clips = table["clips"]
+                k = next(i for i, c in enumerate(clips) if c.get("name") == clip)
+                del clips[k]
+                if not len(clips):
+                    del table["clips"]
+
+            try:
+                self._change_document(cable, change)
+            except (SceneError, WorkbenchError) as err:
+                raise WorkbenchError(
+                    f"cable '{cable}': clip '{clip}' cannot be removed: {err}"
+                ) from None
+
+    def _change_document(self, cable: str, change) -> None:
+        """Applies ``change(document)`` to a copy of the TOML document and rebuilds ``cable``;
+        one undo step. On an invalid scene or a failed solve the document and the cables stay
+        as they were and the error is raised."""
+        import tomlkit
+
+        self._push_undo()
+        old_doc = self.doc
+        self.doc = tomlkit.parse(old_doc.as_string())
+        change(self.doc)
+        try:
+            self._reload(cable)
+        except (SceneError, WorkbenchError):
+            self.doc = old_doc
+            self.undo_stack.pop()
+            self._reload(cable)
+            raise
+
     def _reload(self, changed: str | None = None) -> None:
         """Validates the TOML document as a scene; rebuilds the changed cable's solver (all
         when None). Raises SceneError (nothing rebuilt) for an invalid scene or a failed solve."""
@@ -513,6 +759,7 @@ class Session:
         import tomlkit
 
         with self.lock:
+            self._check_at_rest()
             if not self.undo_stack:
                 return False
             self.doc = tomlkit.parse(self.undo_stack.pop())
@@ -534,12 +781,16 @@ class Session:
         if _without_poses(scene) != _without_poses(self.scene):
             return False
         targets = {}
+        moved = [b for b in scene.bodies if b != self.scene.body(b.name)]
+        contact = any(self._contact_on(b) for b in moved)  # obstacles back: every cable
         for cable in scene.cables:
             pos, quat = clip_poses(scene, cable, np.array([0.0]), with_motion=False)
             live = self.cables[cable.name]
-            if not (np.array_equal(pos[0], live.clip_positions)
-                    and np.array_equal(quat[0], live.clip_quaternions)):  # fmt: skip
+            if contact or not (np.array_equal(pos[0], live.clip_positions)
+                               and np.array_equal(quat[0], live.clip_quaternions)):  # fmt: skip
                 targets[cable.name] = (pos[0], quat[0])
+                if contact:
+                    self._set_contact(live.core, scene, cable)
         if not all(self._solve_targets(targets)):
             return False
         self.scene = scene
@@ -695,6 +946,11 @@ class Session:
                     "message": live.message,
                 }
             out = {"cables": cables, "solves": self.solves, "undo": len(self.undo_stack)}
+            out["time"] = (
+                None
+                if self.track is None
+                else {"step": self.time_index, "t": float(self.track.times[self.time_index])}
+            )
             out["bodies"] = {b.name: self._body_view(b) for b in self.scene.bodies}
             h = self.harness
             if h is not None and h.junction_positions is not None:
@@ -706,16 +962,18 @@ class Session:
             return out
 
     def _body_view(self, body) -> dict:
-        from cablelife.workbench.bodies import body_pose, unsaveable_geometry
+        from cablelife.workbench.bodies import body_pose
 
         o, r = body_pose(body)
+        if self.track is not None:  # at the time shown
+            m = self.track.body_map(body.name, self.time_index)
+            o, r = m[:, :3] @ o + m[:, 3], m[:, :3] @ r
         clips = sum(c.body == body.name for cable in self.scene.cables for c in cable.clips)
         return {
             "origin": o.tolist(),
             "frame": r.T.tolist(),  # rows: the body's axes
             "map": self.body_map(body.name).tolist(),
             "clips": int(clips),
-            "refused": unsaveable_geometry(body),
         }
 
     def geometry(self) -> dict:
@@ -764,11 +1022,31 @@ def _without_poses(scene: Scene) -> dict:
     for body in data.get("bodies", []):
         body.pop("origin", None)
         body.pop("orientation", None)
+        body.pop("placement", None)
     for cable in data.get("cables", []):
         for clip in cable.get("clips", []):
             for key in ("position", "direction", "normal"):
                 clip.pop(key, None)
     return data
+
+
+def _cable_frame_at(live: LiveCable, s: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The cable's axis point, tangent d3 and d1 at arc length ``s`` of its last equilibrium
+    (linear between nodes; the frame of the edge that holds s)."""
+    x, arc = live.state.positions, live.arc_length
+    point = np.array([np.interp(s, arc, x[:, i]) for i in range(3)])
+    e = int(np.clip(np.searchsorted(arc, s, side="right") - 1, 0, len(arc) - 2))
+    frame = quat_matrix(live.state.quaternions[e])
+    return point, frame[:, 2], frame[:, 0]
+
+
+def _inline(values: dict):
+    """A TOML inline table ``{ key = value, … }`` (a placement on one line)."""
+    import tomlkit
+
+    table = tomlkit.inline_table()
+    table.update(values)
+    return table
 
 
 def _type_needs(entry, kind: str, cable: Cable) -> None:

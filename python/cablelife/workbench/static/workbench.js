@@ -320,10 +320,71 @@
     return maps;
   }
 
+  // Clip handles follow the scene's clips (added or removed in the panel).
+  function syncClips(state) {
+    Object.keys(state.cables).forEach(function (n) {
+      var c = state.cables[n], size = Math.max(c.radius * 2.5, 0.004), names = {};
+      clipObjects[n] = clipObjects[n] || {};
+      c.figures.clips.forEach(function (k) {
+        names[k.name] = true;
+        if (!clipObjects[n][k.name]) clipObjects[n][k.name] = makeClip(n, k.name, size);
+      });
+      Object.keys(clipObjects[n]).forEach(function (k) {
+        if (names[k]) return;
+        var o = clipObjects[n][k];
+        if (gizmo.object === o) gizmo.detach();
+        if (o.userData.axis) scene.remove(o.userData.axis);
+        scene.remove(o);
+        delete clipObjects[n][k];
+        if (selected && selected.cable === n && selected.clip === k) selected = null;
+      });
+    });
+  }
+
   function applyLive(state) {
+    syncClips(state);
     live = state;
     if (playing === null) draw(state, true);
     panel(state);
+    showTime(state.time);
+  }
+
+  // ---------------------------------------------------------------- body motion
+  // The live view at a time of the quasistatic grid: no handles (back to rest to edit).
+  function showTime(t) {
+    if (!info || !info.motion || !info.motion.steps) return;
+    var moving = t !== null && t !== undefined;
+    if (moving) {
+      if (gizmo.object) gizmo.detach();
+      $("motion-time").textContent = "t = " + Number(t.t).toFixed(3) + " s (step " + t.step + " of " + (info.motion.steps - 1) + ")";
+      $("motion-step").value = t.step;
+      $("motion-rest").disabled = false;
+      $("time-label").textContent = "t = " + Number(t.t).toFixed(3) + " s: static equilibrium (quasistatic), not dynamics";
+      $("time-label").className = "";
+    } else {
+      if (!gizmo.object && selected && playing === null) gizmo.attach(selectedObject());
+      $("motion-time").textContent = "at rest (editable)";
+      $("motion-rest").disabled = true;
+      $("time-label").className = "hidden";
+    }
+    document.body.dataset.time = moving ? t.step : "";
+  }
+  function setupMotion(m) {
+    var box = $("motion");
+    box.className = "";
+    if (!m.steps) {
+      $("motion-step").className = "hidden";
+      $("motion-rest").parentNode.className = "hidden";
+      box.querySelector(".note").textContent = "Not available: " + m.why;
+      return;
+    }
+    var slider = $("motion-step");
+    slider.max = m.steps - 1;
+    slider.value = 0;
+    slider.addEventListener("input", function () { queueMove({op: "time", step: +slider.value}); });
+    $("motion-rest").addEventListener("click", function () {
+      request({op: "rest"}).catch(function (e) { showMessage(e.message, true); });
+    });
   }
 
   function panel(state) {
@@ -344,7 +405,7 @@
       html += '<tr><td>max |torsion|</td><td class="num">' + fmt(f.maxTorsion, 3) + " N m at s = " + fmt(f.maxTorsionS, 3) + " m</td></tr>";
       if (f.minClearance !== undefined) html += '<tr><td>min clearance</td><td class="num' + (f.minClearance < 0 ? " bad" : "") + '">' + fmt(f.minClearance * 1e3, 3) + " mm at s = " + fmt(f.minClearanceS, 3) + " m</td></tr>";
       html += '<tr><td>last solve</td><td class="num">' + fmt(f.solveMs, 2) + " ms, " + f.iterations + " iterations</td></tr>";
-      html += "</table><table><tr><th>clip</th><th>s [m]</th><th>type</th><th>length [m]</th><th>|F| [N]</th><th>|M| [N m]</th></tr>";
+      html += "</table><table><tr><th>clip</th><th>s [m]</th><th>type</th><th>length [m]</th><th>|F| [N]</th><th>|M| [N&nbsp;m]</th><th></th></tr>";
       var extra = [];
       f.clips.forEach(function (k) {
         var sel = selected && selected.cable === n && selected.clip === k.name;
@@ -353,15 +414,21 @@
         var d = ' data-cable="' + esc(n) + '" data-item="' + esc(k.name) + '"';
         html += '<tr class="clip' + (sel ? " sel" : "") + '"' + d + "><td>" + esc(k.name) + "</td>" +
           '<td><input type="number" step="0.01"' + d + ' data-key="s" value="' + k.s + '" style="width:46px"></td>' +
-          "<td><select" + d + ' data-key="type">' + opts + "</select></td>" +
+          "<td><select" + d + ' data-key="type" style="max-width:66px">' + opts + "</select></td>" +
           '<td><input type="number" step="0.005"' + d + ' data-key="length" value="' + k.length + '" style="width:46px"></td>' +
-          '<td class="num">' + fmt(fn, 3) + '</td><td class="num">' + fmt(mn, 3) + "</td></tr>";
+          '<td class="num">' + fmt(fn, 3) + '</td><td class="num">' + fmt(mn, 3) + "</td>" +
+          '<td class="rmcell"><button class="rm"' + d + ' title="remove clip ' + esc(k.name) + '">×</button></td></tr>';
         if (k.type === "hinge" && k.axis) extra.push("<tr" + d + "><td>" + esc(k.name) + '</td><td>hinge axis (d1, d2, d3)</td><td class="num">' +
           k.axis.map(function (a, i) { return '<input type="number" step="0.1" class="axis"' + d + ' data-key="axis" data-index="' + i + '" value="' + a + '" style="width:40px">'; }).join("") + "</td></tr>");
         if (k.type === "sliding") extra.push("<tr" + d + "><td>" + esc(k.name) + '</td><td>slid through</td><td class="num slid">' + (k.slid === null ? "–" : fmt(k.slid * 1e3, 3) + " mm") + "</td></tr>");
       });
       html += "</table>";
       if (extra.length) html += '<table class="clip-extra">' + extra.join("") + "</table>";
+      var bodies = ["world"].concat(Object.keys(state.bodies || {}));
+      html += '<div class="row add-clip" data-cable="' + esc(n) + '">new clip at s <input type="number" step="0.01" min="0" class="add-s" value="' +
+        fmt(f.length / 2, 3) + '" style="width:58px"> m <select class="add-type" style="max-width:66px">' +
+        info.clipTypes.map(function (t) { return "<option>" + t + "</option>"; }).join("") + '</select> on <select class="add-body" style="max-width:80px">' +
+        bodies.map(function (b) { return "<option>" + esc(b) + "</option>"; }).join("") + '</select> <button class="add">add</button></div>';
     });
     if (state.junctions) {
       html += "<h2>junctions</h2><table>";
@@ -378,7 +445,6 @@
         var b = state.bodies[n], sel = selected && selected.body === n;
         html += '<tr class="body' + (sel ? " sel" : "") + '" data-body="' + esc(n) + '"><td>' + esc(n) + '</td><td class="num">origin [' +
           b.origin.map(function (v) { return fmt(v, 4); }).join(", ") + "] m, " + b.clips + " clip(s)</td></tr>";
-        if (b.refused) html += '<tr><td colspan="2" class="bad">' + esc(b.refused) + "</td></tr>";
       });
       html += "</table>";
     }
@@ -429,7 +495,8 @@
   function sendMove(move) {
     inflight = true;
     var mark = dragMark; dragMark = false;
-    var req = move.op === "moveBody" ? {op: "moveBody", body: move.body, position: move.position, quaternion: move.quaternion || null, mark: mark} : {op: "move", moves: [move], mark: mark};
+    var req = move.op === "moveBody" ? {op: "moveBody", body: move.body, position: move.position, quaternion: move.quaternion || null, mark: mark}
+      : move.op === "time" ? {op: "time", step: move.step} : {op: "move", moves: [move], mark: mark};
     request(req).catch(function (e) { showMessage(e.message, true); }).then(function () {
       inflight = false;
       if (pending) { var p = pending; pending = null; sendMove(p); return; }
@@ -440,16 +507,15 @@
 
   function select(cable, clip) {
     selected = {cable: cable, clip: clip};
-    gizmo.attach(clipObjects[cable][clip]);
+    if (!(live && live.time)) gizmo.attach(clipObjects[cable][clip]); // no handles while the motion is shown
     panel(live);
     $("selected").innerHTML = "selected: cable <b>" + esc(cable) + "</b>, clip <b>" + esc(clip) + "</b> — drag the arrows (W: move, E: turn)";
     dirty = true;
   }
   function selectBody(name) {
     var b = live.bodies[name];
-    if (b.refused) { showMessage(b.refused, true); return; }
     selected = {body: name};
-    gizmo.attach(bodyObjects[name]);
+    if (!(live && live.time)) gizmo.attach(bodyObjects[name]);
     panel(live);
     $("selected").innerHTML = "selected: body <b>" + esc(name) + "</b> (" + b.clips + " clip(s)) — drag the arrows (W: move, E: turn)";
     dirty = true;
@@ -573,12 +639,23 @@
         });
       });
       $("cables").addEventListener("click", function (e) {
+        if (e.target.classList.contains("rm")) {
+          request({op: "removeClip", cable: e.target.dataset.cable, clip: e.target.dataset.item}).catch(function (err) { showMessage(err.message, true); });
+          return;
+        }
+        if (e.target.classList.contains("add")) {
+          var row = e.target.closest(".add-clip");
+          request({op: "addClip", cable: row.dataset.cable, s: parseFloat(row.querySelector(".add-s").value),
+            type: row.querySelector(".add-type").value, body: row.querySelector(".add-body").value}).catch(function (err) { showMessage(err.message, true); });
+          return;
+        }
         var tb = e.target.closest("tr.body");
         if (tb) { selectBody(tb.dataset.body); return; }
         var tr = e.target.closest("tr.clip");
         if (tr && e.target.tagName !== "INPUT" && e.target.tagName !== "SELECT") select(tr.dataset.cable, tr.dataset.item);
       });
       setupPlayer(d.result);
+      setupMotion(d.motion);
       var first = Object.keys(st.cables)[0];
       var clips = st.cables[first].figures.clips;
       select(first, clips[clips.length - 1].name);
@@ -660,6 +737,24 @@
     },
     stats: function () {
       return {solvesPerSecond: rate(updateTimes), lastSolveMs: lastSolveMs, framesPerSecond: rate(frameTimes)};
+    },
+    // the bodies' motion at step k of the quasistatic grid (static equilibrium, warm); resolves when drawn
+    showTime: function (k) {
+      return request({op: "time", step: k}).then(function (msg) {
+        if (msg.ok === false) throw new Error(msg.error);
+        return {time: msg.state.time, label: $("motion-time").textContent, solveMs: msg.solveMs};
+      });
+    },
+    backToRest: function () { return request({op: "rest"}); },
+    motionInfo: function () { return info.motion; },
+    // a clip added at arc length s (type, body) / removed, as the panel's controls; resolve when drawn
+    addClip: function (cable, s, type, body) { return request({op: "addClip", cable: cable, s: s, type: type || "fixed", body: body || "world"}); },
+    removeClip: function (cable, clip) { return request({op: "removeClip", cable: cable, clip: clip}); },
+    // the clip handles drawn, per cable
+    clipNames: function () {
+      var out = {};
+      Object.keys(clipObjects).forEach(function (n) { out[n] = Object.keys(clipObjects[n]).filter(function (k) { return clipObjects[n][k].parent === scene; }); });
+      return out;
     },
     save: function (path) { return request({op: "save", path: path || null}); },
     undo: undo,
