@@ -8,6 +8,7 @@ pub mod conditioning;
 pub mod contact;
 pub mod contact_mesh;
 pub mod dynamics;
+mod escape;
 #[cfg(test)]
 mod fd_check;
 pub mod harness;
@@ -17,6 +18,7 @@ pub mod harness_solver;
 pub mod junction;
 pub mod modal;
 pub mod model;
+mod projection;
 pub mod rotation;
 pub mod routing;
 pub mod shear;
