@@ -702,7 +702,10 @@ impl HarnessStatics {
         st.sync_ends(h);
         self.has_prev = false; // a new sequence starts here
         self.begin_step(h, st); // friction acts against the motion from the start
-        let result = self.solve_static_inner(h, st);
+        let result = self.solve_static_inner(h, st).and_then(|mut s| {
+            self.ensure_stable(h, st, &mut s)?; // an unstable equilibrium is left (harness_escape)
+            Ok(s)
+        });
         result.and_then(|s| self.check_sliding(h, st).map(|_| s))
     }
 

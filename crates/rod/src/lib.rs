@@ -13,6 +13,7 @@ mod escape;
 mod fd_check;
 pub mod harness;
 pub mod harness_dynamics;
+mod harness_escape;
 pub mod harness_modal;
 pub mod harness_solver;
 pub mod junction;

@@ -192,7 +192,7 @@ fn a_round_column_escapes_to_the_buckled_elastica_at_second_order() {
     // about the load line at a cost the tangent cannot resolve next to the stiff axis (a
     // neutral equilibrium without imperfection). Before the escape along the mode with the
     // projection onto the stiff axis and the line search along the neutral mode (docs/
-    // solver.md), 5 of these 16 cases reached the stable state (the perfect column 4/4).
+    // solver.md), 9 of these 16 cases reached the stable state (the perfect column 4/4).
     let p = 1.5 * euler_load(1.0);
     for imperfection in [0.0, 1e-9, 1e-6, 1e-4] {
         let runs: Vec<(f64, f64, f64)> = [10, 20, 40, 80]
