@@ -217,9 +217,12 @@ impl Harness {
                     Ok(s) => s,
                     Err(e) => return (out, Some(format!("step {k}: {e}")), None),
                 };
-                match stability.negative_count(tree, &st) {
-                    Ok(n) => stats.unstable = Some(n),
-                    Err(e) => return (out, Some(format!("step {k}: {e}")), None),
+                // (a static solve has counted at its result already: harness_escape)
+                if !(k == 0 && !from_previous && stats.unstable.is_some()) {
+                    match stability.negative_count(tree, &st) {
+                        Ok(n) => stats.unstable = Some(n),
+                        Err(e) => return (out, Some(format!("step {k}: {e}")), None),
+                    }
                 }
                 if let Err(e) = solver.assemble(tree, &st, 1.0, false) {
                     return (out, Some(format!("step {k}: {e}")), None);
