@@ -217,8 +217,9 @@ impl Harness {
                     Ok(s) => s,
                     Err(e) => return (out, Some(format!("step {k}: {e}")), None),
                 };
-                // (a static solve has counted at its result already: harness_escape)
-                if !(k == 0 && !from_previous && stats.unstable.is_some()) {
+                // (the solver has counted at its result already unless the loads are not
+                // conservative: harness_escape)
+                if stats.unstable.is_none() {
                     match stability.negative_count(tree, &st) {
                         Ok(n) => stats.unstable = Some(n),
                         Err(e) => return (out, Some(format!("step {k}: {e}")), None),

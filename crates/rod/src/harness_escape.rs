@@ -7,6 +7,8 @@
 //! pseudo-transient path (a damped motion, which settles in a stable equilibrium) finished by
 //! Newton, and checks again: up to 4 attempts with doubled perturbations. If none ends stable
 //! the unstable equilibrium is returned and its count reported (`SolveStats::unstable`).
+//! Applied to the static solve and to every step of a sequence (a column compressed past its
+//! Euler load during a quasistatic run buckles there).
 //! Skipped where the loads are not conservative (dead moments, sliding clips' friction: the
 //! symmetric part of the tangent is then no stability criterion), as for one cable.
 use crate::harness::{Harness, HarnessError, HarnessState};
@@ -53,7 +55,23 @@ impl HarnessStatics {
             stats.unstable = None;
             return Ok(());
         }
-        let mut modal = ModalSystem::new(h);
+        // The pencil's buffers are kept between the steps of a sequence (no allocation).
+        let mut modal = self
+            .escape_modal
+            .take()
+            .unwrap_or_else(|| Box::new(ModalSystem::new(h)));
+        let result = self.escape(h, st, stats, &mut modal);
+        self.escape_modal = Some(modal);
+        result
+    }
+
+    fn escape(
+        &mut self,
+        h: &Harness,
+        st: &mut HarnessState,
+        stats: &mut SolveStats,
+        modal: &mut ModalSystem,
+    ) -> Result<(), HarnessError> {
         let count = modal.negative_count(h, st)?;
         stats.unstable = Some(count);
         if count == 0 {
