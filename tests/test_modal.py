@@ -213,3 +213,22 @@ def static_share_is_none(scene_dict) -> bool:
     scene_dict.pop("bodies", None)
     scene_dict["cables"][0]["clips"][1].pop("body", None)
     return cable_summary(simulate(scene_from_dict(scene_dict)).cable)["viscous_share"] is None
+
+
+def test_modal_damping_ratios_of_a_kelvin_voigt_cable(scene_dict):
+    # Straight between two clamps, unstressed: each mode strains one kind only, so the damping
+    # matrix is diagonal in the modes and mode k is damped by exactly ζ = τ ω_k / 2 with the τ
+    # of its kind (the Rayleigh quotient φᵀCφ / (2ω φᵀMφ), crates/rod/src/modal.rs).
+    scene_dict["simulation"]["gravity"] = [0.0, 0.0, 0.0]
+    scene_dict["cables"][0]["clips"][1]["position"] = [1.0, 0.0, 0.0]
+    tau = {"bending": 2e-3, "shear": 2e-3, "torsion": 5e-4, "extension": 1e-4}
+    scene_dict["cables"][0]["damping"] = dict(tau)
+    scene = scene_from_dict(scene_dict)
+    m = cable_modes(scene, scene.cables[0], 24, damping=True)
+    of_kind = {"bending d1": "bending", "bending d2": "bending", "axial": "extension"}
+    kinds = {of_kind.get(k, k) for k in m.kind}
+    assert kinds == {"bending", "torsion", "extension"}
+    for w, kind, zeta in zip(m.omega, m.kind, m.damping_ratio, strict=True):
+        t = tau[of_kind.get(kind, kind)]
+        assert zeta == pytest.approx(0.5 * t * w, rel=1e-8), kind
+    assert cable_modes(scene, scene.cables[0], 2).damping_ratio is None

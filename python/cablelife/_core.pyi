@@ -39,12 +39,15 @@ class Cable:
         Massless unknowns (swivel twists) have mass 0.
         """
         ...
-    def modes(self, count) -> Any:
+    def modes(self, count, shear_tau=None, bend_tau=None) -> Any:
         """The `count` lowest natural modes about the state of the last run (a static
         equilibrium), by the banded shift-invert solver (`rod::modal`). Returns `omega` (k,)
         rad/s, `displacements` (k, N+1, 3) and `rotations` (k, N, 3) mass-normalised (global
         frame), `shares` (k, 4) modal energy shares (bending d1, bending d2, torsion, axial)
-        and `kind` (k,) names. An unstable equilibrium is a ValueError.
+        and `kind` (k,) names. With the Kelvin–Voigt retardation times `shear_tau` (GA₁, GA₂,
+        EA) and `bend_tau` (EI₁, EI₂, GJ), s, also `damping_ratio` (k,): each mode's Rayleigh
+        quotient φᵀCφ / (2ω φᵀMφ) with the damping matrix C of the section law
+        (`rod::modal::damping_ratio`). An unstable equilibrium is a ValueError.
         """
         ...
     @property

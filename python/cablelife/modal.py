@@ -35,6 +35,8 @@ class Modes:
     #: (k, 4) shares of the modal energy: bending d1, bending d2, torsion, axial
     shares: np.ndarray | None = None
     kind: list[str] = field(default_factory=list)  # dominant share of each mode
+    #: (k,) modal damping ratios of the Kelvin–Voigt section law (``cable_modes(damping=True)``)
+    damping_ratio: np.ndarray | None = None
 
     @property
     def frequencies(self) -> np.ndarray:
@@ -55,16 +57,24 @@ def _equilibrium(scene: Scene, cable: Cable):
     return core, out
 
 
-def cable_modes(scene: Scene, cable: Cable, count: int = 6) -> Modes:
+def cable_modes(scene: Scene, cable: Cable, count: int = 6, damping: bool = False) -> Modes:
     """The ``count`` lowest modes of ``cable`` at its static equilibrium with the clip poses
-    of t = 0 (the banded Rust solver)."""
+    of t = 0 (the banded Rust solver). With ``damping``, also each mode's damping ratio of the
+    cable's Kelvin–Voigt damping (``retardation_times``): the Rayleigh quotient
+    φᵀCφ / (2ω φᵀMφ) with the section law's damping matrix C (``rod::modal::damping_ratio``)."""
     if count < 1:
         raise SceneError(f"count = {count}: ask for at least 1 mode")
     if scene.junctions:
+        if damping:
+            raise SceneError("cable_modes(damping=True): harnesses are not supported yet")
         return harness_modes(scene, count)[cable.name]
+    taus = {}
+    if damping:
+        shear, bend, _ = retardation_times(scene, cable)
+        taus = {"shear_tau": list(shear), "bend_tau": list(bend)}
     core, out = _equilibrium(scene, cable)
     try:
-        found = core.modes(count)
+        found = core.modes(count, **taus)
     except ValueError as err:
         raise SceneError(f"cable '{cable.name}': {err}") from None
     return Modes(
@@ -76,6 +86,7 @@ def cable_modes(scene: Scene, cable: Cable, count: int = 6) -> Modes:
         rotations=found["rotations"],
         shares=found["shares"],
         kind=list(found["kind"]),
+        damping_ratio=found.get("damping_ratio"),
     )
 
 

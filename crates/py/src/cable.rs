@@ -919,8 +919,18 @@ impl Cable {
     /// equilibrium), by the banded shift-invert solver (`rod::modal`). Returns `omega` (k,)
     /// rad/s, `displacements` (k, N+1, 3) and `rotations` (k, N, 3) mass-normalised (global
     /// frame), `shares` (k, 4) modal energy shares (bending d1, bending d2, torsion, axial)
-    /// and `kind` (k,) names. An unstable equilibrium is a ValueError.
-    fn modes<'py>(&mut self, py: Python<'py>, count: usize) -> PyResult<Bound<'py, PyDict>> {
+    /// and `kind` (k,) names. With the Kelvin–Voigt retardation times `shear_tau` (GA₁, GA₂,
+    /// EA) and `bend_tau` (EI₁, EI₂, GJ), s, also `damping_ratio` (k,): each mode's Rayleigh
+    /// quotient φᵀCφ / (2ω φᵀMφ) with the damping matrix C of the section law
+    /// (`rod::modal::damping_ratio`). An unstable equilibrium is a ValueError.
+    #[pyo3(signature = (count, shear_tau=None, bend_tau=None))]
+    fn modes<'py>(
+        &mut self,
+        py: Python<'py>,
+        count: usize,
+        shear_tau: Option<[f64; 3]>,
+        bend_tau: Option<[f64; 3]>,
+    ) -> PyResult<Bound<'py, PyDict>> {
         let st = self
             .state
             .as_ref()
@@ -959,6 +969,33 @@ impl Cable {
         )?;
         d.set_item("shares", PyArray1::from_vec(py, shares).reshape([k, 4])?)?;
         d.set_item("kind", kinds)?;
+        match (shear_tau, bend_tau) {
+            (Some(ts), Some(tb)) => {
+                let (ts, tb) = (Vector3::from(ts), Vector3::from(tb));
+                if !(ts
+                    .iter()
+                    .chain(tb.iter())
+                    .all(|t| t.is_finite() && *t >= 0.0))
+                {
+                    return Err(PyValueError::new_err(format!(
+                        "retardation times shear_tau {ts:?}, bend_tau {tb:?}: each must be a \
+                         finite number >= 0 s"
+                    )));
+                }
+                let zeta = modes
+                    .iter()
+                    .map(|m| rod::modal::damping_ratio(rod, st, &m.shape, m.omega, ts, tb))
+                    .collect::<Result<Vec<f64>, _>>()
+                    .map_err(|e| PyValueError::new_err(e.to_string()))?;
+                d.set_item("damping_ratio", PyArray1::from_vec(py, zeta))?;
+            }
+            (None, None) => {}
+            _ => {
+                return Err(PyValueError::new_err(
+                    "modes: give both shear_tau and bend_tau (or neither)",
+                ))
+            }
+        }
         Ok(d)
     }
 

@@ -217,9 +217,13 @@ impl Harness {
                     Ok(s) => s,
                     Err(e) => return (out, Some(format!("step {k}: {e}")), None),
                 };
-                match stability.negative_count(tree, &st) {
-                    Ok(n) => stats.unstable = Some(n),
-                    Err(e) => return (out, Some(format!("step {k}: {e}")), None),
+                // (the solver has counted at its result already unless the loads are not
+                // conservative: harness_escape)
+                if stats.unstable.is_none() {
+                    match stability.negative_count(tree, &st) {
+                        Ok(n) => stats.unstable = Some(n),
+                        Err(e) => return (out, Some(format!("step {k}: {e}")), None),
+                    }
                 }
                 if let Err(e) = solver.assemble(tree, &st, 1.0, false) {
                     return (out, Some(format!("step {k}: {e}")), None);

@@ -246,6 +246,85 @@ impl ModalSystem {
     }
 }
 
+/// An unstable mode of a harness: λ < 0, per cable block vectors, per junction 6-vectors.
+pub(crate) type UnstableMode = (f64, Vec<Vec<Vector6<f64>>>, Vec<Vector6<f64>>);
+
+impl ModalSystem {
+    /// The mode of the most negative eigenvalue of K φ = λ M φ at `st` (per cable block
+    /// vectors, per junction 6-vectors; M-normalised) and λ, for the escape from an unstable
+    /// equilibrium (`harness_escape`); None if K has no negative eigenvalue (or no shift below
+    /// it was found). Inverse iteration with K − μM, μ below the spectrum (the tree LDLᵀ has no
+    /// negative pivot there), then shifted 1 % below the Rayleigh quotient: the two bending
+    /// planes of a round section give two nearly equal eigenvalues.
+    pub(crate) fn unstable_mode(
+        &mut self,
+        h: &Harness,
+        st: &HarnessState,
+    ) -> Result<Option<UnstableMode>, HarnessError> {
+        self.load(h, st)?;
+        let scale = eigen_scale(self);
+        let n = self.m.len();
+        let mut p = HarnessPencil { h, s: self };
+        if p.factor_near(0.0, 1e-12 * scale).1 == 0 {
+            return Ok(None);
+        }
+        let mut x: Vec<Vector6<f64>> = vec![Vector6::zeros(); n];
+        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+        for (v, m) in x.iter_mut().zip(&p.s.m) {
+            for k in 0..6 {
+                seed ^= seed << 13;
+                seed ^= seed >> 7;
+                seed ^= seed << 17;
+                let r = (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
+                v[k] = if m[k] > 0.0 { r } else { 0.0 };
+            }
+        }
+        let (mut y, mut r) = (vec![Vector6::zeros(); n], vec![Vector6::zeros(); n]);
+        let m_dot = |a: &[Vector6<f64>], b: &[Vector6<f64>], m: &[Vector6<f64>]| -> f64 {
+            a.iter()
+                .zip(b)
+                .zip(m)
+                .map(|((a, b), m)| a.component_mul(b).dot(m))
+                .sum()
+        };
+        let mut mu = -1e-8 * scale;
+        let mut rho = f64::NAN;
+        for pass in 0..2 {
+            let mut found = false;
+            for _ in 0..40 {
+                if p.factor(mu) == Some(0) {
+                    found = true;
+                    break;
+                }
+                mu *= if pass == 0 { 10.0 } else { 1.1 };
+            }
+            if !found {
+                return Ok(None);
+            }
+            for _ in 0..(if pass == 0 { 30 } else { 40 }) {
+                p.apply(&x, &mut y, &mut r);
+                let xmy = m_dot(&x, &y, &p.s.m);
+                let xmx = m_dot(&x, &x, &p.s.m);
+                rho = mu + xmx / xmy;
+                let nrm = m_dot(&y, &y, &p.s.m).sqrt().max(1e-300);
+                for (a, b) in x.iter_mut().zip(&y) {
+                    *a = b / nrm;
+                }
+            }
+            if rho.is_nan() || rho >= 0.0 {
+                return Ok(None);
+            }
+            mu = 1.01 * rho;
+        }
+        let sys = &*p.s;
+        let nc = sys.offsets[h.cables.len()];
+        let cables = (0..h.cables.len())
+            .map(|c| x[sys.offsets[c]..sys.offsets[c + 1]].to_vec())
+            .collect();
+        Ok(Some((rho, cables, x[nc..].to_vec())))
+    }
+}
+
 /// The `count` lowest natural modes of the harness at the equilibrium `st`.
 pub fn harness_lowest_modes(
     h: &Harness,

@@ -91,6 +91,8 @@ pub struct HarnessStatics {
     /// pivots) in `inertia` — the stability check and the Sturm count of `harness_modal`.
     pub symmetric: bool,
     pub inertia: Inertia,
+    /// The pencil of the stability check and escape (`harness_escape`), made at first use.
+    pub(crate) escape_modal: Option<Box<crate::harness_modal::ModalSystem>>,
     /// Length scales: the shortest cable (steps) and the finest mean segment (moments).
     length: f64,
     h: f64,
@@ -156,6 +158,7 @@ impl HarnessStatics {
             force_scale,
             symmetric: false,
             inertia: Inertia::default(),
+            escape_modal: None,
             length,
             h: hmin,
         }
@@ -702,7 +705,10 @@ impl HarnessStatics {
         st.sync_ends(h);
         self.has_prev = false; // a new sequence starts here
         self.begin_step(h, st); // friction acts against the motion from the start
-        let result = self.solve_static_inner(h, st);
+        let result = self.solve_static_inner(h, st).and_then(|mut s| {
+            self.ensure_stable(h, st, &mut s)?; // an unstable equilibrium is left (harness_escape)
+            Ok(s)
+        });
         result.and_then(|s| self.check_sliding(h, st).map(|_| s))
     }
 
@@ -898,6 +904,10 @@ impl HarnessStatics {
                 self.step_from_reference(h, st, target)
             }
         };
+        let result = result.and_then(|mut s| {
+            self.ensure_stable(h, st, &mut s)?; // an unstable equilibrium is left (harness_escape)
+            Ok(s)
+        });
         std::mem::swap(&mut self.prev, &mut self.last);
         self.has_prev = true;
         result

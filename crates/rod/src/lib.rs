@@ -8,15 +8,18 @@ pub mod conditioning;
 pub mod contact;
 pub mod contact_mesh;
 pub mod dynamics;
+mod escape;
 #[cfg(test)]
 mod fd_check;
 pub mod harness;
 pub mod harness_dynamics;
+mod harness_escape;
 pub mod harness_modal;
 pub mod harness_solver;
 pub mod junction;
 pub mod modal;
 pub mod model;
+mod projection;
 pub mod rotation;
 pub mod routing;
 pub mod shear;

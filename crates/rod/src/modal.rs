@@ -554,3 +554,74 @@ fn classify(
         kind: ModeKind::dominant(&shares),
     }
 }
+
+/// The modal damping ratio of the Kelvin–Voigt section law for the mode `shape` (mass-
+/// normalised, φᵀMφ = 1) of natural frequency `omega` at the equilibrium `st`: the Rayleigh
+/// quotient ζ = φᵀCφ / (2ω φᵀMφ) with C the viscous damping matrix of the section law
+/// (viscous forces τ_Γ ∘ C^Γ Γ̇, moments τ_K ∘ C^K K̇; `shear_tau`, `bend_tau` the retardation
+/// times of (GA₁, GA₂, EA) and (EI₁, EI₂, GJ)). φᵀCφ is the dissipated power of the assembly
+/// with the mode shape as velocities (ẋ, ω) — one assembly, no matrix. Exact for a
+/// classically damped system (C diagonal in the modes: one τ on every stiffness gives
+/// ζ = τω/2 on every mode of an unstressed cable); otherwise the first-order perturbation of
+/// the complex eigenvalue, accurate while ζ is small and the modes well separated. It counts
+/// the strain rate of every deformation the mode carries, unlike the kinetic-energy shares.
+pub fn damping_ratio(
+    rod: &Rod,
+    st: &State,
+    shape: &[Vector6<f64>],
+    omega: f64,
+    shear_tau: Vector3<f64>,
+    bend_tau: Vector3<f64>,
+) -> Result<f64, ModalError> {
+    use crate::assembly::{Elastic, Eval, Part, Rates, Term};
+    let sec = &rod.spec.section;
+    let mut v: Vec<Vector6<f64>> = shape.to_vec();
+    // Node velocities only where the node moves; a held node's slot 0 is a free clip angle.
+    for (b, vb) in v.iter_mut().enumerate() {
+        let m = &rod.mask[b];
+        if !(m[0] && m[1] && m[2]) {
+            vb.fixed_rows_mut::<3>(0).fill(0.0);
+        }
+        for k in 3..6 {
+            if !m[k] {
+                vb[k] = 0.0;
+            }
+        }
+    }
+    let ghost_omega = rod
+        .ghosts
+        .iter()
+        .map(|g| match g.free_axis {
+            Some(axis) => shape[g.node][0] * axis,
+            None => Vector3::zeros(),
+        })
+        .collect();
+    let rates = Rates {
+        v,
+        ghost_omega,
+        shear_damping: shear_tau.component_mul(&sec.shear_stiffness),
+        bend_damping: bend_tau.component_mul(&sec.bend_stiffness),
+        damping_factor: 0.0,
+        tangent: Vec::new(),
+    };
+    let mut ws = Workspace::new(rod);
+    ws.clear(false);
+    let ev = Eval {
+        part: Part::All,
+        want_jac: false,
+        rates: Some(&rates),
+        load_factor: 1.0,
+    };
+    Elastic
+        .add_residual_jacobian(rod, st, &ev, &mut ws)
+        .map_err(|k| ModalError::Kink { node: k.node })?;
+    let mass: f64 = lumped_mass(rod)
+        .iter()
+        .zip(shape)
+        .map(|(m, s)| (0..6).map(|k| m[k] * s[k] * s[k]).sum::<f64>())
+        .sum();
+    if !(omega > 0.0 && mass > 0.0) {
+        return Ok(0.0);
+    }
+    Ok(ws.dissipation / (2.0 * omega * mass))
+}

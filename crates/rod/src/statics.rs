@@ -200,6 +200,12 @@ const ENERGY_ROUND_OFF: f64 = 1e-10;
 /// below which its steps count as Newton steps for convergence (see `descend`).
 const NEUTRAL_SIGMA: f64 = 1e-9;
 
+/// The damping σ of the energy descent (relative to its floor, 1e-12 of the stiffest entry)
+/// up to which a full step is followed by a line search along the nearly neutral mode that
+/// holds σ up (`Statics::neutral_search`): the curvature of that mode is then below what the
+/// tangent resolves next to the stiff axis.
+const NEUTRAL_SEARCH: f64 = 100.0;
+
 /// A static/quasistatic solver for one cable: the workspace and options.
 pub struct Statics {
     pub ws: Workspace,
@@ -223,6 +229,18 @@ pub struct Statics {
     relax_start: State,
     /// The descent's state before a Newton shortcut.
     shortcut_start: State,
+    /// Scratch of the projection onto the stiff axis (`projection::relax_positions`) and of
+    /// the line search along a nearly neutral mode (`neutral_search`).
+    proj_ws: Workspace,
+    proj_delta: Vec<Vector6<f64>>,
+    neutral: Vec<Vector6<f64>>,
+    /// (H + σD)⁻¹ D z of the neutral mode z and zᵀDw (`neutral_search`), and whether
+    /// `state_along` corrects its trials off the mode with them.
+    neutral_w: Vec<Vector6<f64>>,
+    neutral_zdw: f64,
+    correct_off_mode: bool,
+    /// The unstable modes of an escape (`ensure_stable`).
+    modes: [Vec<Vector6<f64>>; 2],
 }
 
 impl Statics {
@@ -254,7 +272,31 @@ impl Statics {
             before: State::empty(),
             relax_start: State::empty(),
             shortcut_start: State::empty(),
+            proj_ws: Workspace::new(rod),
+            proj_delta: vec![Vector6::zeros(); rod.n_edges() + 1],
+            neutral: vec![Vector6::zeros(); rod.n_edges() + 1],
+            neutral_w: vec![Vector6::zeros(); rod.n_edges() + 1],
+            neutral_zdw: 0.0,
+            correct_off_mode: false,
+            modes: [
+                vec![Vector6::zeros(); rod.n_edges() + 1],
+                vec![Vector6::zeros(); rod.n_edges() + 1],
+            ],
         }
+    }
+
+    /// Relaxes the node positions of `st` with its rotations frozen: the projection of a
+    /// finite rotation step onto the stiff axis (`projection::relax_positions`).
+    fn project_positions(&mut self, rod: &Rod, st: &mut State) -> bool {
+        crate::projection::relax_positions(
+            &mut self.proj_ws,
+            rod,
+            st,
+            &mut [&mut self.contact, &mut self.sliding],
+            &mut self.proj_delta,
+            self.opts.step_tolerance,
+        )
+        .unwrap_or(false)
     }
 
     /// The static assembly: internal forces, external loads and contact.
@@ -610,8 +652,14 @@ impl Statics {
         self.opts.max_iterations = full.min(15);
         let plain = self.newton(rod, st, 1.0, false);
         self.opts.max_iterations = full;
-        if let Err(e @ SolveError::Singular { .. }) = plain {
-            return Err(e);
+        if let Err(e @ SolveError::Singular { .. }) = &plain {
+            let e = e.clone();
+            // Singular at the start: a zero stiffness. Met on the way (Newton passing a
+            // bifurcation: an imperfect column above its Euler load, measured at N = 10): the
+            // damped paths below avoid it.
+            self.assemble(rod, &start, 1.0, true)
+                .map_err(|k| Self::kink_err(rod, k))?;
+            self.ws.factor(rod).map_err(|_| e)?;
         }
         if let Ok(s) = plain {
             return Ok(s);
@@ -718,6 +766,45 @@ impl Statics {
             }
             st.clone_from(&self.before);
             st.apply_increment(rod, &self.trial, best.1 * amp);
+            if attempt == 0 {
+                // First along the mode as far as the energy falls, each trial projected back
+                // onto the stiff axis: a fixed step along the linearised mode stretches it at
+                // second order, and from a small one the descent crawls (docs/solver.md).
+                // With two negative eigenvalues (a round section: one per bending plane, split
+                // only by the imperfection) the directions cos ψ v₁ + sin ψ v₂ of both modes,
+                // 16 values of ψ; the imperfection's plane ends lowest (escape.rs).
+                self.modes[0].clone_from(&self.trial);
+                st.clone_from(&self.before);
+                self.inertia(rod, st, true)?;
+                let [first, second] = &mut self.modes;
+                let planes = inertia.negative >= 2
+                    && crate::escape::second_mode(
+                        &mut self.ws.jac,
+                        rod,
+                        first,
+                        second,
+                        &mut self.delta,
+                    )
+                    .is_some_and(|rho| rho < 0.0);
+                self.base.clone_from(&self.before);
+                let e0 = self.ws.elastic_energy + self.ws.load_potential;
+                let count = if planes { 16 } else { 2 };
+                let mut far = (f64::INFINITY, 0.0, 0);
+                for i in 0..count {
+                    let dth = self.escape_direction(rod, i, count, planes);
+                    let (e, t) = self.minimise_along(rod, st, 1.0, 0.01 / dth, e0);
+                    if t > 0.0 && e < far.0 {
+                        far = (e, t, i);
+                    }
+                }
+                if far.1 != 0.0 {
+                    self.escape_direction(rod, far.2, count, planes);
+                    self.state_along(rod, st, far.1);
+                } else {
+                    st.clone_from(&self.before);
+                    st.apply_increment(rod, &self.trial, best.1 * amp);
+                }
+            }
             let found = self.relax(rod, st, true);
             if std::env::var_os("ROD_DEBUG").is_some() {
                 eprintln!("escape {attempt}: amp {amp:.3e} dx {dx:.3e} dth {dth:.3e} -> {found:?}");
@@ -1016,6 +1103,19 @@ impl Statics {
                 stats.residual = rinf;
                 return Ok(stats);
             }
+            if conservative && alpha == 1.0 && sigma <= NEUTRAL_SEARCH * floor {
+                // σ is held up by a mode whose curvature the tangent cannot resolve against
+                // a stiff axis (the plane of a buckled round column, which an imperfection
+                // turns): minimise the energy along that mode (`neutral_search`); converged
+                // when that gains nothing and the step is below the tolerance outside it.
+                let (moved, off_mode) = self.neutral_search(rod, st, sigma, &mut energy)?;
+                (_, rinf) = self.ws.residual_norms(h);
+                stats.iterations += 1;
+                if !moved && alpha == 1.0 && off_mode < self.opts.step_tolerance {
+                    stats.residual = rinf;
+                    return Ok(stats);
+                }
+            }
             if newton_shortcut && sigma == 0.0 && it >= next_newton {
                 // Positive definite: Newton from here, which does not creep along a nearly
                 // neutral direction as the backtracking does; kept if it ends stable.
@@ -1052,6 +1152,247 @@ impl Statics {
             residual: rinf,
             load_factor: 1.0,
         })
+    }
+
+    /// Direction `i` of `count` of an escape into `self.neutral`: cos ψ v₁ + sin ψ v₂ with
+    /// ψ = 2π i/count (±v₁ without `planes`; the modes in `self.modes`); returns its largest
+    /// rotation component.
+    fn escape_direction(&mut self, rod: &Rod, i: usize, count: usize, planes: bool) -> f64 {
+        let psi = 2.0 * std::f64::consts::PI * i as f64 / count as f64;
+        let (c, s) = if planes {
+            (psi.cos(), psi.sin())
+        } else {
+            (psi.cos().signum(), 0.0)
+        };
+        let mut dth = 0.0f64;
+        for (b, t) in self.neutral.iter_mut().enumerate() {
+            *t = c * self.modes[0][b] + s * self.modes[1][b];
+            for k in 3..6 {
+                if rod.mask[b][k] {
+                    dth = dth.max(t[k].abs());
+                }
+            }
+        }
+        dth.max(1e-300)
+    }
+
+    /// `self.base` moved by t along `self.neutral` and projected onto the stiff axis; its
+    /// potential energy (∞ if the assembly fails).
+    fn state_along(&mut self, rod: &Rod, st: &mut State, t: f64) -> f64 {
+        st.clone_from(&self.base);
+        st.apply_increment(rod, &self.neutral, t);
+        self.project_positions(rod, st);
+        if self.correct_off_mode {
+            // Back onto the curve of the mode: chord-Newton steps with (H + σD) of the start,
+            // constrained to zᵀDΔ = 0 (bordered by w = (H + σD)⁻¹Dz): a straight step along
+            // the mode leaves it at second order, and against the moments of a buckled state
+            // that costs energy at second order too.
+            let nb = rod.arc.len();
+            for _ in 0..3 {
+                if self.assemble(rod, st, 1.0, false).is_err() {
+                    return f64::INFINITY;
+                }
+                for (d, r) in self.trial.iter_mut().zip(&self.ws.rhs) {
+                    *d = -r;
+                }
+                self.ws.jac.solve_factored(&mut self.trial);
+                let mut zd = 0.0;
+                for b in 0..nb {
+                    for k in 0..6 {
+                        if rod.mask[b][k] {
+                            zd += crate::escape::damping(rod, b, k)
+                                * self.neutral[b][k]
+                                * self.trial[b][k];
+                        }
+                    }
+                }
+                let mu = zd / self.neutral_zdw;
+                for (d, w) in self.trial.iter_mut().zip(&self.neutral_w) {
+                    *d -= mu * w;
+                }
+                st.apply_increment(rod, &self.trial, 1.0);
+                self.project_positions(rod, st);
+            }
+        }
+        match self.assemble(rod, st, 1.0, false) {
+            Ok(()) => self.ws.elastic_energy + self.ws.load_potential,
+            Err(_) => f64::INFINITY,
+        }
+    }
+
+    /// Minimises the energy along `sign` × `self.neutral` from `self.base` (energy `e0`):
+    /// steps doubled from `unit` while the energy falls (up to the largest rotation step),
+    /// then 8 ternary refinements in [t/2, 2t] (or [0, unit] if the first step rose). Returns
+    /// the lowest energy found and its step t (0: none lower); `st` is scratch.
+    fn minimise_along(
+        &mut self,
+        rod: &Rod,
+        st: &mut State,
+        sign: f64,
+        unit: f64,
+        e0: f64,
+    ) -> (f64, f64) {
+        let dth = unit.recip() * 0.01;
+        let mut best = (e0, 0.0f64);
+        let mut t = unit;
+        while t * dth <= self.opts.max_rotation_step {
+            let e = self.state_along(rod, st, sign * t);
+            if e.is_nan() || e >= best.0 {
+                break;
+            }
+            best = (e, t);
+            t *= 2.0;
+        }
+        let (mut a, mut b) = if best.1 == 0.0 {
+            (0.0, unit)
+        } else {
+            (0.5 * best.1, 2.0 * best.1)
+        };
+        for _ in 0..8 {
+            let (m1, m2) = (a + (b - a) / 3.0, b - (b - a) / 3.0);
+            let e1 = self.state_along(rod, st, sign * m1);
+            let e2 = self.state_along(rod, st, sign * m2);
+            for (e, m) in [(e1, m1), (e2, m2)] {
+                if e < best.0 {
+                    best = (e, m);
+                }
+            }
+            if e1 < e2 {
+                b = m2;
+            } else {
+                a = m1;
+            }
+        }
+        best
+    }
+
+    /// A line search along the nearly neutral mode of the energy descent: the lowest mode z
+    /// of (H + σD) z = μ D z (inverse iteration from the last descent step in `self.delta`,
+    /// which the slow mode dominates), then the energy minimised along ∓z (the sign of the
+    /// energy's slope) — steps doubled from 0.01 rad while the energy falls, then 8 ternary
+    /// refinements — each trial projected back onto the stiff axis (`project_positions`: a
+    /// finite turn of the frames stretches it at second order). A decrease within the energy's
+    /// round-off does not count. Returns whether the state moved, and the last descent step's
+    /// largest component off the mode (|Δx|/L, |θ|) for the convergence test. Leaves the
+    /// Jacobian assembled at the state returned.
+    fn neutral_search(
+        &mut self,
+        rod: &Rod,
+        st: &mut State,
+        sigma: f64,
+        energy: &mut f64,
+    ) -> Result<(bool, f64), SolveError> {
+        let nb = rod.arc.len();
+        let l = rod.spec.length;
+        let damping = |b: usize, k: usize| -> f64 {
+            if k < 3 {
+                rod.ds_node[b]
+            } else {
+                rod.ds_edge[b.min(nb - 2)].powi(3) / 12.0
+            }
+        };
+        let d_dot = |a: &[Vector6<f64>], c: &[Vector6<f64>]| -> f64 {
+            let mut sum = 0.0;
+            for (b, (x, y)) in a.iter().zip(c).enumerate() {
+                for k in 0..6 {
+                    if rod.mask[b][k] {
+                        sum += damping(b, k) * x[k] * y[k];
+                    }
+                }
+            }
+            sum
+        };
+        let shift = |jac: &mut crate::block_tridiag::BlockTridiag, s: f64| {
+            for b in 0..nb {
+                for k in 0..6 {
+                    if rod.mask[b][k] {
+                        jac.diag[b][(k, k)] += s * damping(b, k);
+                    }
+                }
+            }
+        };
+        self.neutral.clone_from(&self.delta);
+        shift(&mut self.ws.jac, sigma);
+        let factored = self.ws.jac.factor().is_ok();
+        if factored {
+            for _ in 0..8 {
+                for (b, v) in self.neutral.iter_mut().enumerate() {
+                    for k in 0..6 {
+                        v[k] *= if rod.mask[b][k] { damping(b, k) } else { 0.0 };
+                    }
+                }
+                self.ws.jac.solve_factored(&mut self.neutral);
+                let n = d_dot(&self.neutral, &self.neutral).sqrt().max(1e-300);
+                self.neutral.iter_mut().for_each(|v| *v /= n);
+            }
+            for (b, (w, z)) in self.neutral_w.iter_mut().zip(&self.neutral).enumerate() {
+                for k in 0..6 {
+                    w[k] = if rod.mask[b][k] {
+                        damping(b, k) * z[k]
+                    } else {
+                        0.0
+                    };
+                }
+            }
+            self.ws.jac.solve_factored(&mut self.neutral_w);
+            self.neutral_zdw = d_dot(&self.neutral, &self.neutral_w);
+        }
+        shift(&mut self.ws.jac, -sigma);
+        // The last step off the mode.
+        let c = d_dot(&self.neutral, &self.delta);
+        let mut off = 0.0f64;
+        for (b, (d, z)) in self.delta.iter().zip(&self.neutral).enumerate() {
+            for k in 0..6 {
+                if rod.mask[b][k] {
+                    let v = (d[k] - c * z[k]).abs();
+                    off = off.max(if k < 3 { v / l } else { v });
+                }
+            }
+        }
+        let slope: f64 = self
+            .ws
+            .rhs
+            .iter()
+            .zip(&self.neutral)
+            .map(|(r, z)| r.dot(z))
+            .sum();
+        let mut dth = 0.0f64;
+        for (b, z) in self.neutral.iter().enumerate() {
+            for k in 3..6 {
+                if rod.mask[b][k] {
+                    dth = dth.max(z[k].abs());
+                }
+            }
+        }
+        if !factored || !slope.is_finite() || slope == 0.0 || dth == 0.0 {
+            return Ok((false, off));
+        }
+        let dir = -slope.signum();
+        self.base.clone_from(st);
+        let e0 = *energy;
+        let round_off =
+            ENERGY_ROUND_OFF * (self.ws.elastic_energy.abs() + self.ws.load_potential.abs());
+        self.correct_off_mode = self.neutral_zdw > 0.0;
+        let best = self.minimise_along(rod, st, dir, 0.01 / dth, e0);
+        let moved = best.1 > 0.0 && best.0 < e0 - round_off;
+        if moved {
+            *energy = self.state_along(rod, st, dir * best.1);
+        }
+        self.correct_off_mode = false;
+        if !moved {
+            st.clone_from(&self.base);
+        }
+        self.assemble(rod, st, 1.0, true)
+            .map_err(|k| Self::kink_err(rod, k))?;
+        if std::env::var_os("ROD_DEBUG").is_some() {
+            eprintln!(
+                "neutral search: t {:.3e} rad, E {:.9e} → {:.9e}, off-mode step {off:.3e}",
+                best.1 * dth,
+                e0,
+                best.0
+            );
+        }
+        Ok((moved, off))
     }
 
     /// The largest node displacement from `self.before` to `st`.
