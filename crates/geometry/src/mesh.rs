@@ -205,6 +205,8 @@ pub struct TriMesh {
     blocks: Vec<Disk4>,
     /// Largest vertex coordinate magnitude (the scale of the float32 round-off).
     scale: f64,
+    /// Closed and consistently oriented (every edge in two faces, in opposite directions).
+    closed: bool,
 }
 
 struct BinaryView<'a> {
@@ -292,6 +294,13 @@ impl TriMesh {
         }
         keys.sort_unstable();
         let mut edge_of = vec![V3::zeros(); faces.len() * 3];
+        // closed and consistently oriented: every edge in two faces, once in each direction
+        let forward = |side: u32| {
+            let f = &faces[side as usize / 3];
+            let k = side as usize % 3;
+            f[k] < f[(k + 1) % 3]
+        };
+        let mut closed = true;
         let mut g = 0;
         while g < keys.len() {
             let mut h = g;
@@ -300,6 +309,7 @@ impl TriMesh {
                 sum += normals[keys[h].1 as usize / 3];
                 h += 1;
             }
+            closed &= h - g == 2 && forward(keys[g].1) != forward(keys[g + 1].1);
             for key in &keys[g..h] {
                 edge_of[key.1 as usize] = sum;
             }
@@ -359,7 +369,14 @@ impl TriMesh {
             wide,
             blocks,
             scale,
+            closed,
         })
+    }
+
+    /// Whether the mesh is closed and consistently oriented: then the sign of the distance
+    /// (inside or outside) changes only across the surface.
+    pub fn is_closed(&self) -> bool {
+        self.closed
     }
 
     pub fn n_triangles(&self) -> usize {
