@@ -8,6 +8,8 @@
 //! point is.
 use std::fmt;
 
+use rayon::prelude::*;
+
 use crate::closest::{point_triangle, segment_triangle, Feature};
 use crate::wide::{self, f32x3, lower, Disk4, Rounded, Wide, EMPTY, LEAF};
 use crate::{PointProjection, SegmentProjection, Surface, V3};
@@ -49,6 +51,19 @@ struct Node {
 }
 
 impl Node {
+    /// A placeholder (overwritten by the build).
+    const EMPTY: Node = Node {
+        min: V3::new(0.0, 0.0, 0.0),
+        max: V3::new(0.0, 0.0, 0.0),
+        index: 0,
+        count: 0,
+        lo: 0.0,
+        hi: 0.0,
+        axis: V3::new(0.0, 0.0, 0.0),
+        center: V3::new(0.0, 0.0, 0.0),
+        radius: 0.0,
+    };
+
     /// Squared distance of p to the box (a lower bound; cheap, to order the children).
     #[inline(always)]
     fn box_distance2(&self, p: &V3) -> f64 {
@@ -292,7 +307,7 @@ impl TriMesh {
                 keys.push((edge_key(f[k], f[(k + 1) % 3]), (3 * i + k) as u32));
             }
         }
-        keys.sort_unstable();
+        keys.par_sort_unstable();
         let mut edge_of = vec![V3::zeros(); faces.len() * 3];
         // closed and consistently oriented: every edge in two faces, once in each direction
         let forward = |side: u32| {
@@ -318,7 +333,7 @@ impl TriMesh {
         drop(keys);
         // hierarchy over the triangle centroids
         let mut items: Vec<(V3, u32)> = faces
-            .iter()
+            .par_iter()
             .enumerate()
             .map(|(i, f)| {
                 let c = f.iter().fold(V3::zeros(), |s, &k| s + vertices[k as usize]) / 3.0;
@@ -326,7 +341,7 @@ impl TriMesh {
             })
             .collect();
         let boxes: Vec<(V3, V3)> = faces
-            .iter()
+            .par_iter()
             .map(|f| {
                 let [a, b, c] = f.map(|k| vertices[k as usize]);
                 (a.inf(&b).inf(&c), a.sup(&b).sup(&c))
@@ -338,7 +353,8 @@ impl TriMesh {
             faces,
             normals: &normals,
         };
-        let nodes = build(&mut items, 0, &ctx);
+        let mut nodes = vec![Node::EMPTY; tree_size(items.len())];
+        build(&mut items, 0, 0, &mut nodes, &ctx);
         let order: Vec<usize> = items.iter().map(|&(_, i)| i as usize).collect();
         let triangles = order
             .iter()
@@ -1033,9 +1049,19 @@ fn slab(items: &[(V3, u32)], d: &BuildData) -> (V3, f64, f64, V3, f64) {
     (axis, lo - pad, hi + pad, center, radius)
 }
 
-/// Builds the hierarchy over `items` (centroid, triangle), reordering them; `offset` is the
-/// position of items[0] in the whole triangle order. Nodes in depth-first order.
-fn build(items: &mut [(V3, u32)], offset: usize, d: &BuildData) -> Vec<Node> {
+/// Number of nodes of the hierarchy over `k` triangles (median splits).
+fn tree_size(k: usize) -> usize {
+    if k <= LEAF_SIZE {
+        1
+    } else {
+        1 + tree_size(k / 2) + tree_size(k - k / 2)
+    }
+}
+
+/// Builds the hierarchy over `items` (centroid, triangle), reordering them, into `out`
+/// (`tree_size(items.len())` nodes, depth first); `offset` is the position of items[0] in
+/// the whole triangle order, `base` the index of out[0] among all nodes.
+fn build(items: &mut [(V3, u32)], offset: usize, base: usize, out: &mut [Node], d: &BuildData) {
     let boxes = d.boxes;
     if items.len() <= LEAF_SIZE {
         let (mut lo, mut hi) = (V3::repeat(f64::INFINITY), V3::repeat(f64::NEG_INFINITY));
@@ -1045,7 +1071,7 @@ fn build(items: &mut [(V3, u32)], offset: usize, d: &BuildData) -> Vec<Node> {
             hi = hi.sup(&b);
         }
         let (axis, slo, shi, center, radius) = slab(items, d);
-        return vec![Node {
+        out[0] = Node {
             min: lo,
             max: hi,
             axis,
@@ -1055,7 +1081,8 @@ fn build(items: &mut [(V3, u32)], offset: usize, d: &BuildData) -> Vec<Node> {
             radius,
             index: offset as u32,
             count: items.len() as u32,
-        }];
+        };
+        return;
     }
     let (mut clo, mut chi) = (V3::repeat(f64::INFINITY), V3::repeat(f64::NEG_INFINITY));
     for (c, _) in items.iter() {
@@ -1067,19 +1094,20 @@ fn build(items: &mut [(V3, u32)], offset: usize, d: &BuildData) -> Vec<Node> {
     let mid = items.len() / 2;
     items.select_nth_unstable_by(mid, |x, y| x.0[axis].total_cmp(&y.0[axis]));
     let (left_items, right_items) = items.split_at_mut(mid);
-    let (left, right) = if left_items.len() + right_items.len() > PARALLEL_BUILD {
+    let n_left = tree_size(mid);
+    let (head, rest) = out.split_at_mut(1);
+    let (left, right) = rest.split_at_mut(n_left);
+    let right_at = base + 1 + n_left;
+    if left_items.len() + right_items.len() > PARALLEL_BUILD {
         rayon::join(
-            || build(left_items, offset, d),
-            || build(right_items, offset + mid, d),
-        )
+            || build(left_items, offset, base + 1, left, d),
+            || build(right_items, offset + mid, right_at, right, d),
+        );
     } else {
-        (
-            build(left_items, offset, d),
-            build(right_items, offset + mid, d),
-        )
-    };
-    let mut nodes = Vec::with_capacity(1 + left.len() + right.len());
-    nodes.push(Node {
+        build(left_items, offset, base + 1, left, d);
+        build(right_items, offset + mid, right_at, right, d);
+    }
+    head[0] = Node {
         min: left[0].min.inf(&right[0].min),
         max: left[0].max.sup(&right[0].max),
         axis: slab_axis,
@@ -1087,19 +1115,9 @@ fn build(items: &mut [(V3, u32)], offset: usize, d: &BuildData) -> Vec<Node> {
         hi: slab_hi,
         center,
         radius,
-        index: (1 + left.len()) as u32,
+        index: right_at as u32,
         count: 0,
-    });
-    let shift = |mut n: Node, by: usize| {
-        if n.count == 0 {
-            n.index += by as u32;
-        }
-        n
     };
-    nodes.extend(left.into_iter().map(|n| shift(n, 1)));
-    let by = nodes.len();
-    nodes.extend(right.into_iter().map(|n| shift(n, by)));
-    nodes
 }
 
 #[cfg(test)]
