@@ -701,3 +701,47 @@ def test_dynamic_run_uses_the_saved_steps(scene_dict):
     for k, t in enumerate(c.time):
         expected = half_edge_plane(c.positions[k], -0.3 + 0.1 * t)
         assert np.allclose(c.clearance[k], expected, rtol=0, atol=1e-14)
+
+
+def test_vectorised_mesh_reading_equals_trimesh(tmp_path, monkeypatch):
+    """The STL path (trimesh's reader, vertices merged and checked here) against trimesh's own
+    processing: the same merged vertices and faces (up to vertex order), watertightness,
+    boundary edges, orientation and shells — also when the row hash collides everywhere."""
+    from cablelife.surroundings import meshes
+
+    a = trimesh.creation.icosphere(subdivisions=3, radius=0.1)
+    b = trimesh.creation.torus(major_radius=0.2, minor_radius=0.05)
+    b.apply_translation([0.16, 0.01, 0.0])  # overlaps a: two shells
+    two = trimesh.util.concatenate([a, b])
+    two.export(tmp_path / "two.stl")
+    keep = a.triangles_center[:, 2] > 0.02
+    trimesh.Trimesh(a.vertices, a.faces[keep]).export(tmp_path / "cap.stl")
+    trimesh.Trimesh(b.vertices, b.faces[:, ::-1]).export(tmp_path / "inv.stl")
+
+    def same(m, ref):
+        tris = np.sort(m.vertices[m.faces].reshape(len(m.faces), -1), axis=0)
+        ref_tris = np.sort(ref.vertices[ref.faces].reshape(len(ref.faces), -1), axis=0)
+        assert len(m.vertices) == len(ref.vertices)
+        assert np.array_equal(tris, ref_tris)
+
+    for collide in (False, True):
+        if collide:
+            monkeypatch.setattr(meshes, "row_hash", lambda v: np.zeros(len(v), np.uint64))
+        m = meshes.load_mesh(tmp_path / "two.stl", None, "t", 1.0)
+        ref = trimesh.load(tmp_path / "two.stl", process=True)
+        same(m, ref)
+        assert m.watertight and ref.is_watertight and m.boundary_edges == 0
+        assert len(m.shells) == ref.body_count == 2
+        assert sorted(len(s) for s in m.shells) == sorted([len(a.faces), len(b.faces)])
+        with pytest.warns(SurroundingsWarning, match=r"open \((\d+) boundary edges\)") as w:
+            m = meshes.load_mesh(tmp_path / "cap.stl", None, "t", 1.0)
+        ref = trimesh.load(tmp_path / "cap.stl", process=True)
+        same(m, ref)
+        n_boundary = len(trimesh.grouping.group_rows(ref.edges_sorted, require_count=1))
+        assert m.boundary_edges == n_boundary > 0 and f"({n_boundary} boundary" in str(w[0].message)
+        assert not m.watertight and m.shells is None
+        with pytest.warns(SurroundingsWarning, match="face inwards; flipped"):
+            m = meshes.load_mesh(tmp_path / "inv.stl", None, "t", 1.0)
+        tri = m.vertices[m.faces]
+        volume = np.einsum("ij,ij->", tri[:, 0], np.cross(tri[:, 1], tri[:, 2])) / 6
+        assert volume == pytest.approx(b.volume, rel=1e-6)

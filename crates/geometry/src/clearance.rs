@@ -92,6 +92,9 @@ pub fn clearance(
             // per node and mesh part: candidate sets of the node and of its half-edges
             let mut sets = vec![(Candidates::new(), Candidates::new()); n_nodes * parts.len()];
             let mut dist = vec![f64::INFINITY; parts.len()];
+            // per node and part: a lower bound of the node's distance while it is outside a
+            // closed mesh (0: none) and where it held
+            let mut outside = vec![(0.0, V3::zeros()); n_nodes * parts.len()];
             let mut local = vec![V3::zeros(); n_bodies * n_nodes];
             for (j, (vrow, prow)) in val
                 .chunks_mut(n_nodes)
@@ -107,16 +110,34 @@ pub fn clearance(
                     }
                 }
                 step(
-                    parts, &local, n_nodes, radius, &mut hints, &mut sets, &mut dist, vrow, prow,
+                    parts,
+                    &local,
+                    n_nodes,
+                    radius,
+                    &mut hints,
+                    &mut sets,
+                    &mut outside,
+                    &mut dist,
+                    vrow,
+                    prow,
                 );
             }
         });
     Ok(Clearance { value, part })
 }
 
-/// Clearance of the nodes of one step. `dist`: scratch, per part the node's distance. A
-/// half-edge is queried only if it can come nearer than the best so far: the distance is
-/// 1-Lipschitz, so on a half-edge of reach ℓ from the node it is at least d(node) − ℓ.
+/// Clearance of the nodes of one step. `dist`: scratch, per part the node's distance (or a
+/// lower bound of it). A half-edge is queried only if it can come nearer than the best so
+/// far: the distance is 1-Lipschitz, so on a half-edge of reach ℓ from the node it is at
+/// least d(node) − ℓ.
+///
+/// Outside a closed mesh the node's own distance is not queried while the node is certainly
+/// still outside: `outside` keeps a lower bound L of its distance at the last step and the
+/// position there; a node that moved less than L cannot have crossed the surface (every
+/// point of its path is farther than L − moved > 0 from it), and for a closed, consistently
+/// oriented mesh the sign changes only across the surface. Its clearance is then that of
+/// its half-edges, which start at the node: their distance is at most the node's, so the
+/// minimum is the same (to round-off). This needs half-edges (two nodes or more).
 #[allow(clippy::too_many_arguments)]
 fn step(
     parts: &[Part],
@@ -125,6 +146,7 @@ fn step(
     radius: f64,
     hints: &mut [usize],
     sets: &mut [(Candidates, Candidates)],
+    outside: &mut [(f64, V3)],
     dist: &mut [f64],
     value: &mut [f64],
     part: &mut [u32],
@@ -137,6 +159,21 @@ fn step(
             let x = &local[pt.body * n + i];
             let h = &mut hints[3 * (i * n_parts + k)];
             dist[k] = f64::INFINITY;
+            let out = &mut outside[i * n_parts + k];
+            if let Shape::Mesh(mesh) = &pt.shape {
+                if n > 1 && mesh.is_closed() && out.0 > 0.0 {
+                    // round-off of the bound on the safe side
+                    let lower = out.0 * (1.0 - 1e-12)
+                        - (x - out.1).norm() * (1.0 + 1e-12)
+                        - 1e-12 * x.amax();
+                    if lower > 0.0 {
+                        dist[k] = lower;
+                        *out = (lower, *x);
+                        continue;
+                    }
+                }
+                out.0 = 0.0;
+            }
             let found = match &pt.shape {
                 Shape::Mesh(mesh) => sets[i * n_parts + k].0.project_point(mesh, x, *h),
                 shape => shape.project_point(x, f64::INFINITY, *h),
@@ -144,6 +181,9 @@ fn step(
             if let Some(r) = found {
                 *h = r.feature;
                 dist[k] = r.distance;
+                if r.distance > 0.0 {
+                    *out = (r.distance, *x);
+                }
                 if r.distance < best {
                     best = r.distance;
                     nearest = k;
@@ -175,6 +215,7 @@ fn step(
                     // both half-edges in one traversal; warm start: the triangle nearest to
                     // them at the previous step, else the node's
                     // (all of the node's half-edges: the candidate set is theirs)
+                    let out = &mut outside[i * n_parts + k];
                     if m == 0 {
                         continue;
                     }
@@ -191,7 +232,13 @@ fn step(
                         h => h,
                     };
                     let set = &mut sets[i * n_parts + k].1;
-                    if let Some((d, _, t)) = set.nearest_of_segments(mesh, x, &all[..m], best, h) {
+                    let found = set.nearest_of_segments(mesh, x, &all[..m], best, h);
+                    if out.0 > 0.0 {
+                        // the node is at least as far as its half-edges (beyond the bound
+                        // when none came within it)
+                        out.0 = out.0.max(found.map_or(best, |f| f.0));
+                    }
+                    if let Some((d, _, t)) = found {
                         hints[at + 1] = t;
                         if d < best {
                             best = d;
@@ -313,6 +360,150 @@ mod tests {
             let one = &positions[t * nodes..(t + 1) * nodes];
             let cold = clearance(&parts, one, nodes, 0.005, &maps[t..t + 1]).unwrap();
             assert_eq!(cold.value, c.value[t * nodes..(t + 1) * nodes], "step {t}");
+        }
+    }
+
+    /// A closed torus (major radius R, minor r; n × m quads), outward normals.
+    fn torus(big: f64, small: f64, n: usize, m: usize) -> crate::TriMesh {
+        use std::f64::consts::TAU;
+        let mut v = vec![];
+        for i in 0..n {
+            for j in 0..m {
+                let (u, w) = (TAU * i as f64 / n as f64, TAU * j as f64 / m as f64);
+                let rho = big + small * w.cos();
+                v.push(V3::new(rho * u.cos(), rho * u.sin(), small * w.sin()));
+            }
+        }
+        let at = |i: usize, j: usize| ((i % n) * m + j % m) as u32;
+        let mut f = vec![];
+        for i in 0..n {
+            for j in 0..m {
+                let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+                f.push([a, b, c]);
+                f.push([a, c, d]);
+            }
+        }
+        let mesh = crate::TriMesh::new(&v, &f).unwrap();
+        let far = mesh.project_point(&V3::new(0.0, 0.0, 5.0), f64::INFINITY, usize::MAX);
+        if far.unwrap().distance > 0.0 {
+            return mesh;
+        }
+        let f: Vec<[u32; 3]> = f.iter().map(|t| [t[0], t[2], t[1]]).collect();
+        crate::TriMesh::new(&v, &f).unwrap()
+    }
+
+    #[test]
+    fn closed_mesh_outside_nodes_equal_brute_force() {
+        // a cable moving over a closed torus in small steps (the node's own query skipped
+        // while it is certainly outside), dipping into the tube gradually and with one jump:
+        // every step equals brute force
+        use crate::closest::{point_triangle, segment_triangle};
+        let mesh = torus(0.3, 0.08, 40, 16);
+        assert!(mesh.is_closed());
+        let tris: Vec<[V3; 3]> = (0..mesh.n_triangles()).map(|t| mesh.triangle(t)).collect();
+        let parts = vec![Part {
+            shape: Shape::Mesh(mesh),
+            body: 0,
+        }];
+        let (steps, nodes) = (120, 9);
+        let mut positions = vec![];
+        for t in 0..steps {
+            for i in 0..nodes {
+                let s = t as f64 / steps as f64;
+                // over the tube at x ≈ 0.3, sinking from 0.1 above it to 0.03 inside
+                let mut p = V3::new(
+                    0.26 + 0.01 * i as f64 + 0.02 * s,
+                    -0.1 + 0.025 * i as f64,
+                    0.18 - 0.17 * s + 0.01 * (i as f64 * 0.7).sin(),
+                );
+                if t == 60 && i == 4 {
+                    p.z -= 0.12; // one step straight into the tube
+                }
+                positions.push(p);
+            }
+        }
+        let maps = vec![RigidMap::identity(); steps];
+        let radius = 0.004;
+        let c = clearance(&parts, &positions, nodes, radius, &maps).unwrap();
+        let Shape::Mesh(mesh) = &parts[0].shape else {
+            unreachable!()
+        };
+        let mut inside = 0;
+        for t in 0..steps {
+            let x = &positions[t * nodes..(t + 1) * nodes];
+            for i in 0..nodes {
+                let sd = mesh
+                    .project_point(&x[i], f64::INFINITY, usize::MAX)
+                    .unwrap()
+                    .distance;
+                let brute = tris
+                    .iter()
+                    .map(|[a, b, c]| (point_triangle(&x[i], a, b, c).0 - x[i]).norm())
+                    .fold(f64::INFINITY, f64::min);
+                assert_eq!(sd.abs(), brute);
+                let expect = if sd < 0.0 {
+                    inside += 1;
+                    sd
+                } else {
+                    let mut d = sd;
+                    for nb in [i.wrapping_sub(1), i + 1] {
+                        if nb < nodes {
+                            let mid = (x[i] + x[nb]) * 0.5;
+                            for [a, b, c] in &tris {
+                                let (_, p, q) = segment_triangle(&x[i], &mid, a, b, c);
+                                d = d.min((p - q).norm());
+                            }
+                        }
+                    }
+                    d
+                };
+                let got = c.value[t * nodes + i] + radius;
+                assert!(
+                    (got - expect).abs() <= 1e-15,
+                    "step {t} node {i}: {got} vs {expect}"
+                );
+            }
+        }
+        assert!(inside > 50, "{inside} nodes inside");
+    }
+
+    #[test]
+    fn open_mesh_sign_flip_off_the_surface_is_seen() {
+        // two parallel sheets with normals up (an open mesh): between them the sign flips
+        // where the upper sheet becomes the nearer one, away from any surface; a cable rising
+        // through that level in small steps must follow it (no node query is skipped)
+        let mut v = vec![];
+        let mut f = vec![];
+        for z in [0.0, 0.1] {
+            let k = v.len() as u32;
+            v.extend([
+                V3::new(-1.0, -1.0, z),
+                V3::new(1.0, -1.0, z),
+                V3::new(1.0, 1.0, z),
+                V3::new(-1.0, 1.0, z),
+            ]);
+            f.extend([[k, k + 1, k + 2], [k, k + 2, k + 3]]);
+        }
+        let mesh = crate::TriMesh::new(&v, &f).unwrap();
+        assert!(!mesh.is_closed());
+        let parts = vec![Part {
+            shape: Shape::Mesh(mesh),
+            body: 0,
+        }];
+        let (steps, nodes) = (50, 4);
+        let positions: Vec<V3> = (0..steps)
+            .flat_map(|t| {
+                (0..nodes).map(move |i| V3::new(0.1 * i as f64, 0.0, 0.03 + 0.0007 * t as f64))
+            })
+            .collect();
+        let maps = vec![RigidMap::identity(); steps];
+        let c = clearance(&parts, &positions, nodes, 0.0, &maps).unwrap();
+        for t in 0..steps {
+            let z = positions[t * nodes].z;
+            let expect = if z < 0.05 { z } else { z - 0.1 };
+            for i in 0..nodes {
+                assert!((c.value[t * nodes + i] - expect).abs() < 1e-15, "step {t}");
+            }
         }
     }
 }

@@ -19,6 +19,7 @@ pub mod closest;
 pub mod coherence;
 pub mod mesh;
 pub mod primitives;
+mod wide;
 
 use nalgebra::Vector3;
 

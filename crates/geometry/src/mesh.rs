@@ -8,7 +8,10 @@
 //! point is.
 use std::fmt;
 
+use rayon::prelude::*;
+
 use crate::closest::{point_triangle, segment_triangle, Feature};
+use crate::wide::{self, f32x3, lower, Disk4, Rounded, Wide, EMPTY, LEAF};
 use crate::{PointProjection, SegmentProjection, Surface, V3};
 
 const LEAF_SIZE: usize = 4;
@@ -48,6 +51,19 @@ struct Node {
 }
 
 impl Node {
+    /// A placeholder (overwritten by the build).
+    const EMPTY: Node = Node {
+        min: V3::new(0.0, 0.0, 0.0),
+        max: V3::new(0.0, 0.0, 0.0),
+        index: 0,
+        count: 0,
+        lo: 0.0,
+        hi: 0.0,
+        axis: V3::new(0.0, 0.0, 0.0),
+        center: V3::new(0.0, 0.0, 0.0),
+        radius: 0.0,
+    };
+
     /// Squared distance of p to the box (a lower bound; cheap, to order the children).
     #[inline(always)]
     fn box_distance2(&self, p: &V3) -> f64 {
@@ -65,9 +81,12 @@ impl Node {
     /// so its offset across the axis is at most the radius too).
     #[inline(always)]
     fn excludes_point(&self, p: &V3, best_d2: f64) -> bool {
-        if self.box_distance2(p) > best_d2 {
-            return true;
-        }
+        self.box_distance2(p) > best_d2 || self.slab_excludes_point(p, best_d2)
+    }
+
+    /// The slab-and-ball part of [`Self::excludes_point`] (false without a slab).
+    #[inline(always)]
+    fn slab_excludes_point(&self, p: &V3, best_d2: f64) -> bool {
         if !self.radius.is_finite() {
             return false;
         }
@@ -195,6 +214,51 @@ pub struct TriMesh {
     edge_normals: Vec<[V3; 3]>,
     vertex_normals: Vec<V3>,
     nodes: Vec<Node>,
+    /// The 4-wide float32 view of `nodes` for the clearance's queries, and per leaf its
+    /// triangles' planes and disks in float32.
+    wide: Vec<Wide>,
+    blocks: Vec<Disk4>,
+    /// Largest vertex coordinate magnitude (the scale of the float32 round-off).
+    scale: f64,
+    /// Closed and consistently oriented (every edge in two faces, in opposite directions).
+    closed: bool,
+}
+
+struct BinaryView<'a> {
+    nodes: &'a [Node],
+    spheres: &'a [(V3, f64)],
+    normals: &'a [V3],
+}
+
+/// Depth of the traversal stacks: the wide tree is at most as deep as the binary one (median
+/// splits: ≤ 32 levels for u32 triangle counts) and a visit adds at most three entries.
+const STACK: usize = 128;
+
+impl wide::Binary for BinaryView<'_> {
+    fn bounds(&self, node: u32) -> (V3, V3) {
+        let n = &self.nodes[node as usize];
+        (n.min, n.max)
+    }
+    fn children(&self, node: u32) -> Option<(u32, u32)> {
+        let n = &self.nodes[node as usize];
+        (n.count == 0).then_some((node + 1, n.index))
+    }
+    fn triangles(&self, node: u32) -> (usize, usize) {
+        let n = &self.nodes[node as usize];
+        (n.index as usize, n.count as usize)
+    }
+    fn slab(&self, node: u32) -> Option<(V3, f64, f64, V3, f64)> {
+        let n = &self.nodes[node as usize];
+        n.radius
+            .is_finite()
+            .then_some((n.axis, n.lo, n.hi, n.center, n.radius))
+    }
+    fn disk(&self, t: usize) -> (V3, f64, f64, V3, f64) {
+        let (c, r) = self.spheres[t];
+        let n = self.normals[t];
+        let x = n.dot(&c);
+        (n, x, x, c, r)
+    }
 }
 
 impl TriMesh {
@@ -243,8 +307,15 @@ impl TriMesh {
                 keys.push((edge_key(f[k], f[(k + 1) % 3]), (3 * i + k) as u32));
             }
         }
-        keys.sort_unstable();
+        keys.par_sort_unstable();
         let mut edge_of = vec![V3::zeros(); faces.len() * 3];
+        // closed and consistently oriented: every edge in two faces, once in each direction
+        let forward = |side: u32| {
+            let f = &faces[side as usize / 3];
+            let k = side as usize % 3;
+            f[k] < f[(k + 1) % 3]
+        };
+        let mut closed = true;
         let mut g = 0;
         while g < keys.len() {
             let mut h = g;
@@ -253,6 +324,7 @@ impl TriMesh {
                 sum += normals[keys[h].1 as usize / 3];
                 h += 1;
             }
+            closed &= h - g == 2 && forward(keys[g].1) != forward(keys[g + 1].1);
             for key in &keys[g..h] {
                 edge_of[key.1 as usize] = sum;
             }
@@ -261,7 +333,7 @@ impl TriMesh {
         drop(keys);
         // hierarchy over the triangle centroids
         let mut items: Vec<(V3, u32)> = faces
-            .iter()
+            .par_iter()
             .enumerate()
             .map(|(i, f)| {
                 let c = f.iter().fold(V3::zeros(), |s, &k| s + vertices[k as usize]) / 3.0;
@@ -269,7 +341,7 @@ impl TriMesh {
             })
             .collect();
         let boxes: Vec<(V3, V3)> = faces
-            .iter()
+            .par_iter()
             .map(|f| {
                 let [a, b, c] = f.map(|k| vertices[k as usize]);
                 (a.inf(&b).inf(&c), a.sup(&b).sup(&c))
@@ -281,7 +353,8 @@ impl TriMesh {
             faces,
             normals: &normals,
         };
-        let nodes = build(&mut items, 0, &ctx);
+        let mut nodes = vec![Node::EMPTY; tree_size(items.len())];
+        build(&mut items, 0, 0, &mut nodes, &ctx);
         let order: Vec<usize> = items.iter().map(|&(_, i)| i as usize).collect();
         let triangles = order
             .iter()
@@ -294,6 +367,13 @@ impl TriMesh {
             .iter()
             .map(|&i| [0, 1, 2].map(|k| edge_of[3 * i + k]))
             .collect();
+        let view = BinaryView {
+            nodes: &nodes,
+            spheres: &spheres,
+            normals: &face_normals,
+        };
+        let (wide, blocks) = wide::collapse(&view, 0);
+        let scale = vertices.iter().fold(0.0, |m: f64, v| m.max(v.amax()));
         Ok(TriMesh {
             triangles,
             corners,
@@ -302,7 +382,17 @@ impl TriMesh {
             edge_normals,
             vertex_normals,
             nodes,
+            wide,
+            blocks,
+            scale,
+            closed,
         })
+    }
+
+    /// Whether the mesh is closed and consistently oriented: then the sign of the distance
+    /// (inside or outside) changes only across the surface.
+    pub fn is_closed(&self) -> bool {
+        self.closed
     }
 
     pub fn n_triangles(&self) -> usize {
@@ -382,18 +472,40 @@ impl TriMesh {
                 best = Some((hint, cp));
             }
         }
-        let mut stack = [0u32; 64];
+        // the wide tree: per visit four float32 boxes and slab-and-ball bounds (lower bounds),
+        // leaves nearest first (their triangles' float32 plane-and-disk bounds, then the
+        // exact distance), inner lanes pushed farthest first
+        let q = Rounded::new(p, p);
+        let pf = f32x3(p);
+        let pad = wide::pad(p.amax().max(self.scale));
+        let mut stack = [(0u32, 0f32); STACK];
         let mut top = 1;
         while top > 0 {
             top -= 1;
-            let node = &self.nodes[stack[top] as usize];
-            if node.excludes_point(p, best_d2) {
+            let (w, g) = stack[top];
+            if lower(g) > best_d2 {
                 continue;
             }
-            if node.count > 0 {
+            let wn = &self.wide[w as usize];
+            let mut g = wn.gaps2(&q);
+            let gd = wn.disk.point_bounds2(&pf, pad);
+            for l in 0..4 {
+                g[l] = g[l].max(gd[l]);
+            }
+            let order = wide::order(&g);
+            for &l in &order {
+                if lower(g[l]) > best_d2 {
+                    break;
+                }
+                if wn.wide[l] & LEAF == 0 || wn.node[l] == EMPTY {
+                    continue;
+                }
+                let node = &self.nodes[wn.node[l] as usize];
+                let tb = self.blocks[(wn.wide[l] & !LEAF) as usize].point_bounds2(&pf, pad);
                 let start = node.index as usize;
-                for t in start..start + node.count as usize {
-                    if self.point_lower2(t, p) > best_d2 {
+                for (i, b) in tb.iter().enumerate().take(node.count as usize) {
+                    let t = start + i;
+                    if lower(*b) > best_d2 || self.point_lower2(t, p) > best_d2 {
                         continue;
                     }
                     let [a, b, c] = &self.triangles[t];
@@ -404,20 +516,12 @@ impl TriMesh {
                         best = Some((t, cp));
                     }
                 }
-            } else {
-                let left = stack[top] + 1;
-                let right = node.index;
-                let dl = self.nodes[left as usize].box_distance2(p);
-                let dr = self.nodes[right as usize].box_distance2(p);
-                // nearer child on top of the stack
-                let (near, far) = if dl <= dr {
-                    (left, right)
-                } else {
-                    (right, left)
-                };
-                stack[top] = far;
-                stack[top + 1] = near;
-                top += 2;
+            }
+            for &l in order.iter().rev() {
+                if wn.wide[l] & LEAF == 0 && lower(g[l]) <= best_d2 {
+                    stack[top] = (wn.wide[l], g[l]);
+                    top += 1;
+                }
             }
         }
         best
@@ -465,42 +569,74 @@ impl TriMesh {
         if hint < self.triangles.len() {
             check(hint, &mut best_d2, &mut best);
         }
-        let mut stack = [0u32; 64];
+        // the wide tree: per visit and segment four float32 boxes and slab-and-ball bounds, a
+        // lane's bound the least over the segments; leaves nearest first (per triangle and
+        // segment the float32 plane-and-disk bound, the float64 one, then the exact
+        // distance), inner lanes pushed farthest first
+        let scale = ends.iter().fold(a.amax(), |m, b| m.max(b.amax()));
+        let pad = wide::pad(scale.max(self.scale));
+        let af = f32x3(a);
+        let mut bf = [[0f32; 3]; MAX_ENDS];
+        let mut qs = [Rounded::new(a, a); MAX_ENDS];
+        for j in 0..ends.len() {
+            bf[j] = f32x3(&ends[j]);
+            qs[j] = Rounded::new(&seg[j].0, &seg[j].1);
+        }
+        let (bf, qs) = (&bf[..ends.len()], &qs[..ends.len()]);
+        let mut stack = [(0u32, 0f32); STACK];
         let mut top = 1;
         while top > 0 {
             top -= 1;
-            let node = &self.nodes[stack[top] as usize];
-            // the box of all segments first, then each segment
-            let mut d2 = 0.0;
-            for k in 0..3 {
-                let e = (node.min[k] - vhi[k]).max(vlo[k] - node.max[k]).max(0.0);
-                d2 += e * e;
-            }
-            if d2 > best_d2
-                || ends.iter().zip(seg).all(|(b, (lo, hi, mid, half))| {
-                    node.excludes_segment(a, b, lo, hi, mid, *half, best_d2)
-                })
-            {
+            let (w, g) = stack[top];
+            if lower(g) > best_d2 {
                 continue;
             }
-            if node.count > 0 {
-                let start = node.index as usize;
-                for t in start..start + node.count as usize {
-                    check(t, &mut best_d2, &mut best);
+            let wn = &self.wide[w as usize];
+            let mut g = [f32::INFINITY; 4];
+            for (q, b) in qs.iter().zip(bf) {
+                let gb = wn.gaps2(q);
+                let gd = wn.disk.segment_bounds2(&af, b, pad);
+                for l in 0..4 {
+                    g[l] = g[l].min(gb[l].max(gd[l]));
                 }
-            } else {
-                let left = stack[top] + 1;
-                let right = node.index;
-                let dl = self.nodes[left as usize].box_distance2(a);
-                let dr = self.nodes[right as usize].box_distance2(a);
-                let (near, far) = if dl <= dr {
-                    (left, right)
-                } else {
-                    (right, left)
-                };
-                stack[top] = far;
-                stack[top + 1] = near;
-                top += 2;
+            }
+            let order = wide::order(&g);
+            for &l in &order {
+                if lower(g[l]) > best_d2 {
+                    break;
+                }
+                if wn.wide[l] & LEAF == 0 || wn.node[l] == EMPTY {
+                    continue;
+                }
+                let node = &self.nodes[wn.node[l] as usize];
+                let block = &self.blocks[(wn.wide[l] & !LEAF) as usize];
+                let mut tb = [[0f32; 4]; MAX_ENDS];
+                for (j, b) in bf.iter().enumerate() {
+                    tb[j] = block.segment_bounds2(&af, b, pad);
+                }
+                let start = node.index as usize;
+                #[allow(clippy::needless_range_loop)] // tb is per segment, then lane
+                for i in 0..node.count as usize {
+                    let t = start + i;
+                    let [p, q, r] = &self.triangles[t];
+                    for (j, b) in ends.iter().enumerate() {
+                        if lower(tb[j][i]) > best_d2 || self.segment_excluded(t, a, b, best_d2) {
+                            continue;
+                        }
+                        let (_, x, y) = segment_triangle(a, b, p, q, r);
+                        let d2 = (x - y).norm_squared();
+                        if d2 < best_d2 || (d2 == best_d2 && best.is_none()) {
+                            best_d2 = d2;
+                            best = Some((j, t));
+                        }
+                    }
+                }
+            }
+            for &l in order.iter().rev() {
+                if wn.wide[l] & LEAF == 0 && lower(g[l]) <= best_d2 {
+                    stack[top] = (wn.wide[l], g[l]);
+                    top += 1;
+                }
             }
         }
         best.map(|(j, t)| (best_d2.sqrt(), j, t))
@@ -913,9 +1049,19 @@ fn slab(items: &[(V3, u32)], d: &BuildData) -> (V3, f64, f64, V3, f64) {
     (axis, lo - pad, hi + pad, center, radius)
 }
 
-/// Builds the hierarchy over `items` (centroid, triangle), reordering them; `offset` is the
-/// position of items[0] in the whole triangle order. Nodes in depth-first order.
-fn build(items: &mut [(V3, u32)], offset: usize, d: &BuildData) -> Vec<Node> {
+/// Number of nodes of the hierarchy over `k` triangles (median splits).
+fn tree_size(k: usize) -> usize {
+    if k <= LEAF_SIZE {
+        1
+    } else {
+        1 + tree_size(k / 2) + tree_size(k - k / 2)
+    }
+}
+
+/// Builds the hierarchy over `items` (centroid, triangle), reordering them, into `out`
+/// (`tree_size(items.len())` nodes, depth first); `offset` is the position of items[0] in
+/// the whole triangle order, `base` the index of out[0] among all nodes.
+fn build(items: &mut [(V3, u32)], offset: usize, base: usize, out: &mut [Node], d: &BuildData) {
     let boxes = d.boxes;
     if items.len() <= LEAF_SIZE {
         let (mut lo, mut hi) = (V3::repeat(f64::INFINITY), V3::repeat(f64::NEG_INFINITY));
@@ -925,7 +1071,7 @@ fn build(items: &mut [(V3, u32)], offset: usize, d: &BuildData) -> Vec<Node> {
             hi = hi.sup(&b);
         }
         let (axis, slo, shi, center, radius) = slab(items, d);
-        return vec![Node {
+        out[0] = Node {
             min: lo,
             max: hi,
             axis,
@@ -935,7 +1081,8 @@ fn build(items: &mut [(V3, u32)], offset: usize, d: &BuildData) -> Vec<Node> {
             radius,
             index: offset as u32,
             count: items.len() as u32,
-        }];
+        };
+        return;
     }
     let (mut clo, mut chi) = (V3::repeat(f64::INFINITY), V3::repeat(f64::NEG_INFINITY));
     for (c, _) in items.iter() {
@@ -947,19 +1094,20 @@ fn build(items: &mut [(V3, u32)], offset: usize, d: &BuildData) -> Vec<Node> {
     let mid = items.len() / 2;
     items.select_nth_unstable_by(mid, |x, y| x.0[axis].total_cmp(&y.0[axis]));
     let (left_items, right_items) = items.split_at_mut(mid);
-    let (left, right) = if left_items.len() + right_items.len() > PARALLEL_BUILD {
+    let n_left = tree_size(mid);
+    let (head, rest) = out.split_at_mut(1);
+    let (left, right) = rest.split_at_mut(n_left);
+    let right_at = base + 1 + n_left;
+    if left_items.len() + right_items.len() > PARALLEL_BUILD {
         rayon::join(
-            || build(left_items, offset, d),
-            || build(right_items, offset + mid, d),
-        )
+            || build(left_items, offset, base + 1, left, d),
+            || build(right_items, offset + mid, right_at, right, d),
+        );
     } else {
-        (
-            build(left_items, offset, d),
-            build(right_items, offset + mid, d),
-        )
-    };
-    let mut nodes = Vec::with_capacity(1 + left.len() + right.len());
-    nodes.push(Node {
+        build(left_items, offset, base + 1, left, d);
+        build(right_items, offset + mid, right_at, right, d);
+    }
+    head[0] = Node {
         min: left[0].min.inf(&right[0].min),
         max: left[0].max.sup(&right[0].max),
         axis: slab_axis,
@@ -967,19 +1115,9 @@ fn build(items: &mut [(V3, u32)], offset: usize, d: &BuildData) -> Vec<Node> {
         hi: slab_hi,
         center,
         radius,
-        index: (1 + left.len()) as u32,
+        index: right_at as u32,
         count: 0,
-    });
-    let shift = |mut n: Node, by: usize| {
-        if n.count == 0 {
-            n.index += by as u32;
-        }
-        n
     };
-    nodes.extend(left.into_iter().map(|n| shift(n, 1)));
-    let by = nodes.len();
-    nodes.extend(right.into_iter().map(|n| shift(n, by)));
-    nodes
 }
 
 #[cfg(test)]
@@ -1200,6 +1338,89 @@ mod tests {
             // nothing within a bound below the distance (d = 0: a half-edge crosses)
             if d > 0.0 {
                 assert!(m.nearest_of_segments(&a, &[b, c], d * 0.99, t).is_none());
+            }
+        }
+    }
+
+    #[test]
+    fn float32_hierarchy_is_exact_near_the_surface_and_far_from_the_origin() {
+        // the wide tree's float32 bounds against brute force where their round-off matters:
+        // a bumpy surface moved far from the origin (the allowance grows with the
+        // coordinates), points and half-edges from 1e-9 to 1e-2 above it and just below it,
+        let h = |x: f64, y: f64| 0.02 * (x * 11.0).sin() * (y * 7.0).cos();
+        let n = 24;
+        for offset in [
+            V3::zeros(),
+            V3::new(3.0, -2.0, 1.0),
+            V3::new(250.0, 40.0, -90.0),
+        ] {
+            let mut v = vec![];
+            for i in 0..=n {
+                for j in 0..=n {
+                    let (x, y) = (i as f64 / n as f64, j as f64 / n as f64);
+                    v.push(offset + V3::new(x, y, h(x, y)));
+                }
+            }
+            // and a second sheet 1 µm above the first (a double wall): nearest triangles
+            // decided by less than the float32 resolution of the coordinates
+            let k0 = v.len() as u32;
+            for k in 0..k0 as usize {
+                v.push(v[k] + V3::new(0.0, 0.0, 1e-6));
+            }
+            let mut f = vec![];
+            for sheet in [0, k0] {
+                for i in 0..n {
+                    for j in 0..n {
+                        let a = sheet + (i * (n + 1) + j) as u32;
+                        let (b, c, d) = (a + n as u32 + 1, a + 1, a + n as u32 + 2);
+                        f.push([a, b, d]);
+                        f.push([a, d, c]);
+                    }
+                }
+            }
+            let m = TriMesh::new(&v, &f).unwrap();
+            let tri = |t: &[u32; 3]| [0, 1, 2].map(|k| v[t[k] as usize]);
+            for q in 0..400 {
+                let (x, y) = (
+                    0.05 + (q as f64 * 0.377) % 0.9,
+                    0.05 + (q as f64 * 0.613) % 0.9,
+                );
+                let lift = if q % 2 == 0 {
+                    10f64.powf(-9.0 + 7.0 * (q % 13) as f64 / 12.0)
+                        * if q % 5 == 0 { -1.0 } else { 1.0 }
+                } else {
+                    1e-6 * (q % 17) as f64 / 16.0 // between the sheets
+                };
+                let a = offset + V3::new(x, y, h(x, y) + lift);
+                let dir = V3::new((q as f64).cos(), (q as f64).sin(), 0.0) * 0.02;
+                let b = offset + V3::new(x + dir.x, y + dir.y, h(x + dir.x, y + dir.y) + lift);
+                let c = offset + V3::new(x - dir.y, y + dir.x, h(x - dir.y, y + dir.x) + lift);
+                let r = m.project_point(&a, f64::INFINITY, usize::MAX).unwrap();
+                let brute = f
+                    .iter()
+                    .map(|t| {
+                        let [p, u, w] = tri(t);
+                        (point_triangle(&a, &p, &u, &w).0 - a).norm()
+                    })
+                    .fold(f64::INFINITY, f64::min);
+                assert_eq!(r.distance.abs(), brute, "offset {offset:?} query {q}");
+                let seg_brute = |e: &V3| {
+                    f.iter()
+                        .map(|t| {
+                            let [p, u, w] = tri(t);
+                            let (_, x, y) = segment_triangle(&a, e, &p, &u, &w);
+                            (x - y).norm()
+                        })
+                        .fold(f64::INFINITY, f64::min)
+                };
+                let (d, _, _) = m
+                    .nearest_of_segments(&a, &[b, c], f64::INFINITY, usize::MAX)
+                    .unwrap();
+                assert_eq!(
+                    d,
+                    seg_brute(&b).min(seg_brute(&c)),
+                    "offset {offset:?} query {q}"
+                );
             }
         }
     }

@@ -1,0 +1,476 @@
+//! A 4-wide view of a binary bounding volume hierarchy, for the hot queries of the clearance.
+//!
+//! Each wide node holds the boxes of up to four nodes of the binary tree (its children and
+//! grandchildren) in float32, structure of arrays (`min[axis][lane]`), so one visit tests four
+//! boxes in loops the compiler turns into SIMD, and the tree takes a quarter of the memory
+//! traffic of the float64 binary nodes. The float32 boxes are rounded outwards and the query
+//! rounded down and up ([`Rounded`]), so a float32 box distance (scaled by [`F32_SAFE`]) is a
+//! lower bound of the exact float64 distance: it only ever skips what the float64 test would
+//! skip. The binary nodes keep their float64 data (slab and ball bounds, triangle ranges): the
+//! wide nodes point at them, and the leaves are tested exactly.
+use crate::V3;
+
+/// A lane with no node: an empty box (every distance infinite).
+pub(crate) const EMPTY: u32 = u32::MAX;
+
+/// A float32 squared box distance times this is at most the exact squared distance: the
+/// outward-rounded boxes and the rounded query already bound the distance from below; six
+/// float32 operations on it (a subtraction, three squares, two sums) each round up by at most
+/// 2⁻²⁴ relative.
+pub(crate) const F32_SAFE: f64 = 1.0 - 1e-6;
+
+/// A lower bound of the exact squared distance from a float32 one of [`Wide::gaps2`]: scaled
+/// by [`F32_SAFE`], less the absolute round-off of float32 results below the normal range.
+#[inline(always)]
+pub(crate) fn lower(g: f32) -> f64 {
+    g as f64 * F32_SAFE - 4.0 * f32::MIN_POSITIVE as f64
+}
+
+/// Lane indices in increasing order of `g` (empty lanes, infinite, last).
+#[inline(always)]
+pub(crate) fn order(g: &[f32; 4]) -> [usize; 4] {
+    let mut o = [0, 1, 2, 3];
+    for i in 1..4 {
+        let mut j = i;
+        while j > 0 && g[o[j - 1]] > g[o[j]] {
+            o.swap(j - 1, j);
+            j -= 1;
+        }
+    }
+    o
+}
+
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
+pub(crate) struct Wide {
+    pub min: [[f32; 4]; 3],
+    pub max: [[f32; 4]; 3],
+    /// Per lane: the binary node (`EMPTY`: none).
+    pub node: [u32; 4],
+    /// Per lane: the wide node of an inner binary node, `LEAF | block` for a leaf (its
+    /// triangles' disks in `blocks[block]`), `EMPTY` for none.
+    pub wide: [u32; 4],
+    /// Per lane: the node's slab and ball ([`Disk4::NONE`] lanes without).
+    pub disk: Disk4,
+}
+
+/// Flag of a leaf lane in [`Wide::wide`].
+pub(crate) const LEAF: u32 = 1 << 31;
+
+/// The float32 round-off allowance of [`Disk4`] bounds for a query whose coordinates and
+/// the mesh's are at most `scale` in magnitude: every float32 quantity of the bounds (the
+/// rounded query and stored data, and a dozen operations on them) is within a few dozen
+/// 2⁻²⁴·scale of its exact value; 2⁻¹⁶·scale covers that with a margin of ×4 or more.
+/// Infinite (no pruning) where float32 squares could overflow.
+#[inline]
+pub(crate) fn pad(scale: f64) -> f32 {
+    if scale < 1e15 {
+        f32_up(scale * (1.0 / 65536.0))
+    } else {
+        f32::INFINITY
+    }
+}
+
+/// Four thin disk-like sets in float32, structure of arrays: per lane the points z with
+/// axis·z in [lo, hi] and |P(z − center)| ≤ radius (P the projection across the unit axis),
+/// a node's slab and ball or a triangle (its plane, lo = hi, and circumscribed disk about the
+/// centroid). The bounds are those of the float64 `disk_excludes` (first stage), less the
+/// allowance [`pad`] on each gap, so they stay below the exact distance.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(16))]
+pub(crate) struct Disk4 {
+    pub axis: [[f32; 4]; 3],
+    pub lo: [f32; 4],
+    pub hi: [f32; 4],
+    pub center: [[f32; 4]; 3],
+    pub radius: [f32; 4],
+}
+
+impl Disk4 {
+    /// Every lane unbounded (bound 0): no slab.
+    pub const NONE: Disk4 = Disk4 {
+        axis: [[0.0; 4]; 3],
+        lo: [f32::NEG_INFINITY; 4],
+        hi: [f32::INFINITY; 4],
+        center: [[0.0; 4]; 3],
+        radius: [f32::INFINITY; 4],
+    };
+
+    /// Lane `l` holds the set (axis unit; lo, hi, radius already widened for the float64
+    /// round-off of their computation).
+    pub fn set(&mut self, l: usize, axis: &V3, lo: f64, hi: f64, center: &V3, radius: f64) {
+        for k in 0..3 {
+            self.axis[k][l] = axis[k] as f32;
+            self.center[k][l] = center[k] as f32;
+        }
+        self.lo[l] = f32_down(lo);
+        self.hi[l] = f32_up(hi);
+        self.radius[l] = f32_up(radius);
+    }
+
+    /// Lower bounds of the squared distances of point p (float32) to the four sets.
+    #[inline(always)]
+    pub fn point_bounds2(&self, p: &[f32; 3], pad: f32) -> [f32; 4] {
+        let mut out = [0.0f32; 4];
+        for (l, o) in out.iter_mut().enumerate() {
+            let a = [self.axis[0][l], self.axis[1][l], self.axis[2][l]];
+            let v = [
+                p[0] - self.center[0][l],
+                p[1] - self.center[1][l],
+                p[2] - self.center[2][l],
+            ];
+            let x = a[0] * p[0] + a[1] * p[1] + a[2] * p[2];
+            let h = ((self.lo[l] - x).max(x - self.hi[l]) - pad).max(0.0);
+            let av = a[0] * v[0] + a[1] * v[1] + a[2] * v[2];
+            let w = [v[0] - a[0] * av, v[1] - a[1] * av, v[2] - a[2] * av];
+            let wn = (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]).sqrt();
+            let lat = (wn - self.radius[l] - pad).max(0.0);
+            *o = h * h + lat * lat;
+        }
+        out
+    }
+
+    /// Lower bounds of the squared distances of segment [a, b] (float32) to the four sets:
+    /// the least axial gap over the segment and the least in-plane offset of the projected
+    /// segment beyond the radius, taken apart.
+    #[inline(always)]
+    pub fn segment_bounds2(&self, a: &[f32; 3], b: &[f32; 3], pad: f32) -> [f32; 4] {
+        let d = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+        let mut out = [0.0f32; 4];
+        for (l, o) in out.iter_mut().enumerate() {
+            let n = [self.axis[0][l], self.axis[1][l], self.axis[2][l]];
+            let xa = n[0] * a[0] + n[1] * a[1] + n[2] * a[2];
+            let xd = n[0] * d[0] + n[1] * d[1] + n[2] * d[2];
+            let xb = xa + xd;
+            let g = ((self.lo[l] - xa.max(xb)).max(xa.min(xb) - self.hi[l]) - pad).max(0.0);
+            let u = [
+                a[0] - self.center[0][l],
+                a[1] - self.center[1][l],
+                a[2] - self.center[2][l],
+            ];
+            let xu = n[0] * u[0] + n[1] * u[1] + n[2] * u[2];
+            let pu = [u[0] - n[0] * xu, u[1] - n[1] * xu, u[2] - n[2] * xu];
+            let e = [d[0] - n[0] * xd, d[1] - n[1] * xd, d[2] - n[2] * xd];
+            let l2 = e[0] * e[0] + e[1] * e[1] + e[2] * e[2];
+            let pe = pu[0] * e[0] + pu[1] * e[1] + pu[2] * e[2];
+            // any s in [0, 1] is a point of the segment; round-off in s only moves q(s) by
+            // second-order amounts (|q|² is stationary at the interior minimum)
+            let s = if l2 > 0.0 {
+                (-pe / l2).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            let q = [pu[0] + e[0] * s, pu[1] + e[1] * s, pu[2] + e[2] * s];
+            let qn = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2]).sqrt();
+            let lat = (qn - self.radius[l] - pad).max(0.0);
+            *o = g * g + lat * lat;
+        }
+        out
+    }
+}
+
+/// A float64 point rounded to nearest float32.
+#[inline(always)]
+pub(crate) fn f32x3(p: &V3) -> [f32; 3] {
+    [p.x as f32, p.y as f32, p.z as f32]
+}
+
+/// float32 nearest below / above a float64 (infinities stay).
+#[inline(always)]
+pub(crate) fn f32_down(x: f64) -> f32 {
+    let f = x as f32;
+    if f as f64 > x {
+        f.next_down()
+    } else {
+        f
+    }
+}
+
+#[inline(always)]
+pub(crate) fn f32_up(x: f64) -> f32 {
+    let f = x as f32;
+    if (f as f64) < x {
+        f.next_up()
+    } else {
+        f
+    }
+}
+
+/// A box [lo, hi] in float32 holding a float64 box (a point: lo = hi).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Rounded {
+    pub lo: [f32; 3],
+    pub hi: [f32; 3],
+}
+
+impl Rounded {
+    #[inline(always)]
+    pub fn new(lo: &V3, hi: &V3) -> Self {
+        Rounded {
+            lo: [f32_down(lo.x), f32_down(lo.y), f32_down(lo.z)],
+            hi: [f32_up(hi.x), f32_up(hi.y), f32_up(hi.z)],
+        }
+    }
+}
+
+impl Wide {
+    /// Lower bounds (float32, see [`F32_SAFE`]) of the squared distances between the box q
+    /// and the four lanes' boxes; infinite for empty lanes.
+    #[inline(always)]
+    #[allow(clippy::needless_range_loop)] // structure of arrays: lane l of each
+    pub fn gaps2(&self, q: &Rounded) -> [f32; 4] {
+        let mut d2 = [0.0f32; 4];
+        for k in 0..3 {
+            for l in 0..4 {
+                let e = (self.min[k][l] - q.hi[k])
+                    .max(q.lo[k] - self.max[k][l])
+                    .max(0.0);
+                d2[l] += e * e;
+            }
+        }
+        d2
+    }
+}
+
+/// The binary tree as the wide builder sees it.
+pub(crate) trait Binary {
+    /// The node's box.
+    fn bounds(&self, node: u32) -> (V3, V3);
+    /// An inner node's two children (None: a leaf).
+    fn children(&self, node: u32) -> Option<(u32, u32)>;
+    /// A leaf's triangles (first, count ≤ 4).
+    fn triangles(&self, node: u32) -> (usize, usize);
+    /// The node's slab and ball (axis, lo, hi, center, radius), if it has one.
+    fn slab(&self, node: u32) -> Option<(V3, f64, f64, V3, f64)>;
+    /// Triangle t's plane and disk (normal, n·c, n·c, centroid c, circumradius).
+    fn disk(&self, t: usize) -> (V3, f64, f64, V3, f64);
+    fn size(&self, node: u32) -> f64 {
+        let (lo, hi) = self.bounds(node);
+        let e = hi - lo;
+        e.x * e.y + e.y * e.z + e.z * e.x
+    }
+}
+
+/// Wide nodes over the binary tree rooted at `root` (wide node 0 holds the root's children,
+/// or the root itself when it is a leaf) and the leaves' triangle disks.
+pub(crate) fn collapse<T: Binary + ?Sized>(tree: &T, root: u32) -> (Vec<Wide>, Vec<Disk4>) {
+    let mut out = (Vec::new(), Vec::new());
+    let lanes = match tree.children(root) {
+        Some((l, r)) => vec![l, r],
+        None => vec![root],
+    };
+    push(tree, lanes, &mut out);
+    out
+}
+
+/// Adds the wide node of `lanes` (opening the largest inner lanes until there are four) and,
+/// depth first, those of its inner lanes; returns its index.
+fn push<T: Binary + ?Sized>(
+    tree: &T,
+    mut lanes: Vec<u32>,
+    out: &mut (Vec<Wide>, Vec<Disk4>),
+) -> u32 {
+    while lanes.len() < 4 {
+        let open = lanes
+            .iter()
+            .enumerate()
+            .filter(|(_, &n)| tree.children(n).is_some())
+            .max_by(|a, b| tree.size(*a.1).total_cmp(&tree.size(*b.1)));
+        let Some((i, &n)) = open else { break };
+        let (l, r) = tree.children(n).unwrap();
+        lanes[i] = l;
+        lanes.push(r);
+    }
+    let at = out.0.len();
+    out.0.push(Wide {
+        min: [[f32::INFINITY; 4]; 3],
+        max: [[f32::NEG_INFINITY; 4]; 3],
+        node: [EMPTY; 4],
+        wide: [EMPTY; 4],
+        disk: Disk4::NONE,
+    });
+    for (l, &n) in lanes.iter().enumerate() {
+        let (lo, hi) = tree.bounds(n);
+        let r = Rounded::new(&lo, &hi);
+        let w = &mut out.0[at];
+        for k in 0..3 {
+            w.min[k][l] = r.lo[k];
+            w.max[k][l] = r.hi[k];
+        }
+        w.node[l] = n;
+        if let Some((axis, slo, shi, center, radius)) = tree.slab(n) {
+            w.disk.set(l, &axis, slo, shi, &center, radius);
+        }
+        if let Some((a, b)) = tree.children(n) {
+            let c = push(tree, vec![a, b], out);
+            out.0[at].wide[l] = c;
+        } else {
+            let (first, count) = tree.triangles(n);
+            assert!(count <= 4, "a leaf holds at most 4 triangles");
+            let mut block = Disk4::NONE;
+            for i in 0..count {
+                let (axis, lo, hi, center, radius) = tree.disk(first + i);
+                block.set(i, &axis, lo, hi, &center, radius);
+            }
+            out.0[at].wide[l] = LEAF | out.1.len() as u32;
+            out.1.push(block);
+        }
+    }
+    at as u32
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rounding_brackets_the_value() {
+        for x in [
+            0.1,
+            -0.1,
+            1.0 / 3.0,
+            -2.0 / 3.0,
+            1e-40,
+            -1e-40,
+            0.0,
+            1e30,
+            123456.789,
+            f64::INFINITY,
+        ] {
+            let (lo, hi) = (f32_down(x), f32_up(x));
+            assert!((lo as f64) <= x && x <= hi as f64, "{x}");
+            // the nearest ones: one float32 step at most
+            assert!(lo == hi || lo.next_up() == hi, "{x}");
+        }
+        assert_eq!(order(&[3.0, f32::INFINITY, 1.0, 2.0]), [2, 3, 0, 1]);
+        assert_eq!(f32_down(0.5), 0.5);
+        assert_eq!(f32_up(0.5), 0.5);
+    }
+
+    #[test]
+    fn float32_gaps_are_lower_bounds() {
+        // boxes and points chosen so that float32 rounding to nearest would overestimate the
+        // gap (the box's face and the point a fraction of a float32 step apart): the bound
+        // must stay at or below the exact float64 distance, times F32_SAFE
+        let mut seed = 7u64;
+        let mut rnd = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for _ in 0..20000 {
+            let scale = [1e-3, 1.0, 1e3][(rnd() * 3.0) as usize % 3];
+            let lo = V3::new(rnd(), rnd(), rnd()) * scale;
+            let hi = lo + V3::new(rnd(), rnd(), rnd()) * scale * 0.1;
+            // a point just outside a face, gaps from ~1 float32 step to a box size
+            let gap = scale * 10f64.powf(-9.0 * rnd());
+            let mut p = (lo + hi) * 0.5;
+            let k = (rnd() * 3.0) as usize % 3;
+            p[k] = if rnd() < 0.5 {
+                lo[k] - gap
+            } else {
+                hi[k] + gap
+            };
+            let exact2 = {
+                let e = (lo - p).sup(&(p - hi)).sup(&V3::zeros());
+                e.norm_squared()
+            };
+            let r = Rounded::new(&lo, &hi);
+            let mut w = Wide {
+                min: [[f32::INFINITY; 4]; 3],
+                max: [[f32::NEG_INFINITY; 4]; 3],
+                node: [EMPTY; 4],
+                wide: [EMPTY; 4],
+                disk: Disk4::NONE,
+            };
+            for j in 0..3 {
+                w.min[j][1] = r.lo[j];
+                w.max[j][1] = r.hi[j];
+            }
+            let g = w.gaps2(&Rounded::new(&p, &p));
+            assert!(lower(g[1]) <= exact2, "{lo:?} {hi:?} {p:?}");
+            assert!(g[0].is_infinite() && g[2].is_infinite() && g[3].is_infinite());
+        }
+    }
+
+    /// Random triangles at scales 1 mm … 1 km and offsets up to 1000 × their size from the
+    /// origin, and points and segments near them (nearly touching, nearly parallel, far):
+    /// the float32 plane-and-disk bounds must stay at or below the exact distances, and
+    /// without the round-off allowance they would not (the test sees the rounding).
+    #[test]
+    fn float32_disk_bounds_are_lower_bounds() {
+        use crate::closest::{point_triangle, segment_triangle};
+        let mut seed = 99u64;
+        let mut rnd = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut over_without_pad = 0;
+        for case in 0..20000 {
+            let size = [1e-3, 1.0, 1e3][case % 3];
+            let off = V3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5)
+                * size
+                * [0.0, 10.0, 1000.0][case / 3 % 3];
+            let v: Vec<V3> = (0..3)
+                .map(|_| off + V3::new(rnd(), rnd(), rnd()) * size)
+                .collect();
+            let n = (v[1] - v[0]).cross(&(v[2] - v[0])).normalize();
+            let c = (v[0] + v[1] + v[2]) / 3.0;
+            let r = v.iter().map(|x| (x - c).norm()).fold(0.0, f64::max) * (1.0 + 1e-12);
+            let mut disk = Disk4::NONE;
+            let x = n.dot(&c);
+            disk.set(0, &n, x, x, &c, r);
+            // a point near the triangle: on it, lifted by 1e-12 … 1 of its size
+            let (w0, w1) = (rnd(), rnd());
+            let (w0, w1) = if w0 + w1 > 1.0 {
+                (1.0 - w0, 1.0 - w1)
+            } else {
+                (w0, w1)
+            };
+            let on = v[0] + (v[1] - v[0]) * w0 + (v[2] - v[0]) * w1;
+            let lift = size * 10f64.powf(-12.0 * rnd());
+            let p = on
+                + n * lift * if rnd() < 0.5 { 1.0 } else { -1.0 }
+                + V3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5) * size * 0.01 * rnd().powi(4);
+            let b = p
+                + (V3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5) * 0.2 + n * 0.01 * (rnd() - 0.5))
+                    * size;
+            let scale = v
+                .iter()
+                .chain([&p, &b])
+                .fold(0.0, |m: f64, x| m.max(x.amax()));
+            let exact_p = (point_triangle(&p, &v[0], &v[1], &v[2]).0 - p).norm_squared();
+            let (_, sx, sy) = segment_triangle(&p, &b, &v[0], &v[1], &v[2]);
+            let exact_s = (sx - sy).norm_squared();
+            let (pf, bf) = (f32x3(&p), f32x3(&b));
+            let gp = disk.point_bounds2(&pf, pad(scale))[0];
+            let gs = disk.segment_bounds2(&pf, &bf, pad(scale))[0];
+            assert!(
+                lower(gp) <= exact_p,
+                "point, case {case}: {} > {exact_p}",
+                lower(gp)
+            );
+            assert!(
+                lower(gs) <= exact_s,
+                "segment, case {case}: {} > {exact_s}",
+                lower(gs)
+            );
+            let gp0 = disk.point_bounds2(&pf, 0.0)[0];
+            let gs0 = disk.segment_bounds2(&pf, &bf, 0.0)[0];
+            if lower(gp0) > exact_p || lower(gs0) > exact_s {
+                over_without_pad += 1;
+            }
+            // the bound is not void: where the nearest point is inside the face, it is the
+            // plane distance less the allowance
+            let hp = n.dot(&(p - c)).abs();
+            if (exact_p.sqrt() - hp).abs() < 1e-9 * size {
+                let h = (hp - 2.0 * pad(scale) as f64).max(0.0);
+                assert!(gp as f64 >= 0.98 * h * h, "case {case}");
+            }
+        }
+        assert!(over_without_pad > 100, "{over_without_pad}");
+    }
+}
