@@ -205,20 +205,37 @@ def lowest_frequencies(cable: Cable) -> dict[str, float]:
     }
 
 
+def bending_damping_of_mode1(scene: Scene, cable: Cable) -> tuple[float, float]:
+    """ω₁ of the mounted cable at t = 0 and its Rayleigh damping ratio per second of bending
+    retardation time: ζ₁ for τ = 1 s on EI₁ and EI₂ only (torsion, extension, shear undamped).
+    ζ₁ is linear in τ, so τ = ζ / (this value) damps mode 1 at ζ."""
+    core, _ = _equilibrium(scene, cable)
+    try:
+        found = core.modes(1, shear_tau=[0.0, 0.0, 0.0], bend_tau=[1.0, 1.0, 0.0])
+    except ValueError as err:
+        raise SceneError(f"cable '{cable.name}': {err}") from None
+    return float(found["omega"][0]), float(found["damping_ratio"][0])
+
+
 def retardation_times(
     scene: Scene, cable: Cable, omega1: float | None = None
 ) -> tuple[list[float], list[float], dict]:
     """Kelvin–Voigt retardation times (GA₁, GA₂, EA) and (EI₁, EI₂, GJ) of a cable, with how
     they were set.
 
-    Default (``ratio`` ζ, 1 unless given): bending gets τ = 2ζ/ω₁ from the first natural mode
-    of the mounted cable (ζ = 1: critical); extension, torsion and shear get a material-like
-    damping: the loss factor η = ``DEFAULT_LOSS_FACTOR`` on their own lowest mode,
-    τ_i = min(τ, η/ω_i) (``lowest_frequencies``). One τ = 2ζ/ω₁ on all modes would damp
-    extension, torsion and shear hundreds of times over-critically and let the viscous forces
-    dominate the section loads (docs/dynamics.md). A given ``retardation_time`` applies to all
-    modes. Per-mode values override either. ``omega1``: the first natural frequency when known
-    (a harness: the whole tree's), else computed."""
+    Default (``ratio`` ζ, 1 unless given): bending gets the τ that gives the first natural
+    mode of the mounted cable the damping ratio ζ (ζ = 1: critical), τ = ζ / ζ₁(τ = 1 s) with
+    ζ₁ the mode's Rayleigh damping ratio φᵀC_bφ / (2ω φᵀMφ) (``bending_damping_of_mode1``);
+    τ = 2ζ/ω₁ only where the mode's bending stiffness is its whole stiffness: where the
+    loads' geometric stiffness lowers ω₁ (a slack, curved or compressed span) it would give
+    several times ζ. Harnesses keep τ = 2ζ/ω₁ of the whole tree's ω₁ (no harness damping
+    ratios yet). Extension, torsion and shear get a material-like damping: the loss factor
+    η = ``DEFAULT_LOSS_FACTOR`` on their own lowest mode, τ_i = min(τ, η/ω_i)
+    (``lowest_frequencies``). One τ on all modes would damp extension, torsion and shear
+    hundreds of times over-critically and let the viscous forces dominate the section loads
+    (docs/dynamics.md). A given ``retardation_time`` applies to all modes. Per-mode values
+    override either. ``omega1``: the first natural frequency when known (a harness: the whole
+    tree's), else computed."""
     from cablelife.scene import DEFAULT_DAMPING_RATIO
 
     d = cable.damping
@@ -229,9 +246,13 @@ def retardation_times(
         own = {"extension": tau, "torsion": tau, "shear": tau}
     else:
         zeta = d.ratio if d.ratio is not None else DEFAULT_DAMPING_RATIO
+        per_tau = None
         if omega1 is None:
-            omega1 = float(cable_modes(scene, cable, 1).omega[0])
-        tau = 2 * zeta / omega1 if omega1 > 0 else 0.0
+            omega1, per_tau = bending_damping_of_mode1(scene, cable)
+        if per_tau is not None and per_tau > 0:
+            tau = zeta / per_tau  # mode 1's Rayleigh damping ratio from bending is ζ exactly
+        else:  # a harness (its modes carry no damping ratios yet): τ = 2ζ/ω₁
+            tau = 2 * zeta / omega1 if omega1 > 0 else 0.0
         info.update(source="ratio", ratio=zeta, omega1=omega1)
         own = {k: min(tau, DEFAULT_LOSS_FACTOR / w) for k, w in lowest_frequencies(cable).items()}
     info["tau"] = tau
