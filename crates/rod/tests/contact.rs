@@ -436,6 +436,14 @@ fn friction_holds_on_an_incline_below_the_friction_angle_and_slides_above() {
 /// capsules never go through the plane, and it comes to rest on it (frictionless: the
 /// horizontal momentum of the tilted impact stays; with friction it is stopped too).
 fn drop(r: f64, mu: f64) {
+    if let Err((k, e)) = drop_with(r, mu, false) {
+        panic!("r = {r}: step {k}: {e}");
+    }
+}
+
+/// The drop of `drop`; a solver error is returned with its step (the energy bounds are asserted
+/// on every step accepted before it).
+fn drop_with(r: f64, mu: f64, line_search: bool) -> Result<(), (usize, SolveError)> {
     let l = 0.4;
     let n = 40;
     let rho = 1500.0;
@@ -460,6 +468,7 @@ fn drop(r: f64, mu: f64) {
     let opts = DynamicOptions {
         tau_bend: Vector3::new(1e-3, 1e-3, 1e-3),
         tau_shear: Vector3::new(1e-4, 1e-4, 1e-4),
+        contact_line_search: line_search,
         ..Default::default()
     };
     let mut dy = Dynamics::new(&rod, &st, &[], opts);
@@ -476,9 +485,8 @@ fn drop(r: f64, mu: f64) {
     let h = 1e-3;
     let mut min_gap = f64::INFINITY;
     for k in 0..3000 {
-        if let Err(e) = dy.advance(&rod, &mut st, h, &[], &[], 6) {
-            panic!("r = {r}: step {k}: {e}");
-        }
+        dy.advance(&rod, &mut st, h, &[], &[], 6)
+            .map_err(|e| (k, e))?;
         let e = total(&dy);
         let en = dy.energies;
         // Never above the start; per step, within the step guard's bound on the growth of the
@@ -530,6 +538,7 @@ fn drop(r: f64, mu: f64) {
     assert!(st.x.iter().all(|x| (x.z - r).abs() < 0.01 * r));
     let ct = dy.contact.as_ref().unwrap();
     assert!(ct.node_state.iter().all(|&s| s == STICK));
+    Ok(())
 }
 
 #[test]
@@ -538,6 +547,19 @@ fn dropped_cable_comes_to_rest_without_gaining_energy_or_tunnelling() {
         drop(r, 0.0);
     }
     drop(0.003, 0.3);
+}
+
+/// Reproducer of the open defect (docs/contact.md, "Open: the impact energy at the guard's
+/// deepest sub-step"): with the line search (`contact_line_search`) the r = 1 mm drop gains
+/// 5.7 % of the energy in motion at step 70, in a sub-step of h/64 that the step guard accepts
+/// unchecked. Fails today; run with `--ignored`. It must pass (or stop with a named error)
+/// before the guard or the contact Newton path change.
+#[test]
+#[ignore = "open defect: the guard accepts its deepest sub-step unchecked (docs/contact.md)"]
+fn impact_never_gains_energy_at_the_deepest_sub_step() {
+    if let Err((k, e)) = drop_with(0.001, 0.0, true) {
+        panic!("step {k}: {e}");
+    }
 }
 
 /// The assembled Jacobian with contact and friction equals the finite-difference derivative
