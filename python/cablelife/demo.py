@@ -121,21 +121,14 @@ def run_demo(
     # the report computes the motion volumes it draws: not twice
     volume = study.volume.model_copy(update={"voxel": 0.0}) if report else study.volume
 
-    prepared: dict = {}  # run label -> (ReportRun, its report.html.prepare_run)
-
     def one(v: Variant) -> dict:
         cb = None if on_stage is None else (lambda stage, _n=v.name: on_stage(_n, stage))
         row = run_variant(v, out, study.lda, volume, 1, on_stage=cb)
-        if report and row["status"] == "ok" and not interrupt.stop_requested():
-            # the report's share of this run, overlapped with the other runs
-            prepared[v.name] = _prepare(out, v, report_frames)
         if on_stage is not None:
             on_stage(v.name, row["status"])
         return row
 
     with ThreadPoolExecutor(max_workers=n) as pool:
-        if report:  # the report's imports and plotly.js, while the runs start
-            warm = pool.submit(_warm_up)
         futures = [pool.submit(one, v) for v in runs]
 
         def stop() -> None:  # Ctrl-C: the runs keep what they computed (partial result.h5)
@@ -143,7 +136,7 @@ def run_demo(
             for f in futures:
                 f.cancel()
 
-        if interrupt.wait_stopping(futures + ([warm] if report else []), stop, stop_on_error=False):
+        if interrupt.wait_stopping(futures, stop, stop_on_error=False):
             interrupt.reset()  # every run has ended
             raise KeyboardInterrupt
         rows = {v.name: f.result() for v, f in zip(runs, futures, strict=True)}
@@ -163,22 +156,22 @@ def run_demo(
 
     dynamic = ranking("dynamic")
     qs = ranking("quasistatic") if quasistatic else None
-    clearances = _clearances(out, runs, {k: r.result for k, (r, _) in prepared.items()})
+    clearances = _clearances(out, runs)
     path = None
     if report:
         if on_stage is not None:
             on_stage("report", "report")
         t1 = time.perf_counter()
         step = None if on_stage is None else (lambda what: on_stage("report", what))
-        path = _write_report(out, runs, report_frames, step, prepared)
+        path = _write_report(out, runs, report_frames, step)
         times["report"] = time.perf_counter() - t1
     times["total"] = time.perf_counter() - t0
     return DemoOutcome(out, rows, dynamic, qs, path, times, clearances)
 
 
-def _clearances(out: Path, runs: list[Variant], loaded: dict | None = None) -> dict[str, dict]:
+def _clearances(out: Path, runs: list[Variant]) -> dict[str, dict]:
     """The clearance summary of every run's cable (dynamic runs first), read from its result
-    file (or ``loaded``: run name → its result); runs without geometry are left out."""
+    file; runs without geometry are left out."""
     from cablelife.results import load_result
     from cablelife.surroundings.summary import clearance_summary
 
@@ -187,9 +180,7 @@ def _clearances(out: Path, runs: list[Variant], loaded: dict | None = None) -> d
         for v in runs:
             if v.mode != mode:
                 continue
-            res = (loaded or {}).get(v.name)
-            if res is None:
-                res = load_result(variant_dir(out, v.name) / "result.h5")
+            res = load_result(variant_dir(out, v.name) / "result.h5")
             for name, c in res.cables.items():
                 if c.surroundings is not None:
                     label = v.name if len(res.cables) == 1 else f"{v.name}: {name}"
@@ -203,45 +194,17 @@ def least_clearance(summary: dict) -> tuple[str, dict] | None:
     return min(near, key=lambda bv: bv[1]["min"]) if near else None
 
 
-def _report_run(out: Path, v: Variant):
+def _write_report(out: Path, runs: list[Variant], frames: int, on_step=None) -> Path:
     from cablelife.lda.io import load_damage
-    from cablelife.report.html import ReportRun
+    from cablelife.report.html import ReportRun, write_report
     from cablelife.results import load_result
 
-    d = variant_dir(out, v.name)
-    return ReportRun(v.name, load_result(d / "result.h5"), load_damage(d / "damage.h5"))
-
-
-def _prepare(out: Path, v: Variant, frames: int) -> tuple:
-    """A finished run's ReportRun and the report's work on it alone (report.html.prepare_run):
-    done in the run's worker while the other runs go on."""
-    from cablelife.report.html import prepare_run
-
-    r = _report_run(out, v)
-    return r, prepare_run(r, frames=frames)
-
-
-def _warm_up() -> None:
-    """Imports the report needs and packs plotly.js (cached) while the runs start."""
-    import plotly.graph_objects  # noqa: F401
-    import plotly.subplots  # noqa: F401
-
-    import cablelife.plots.figure  # noqa: F401  (matplotlib)
-    import cablelife.report.html  # noqa: F401
-    import cablelife.report.mpl_plotly  # noqa: F401
-    from cablelife.report.page import plotly_js_packed
-
-    plotly_js_packed()
-
-
-def _write_report(
-    out: Path, runs: list[Variant], frames: int, on_step=None, prepared: dict | None = None
-) -> Path:
-    from cablelife.report.html import write_report
-
-    prepared = prepared or {}
-    report_runs = [prepared[v.name][0] if v.name in prepared else _report_run(out, v) for v in runs]
-    ready = {k: p for k, (_, p) in prepared.items()}
-    return write_report(
-        out / "report.html", report_runs, frames=frames, on_step=on_step, prepared=ready
-    )
+    report_runs = [
+        ReportRun(
+            v.name,
+            load_result(variant_dir(out, v.name) / "result.h5"),
+            load_damage(variant_dir(out, v.name) / "damage.h5"),
+        )
+        for v in runs
+    ]
+    return write_report(out / "report.html", report_runs, frames=frames, on_step=on_step)

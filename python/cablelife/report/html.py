@@ -604,26 +604,16 @@ def run_view(run: ReportRun, name: str, volume, color_by: str, frames: int) -> d
     return view
 
 
-def variant_views(
-    runs: list[ReportRun], volumes: dict, color_by: str, frames: int, ready: dict | None = None
-) -> dict:
+def variant_views(runs: list[ReportRun], volumes: dict, color_by: str, frames: int) -> dict:
     """One 3D view per variant of its dynamic and quasistatic runs (single-cable runs with the
     same saved times: :func:`cablelife.report.scene3d.merge_runs`), as each WebGL scene costs
-    CPU to draw without a GPU: (run label, cable) → the view (in the dynamic run's section)
-    or, in the quasistatic run's, (the note that replaces it, where its views are).
-    ``ready``: run label → its :class:`Prepared` (views not built again). (One view of all
-    four demo runs, :func:`cablelife.report.scene3d.merge_views`, saved 0.45 s of chromium's
-    CPU but drew 0.15 s slower: every run's tubes and frames are rebuilt in one go.)"""
-
-    def view_of(r: ReportRun, name: str) -> dict:
-        p = (ready or {}).get(r.label)
-        got = None if p is None else p.views.pop((color_by, frames, name), None)
-        return got or run_view(r, name, volumes.get(r.label), color_by, frames)
-
-    single = [r for r in runs if len(r.result.cables) == 1]
+    about a second to draw without a GPU whatever it shows: (run label, cable) → the view (in
+    the dynamic run's section) or, in the quasistatic run's, (the note that replaces it, where
+    its views are)."""
     by_variant: dict[str, dict[str, ReportRun]] = {}
-    for r in single:
-        by_variant.setdefault(variant_of(r.label, r.result.mode), {})[r.result.mode] = r
+    for r in runs:
+        if len(r.result.cables) == 1:
+            by_variant.setdefault(variant_of(r.label, r.result.mode), {})[r.result.mode] = r
     out: dict = {}
     for pair in by_variant.values():
         d, q = pair.get("dynamic"), pair.get("quasistatic")
@@ -632,7 +622,7 @@ def variant_views(
         (name,) = d.result.cables
         if list(q.result.cables) != [name]:
             continue
-        views = [view_of(r, name) for r in (d, q)]
+        views = [run_view(r, name, volumes.get(r.label), color_by, frames) for r in (d, q)]
         merged = merge_runs(*views, d.label, q.label)
         if merged is not None:
             out[(d.label, name)] = merged
@@ -712,47 +702,6 @@ th,td{border:1px solid #ccd;padding:.25em .6em;text-align:left}th{background:#ee
 """
 
 
-def _volume(r: ReportRun, voxel: float):
-    """The motion volume of a run as the report draws it (at most VOLUME_STEPS steps)."""
-    from cablelife.volume import motion_volume
-
-    n = next(iter(r.result.cables.values())).n_steps
-    every = slice(None, None, max(1, -(-n // VOLUME_STEPS)))
-    return motion_volume(r.result, voxel, steps=every)
-
-
-@dataclass
-class Prepared:
-    """What the report computes from one run alone (:func:`prepare_run`)."""
-
-    voxel: float | None
-    volume: object | None
-    summaries: dict  # cable name -> cable_summary
-    frequencies: dict  # _scene_key -> frequency_data
-    views: dict  # (color_by, frames, cable name) -> run_view (single-cable runs)
-
-
-def prepare_run(
-    run: ReportRun, voxel: float | None = 0.004, color_by: str = "bending", frames: int = FRAMES
-) -> Prepared:
-    """The report's work on one run that needs no other run (its motion volume, cable
-    summaries, natural frequencies and excitation, its 3D view), for
-    ``build_report(prepared=…)`` with the same settings: a caller running several runs (the
-    demo) computes it in its workers as each run ends."""
-    volume = None if voxel is None else _volume(run, voxel)
-    views = {}
-    if len(run.result.cables) == 1:
-        (name,) = run.result.cables
-        views[(color_by, frames, name)] = run_view(run, name, volume, color_by, frames)
-    return Prepared(
-        voxel,
-        volume,
-        {name: cable_summary(c, strains=False) for name, c in run.result.cables.items()},
-        {_scene_key(run.result, n): frequency_data(run.result, n) for n in run.result.cables},
-        views,
-    )
-
-
 def build_report(
     runs: list[ReportRun],
     *,
@@ -762,12 +711,11 @@ def build_report(
     bend_factor: float = DEFAULT_FACTOR,
     title: str = "cablelife report",
     on_step: Callable[[str], None] | None = None,
-    prepared: dict[str, Prepared] | None = None,
 ) -> str:
     """The report page as an HTML string. ``voxel`` (m) for the motion volumes; None skips
-    them. ``on_step(what)`` follows the progress (one call per section). ``prepared``: run
-    label → its :func:`prepare_run` (with the same ``voxel``), not computed again."""
+    them. ``on_step(what)`` follows the progress (one call per section)."""
     from cablelife import __version__
+    from cablelife.volume import motion_volume
 
     if not runs:
         raise ValueError("runs: give at least one result")
@@ -775,29 +723,27 @@ def build_report(
     if len(set(labels)) != len(labels):
         raise ValueError(f"run labels must be unique, got {labels}")
     step = on_step or (lambda what: None)
-    ready = {k: p for k, p in (prepared or {}).items() if p.voxel == voxel}
     # In the background (the modal solves, signal synthesis and volume kernels release the
     # GIL): the natural frequencies and excitation per scene, the motion volumes per run.
     pool = ThreadPoolExecutor(max_workers=max(1, min(4, os.cpu_count() or 1)))
-    pending = {}
+
+    def volume(r):
+        n = next(iter(r.result.cables.values())).n_steps
+        every = slice(None, None, max(1, -(-n // VOLUME_STEPS)))
+        return motion_volume(r.result, voxel, steps=every)
+
+    pending = {r.label: pool.submit(volume, r) for r in runs} if voxel is not None else {}
     cache: dict = {}
     for r in runs:
-        p = ready.get(r.label)
-        if voxel is not None:
-            pending[r.label] = p.volume if p is not None else pool.submit(_volume, r, voxel)
         for name, c in r.result.cables.items():
-            key = _scene_key(r.result, name)
-            if p is not None:
-                cache[("summary", id(c))] = p.summaries[name]
-                cache.setdefault(key, p.frequencies[key])
-                continue
             cache[("summary", id(c))] = pool.submit(cable_summary, c, strains=False)
+            key = _scene_key(r.result, name)
             if key not in cache:
                 cache[key] = pool.submit(frequency_data, r.result, name)
     volumes = {}
     for label, f in pending.items():
         step(f"motion volume of {label}")
-        volumes[label] = f.result() if hasattr(f, "result") else f
+        volumes[label] = f.result()
     page = Page()
     stamp = _dt.datetime.now().strftime("%Y-%m-%d %H:%M")
     page.h(1, title)
@@ -811,7 +757,7 @@ def build_report(
         _comparison(page, runs, volumes, voxel or 0.004, bend_factor, cache)
     if len(runs) > 1:
         step("3D views")
-        cache["views"] = variant_views(runs, volumes, color_by, frames, ready)
+        cache["views"] = variant_views(runs, volumes, color_by, frames)
     for k, run in enumerate(runs):
         step(f"run {run.label}")
         _run_section(page, k, run, volumes, color_by, frames, bend_factor, cache, len(runs) == 1)
