@@ -6,12 +6,21 @@
    ``--duration`` s each, dynamic, default LDA, 4 mm motion volume) on a local cluster of 1 and
    of 2 worker processes: wall time (cluster start included), per-variant time and the speed-up.
 
+3. ``--process PY [PY …]``: ``PY -m cablelife demo -o DIR`` as a whole process (imports
+   included), the interpreters (e.g. the venvs of an older checkout and of this one) taking
+   turns ``--repeat`` times: median wall and CPU time (the process and its children, os.wait4)
+   of each, with the load average (on a shared machine compare them side by side).
+
     python benchmarks/bench_demo.py [--duration 1.0] [--skip-demo] [--skip-study]
+    python benchmarks/bench_demo.py --process OLD/bin/python NEW/bin/python --repeat 3
 """
 
 from __future__ import annotations
 
 import argparse
+import os
+import statistics
+import subprocess
 import tempfile
 import time
 import warnings
@@ -79,12 +88,48 @@ def bench_study(duration: float) -> None:
     print(f"speed-up 2 vs 1 worker: {walls[1] / walls[2]:.2f}")
 
 
+def bench_process(pythons: list[str], repeat: int) -> None:
+    walls: dict[str, list[float]] = {p: [] for p in pythons}
+    cpus: dict[str, list[float]] = {p: [] for p in pythons}
+    loads = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for k in range(repeat):
+            for i, py in enumerate(pythons):
+                out = Path(tmp) / f"demo-{i}-{k}"
+                loads.append(os.getloadavg()[0])
+                t0 = time.perf_counter()
+                proc = subprocess.Popen(
+                    [py, "-m", "cablelife", "demo", "-o", str(out)],
+                    stdout=subprocess.DEVNULL,
+                    stderr=subprocess.DEVNULL,
+                    cwd=tmp,
+                )
+                _, status, ru = os.wait4(proc.pid, 0)
+                walls[py].append(time.perf_counter() - t0)
+                cpus[py].append(ru.ru_utime + ru.ru_stime)
+                if os.waitstatus_to_exitcode(status) != 0:
+                    raise SystemExit(f"{py} -m cablelife demo failed")
+    med = statistics.median
+    for py in pythons:
+        w, c = walls[py], cpus[py]
+        print(
+            f"{py}: demo as a process: wall median {med(w):.2f} s (min {min(w):.2f}, max "
+            f"{max(w):.2f}), CPU median {med(c):.2f} s (min {min(c):.2f}), n = {repeat}"
+        )
+    print(f"load average during the runs: {min(loads):.1f} – {max(loads):.1f}")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--duration", type=float, default=1.0, help="simulated s per study variant")
     ap.add_argument("--skip-demo", action="store_true")
     ap.add_argument("--skip-study", action="store_true")
+    ap.add_argument("--process", nargs="+", metavar="PYTHON", help="whole-process demo timing")
+    ap.add_argument("--repeat", type=int, default=3)
     args = ap.parse_args()
+    if args.process:
+        bench_process(args.process, args.repeat)
+        return
     if not args.skip_demo:
         bench_demo()
     if not args.skip_study:

@@ -142,3 +142,34 @@ def copy_of(view: dict) -> dict:
     import copy
 
     return copy.deepcopy(view)
+
+
+def test_one_3d_view_for_every_run():
+    """merge_views of three runs: one scene, a drop-down entry per run and view showing only
+    that run's traces, the frames moving every run's traces (indices shifted per run), the
+    first run shown, the title naming every run; runs saved at other times are not merged."""
+    from cablelife.report.scene3d import merge_views
+
+    views = [_views_of(3, 0.01), _views_of(3, 0.02), _views_of(3, 0.03)]
+    sizes = [len(v["data"]) for v in views]
+    starts = [0, sizes[0], sizes[0] + sizes[1]]
+    frame_traces = [v["frames"][1]["traces"] for v in views]
+    labels = ["A-dynamic", "B-dynamic", "A-quasistatic"]
+    m = merge_views(list(zip(labels, map(copy_of, views), strict=True)))
+    assert len(m["data"]) == sum(sizes)
+    (menu,) = [u for u in m["layout"]["updatemenus"] if u.get("name") == "views"]
+    assert len(menu["buttons"]) == 3 * 2  # the quantity and "extra view" of each run
+    for bt in menu["buttons"]:
+        vis = bt["args"][0]["visible"]
+        assert len(vis) == sum(sizes)
+        k = labels.index(bt["label"].split(": ")[0])
+        mine = vis[starts[k] : starts[k] + sizes[k]]
+        assert any(mine) and sum(vis) == sum(mine)
+    assert m["data"][0].get("visible") is not False
+    assert all(t.get("visible") is False for t in m["data"][sizes[0] :])
+    f = m["frames"][1]
+    assert f["traces"] == [i + s for ft, s in zip(frame_traces, starts, strict=True) for i in ft]
+    assert len(f["data"]) == len(f["traces"])
+    assert all(x in m["layout"]["title"]["text"] for x in labels)
+    other = [("a", _views_of(3, 0.01)), ("b", _views_of(3, 0.02, times=0.3))]
+    assert merge_views(other) is None

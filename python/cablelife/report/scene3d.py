@@ -563,29 +563,40 @@ def _view_buttons(fig: dict) -> list[dict]:
 
 def merge_runs(a: dict, b: dict, label_a: str, label_b: str) -> dict | None:
     """One 3D view of two runs of a cable (e.g. a variant's dynamic and quasistatic runs):
-    the views of both (:func:`cable_figure` with its :func:`with_view` views) in one WebGL
-    scene, chosen from a drop-down ("<run>: <view>"), the slider moving both; ``a`` starts
+    :func:`merge_views` of the two."""
+    return merge_views([(label_a, a), (label_b, b)])
+
+
+def merge_views(views: list[tuple[str, dict]]) -> dict | None:
+    """One 3D view of several runs of a cable (the variants' dynamic and quasistatic runs):
+    the views of all (:func:`cable_figure` with its :func:`with_view` views) in one WebGL
+    scene, chosen from a drop-down ("<run>: <view>"), the slider moving all; the first starts
     shown. None when their animation frames differ (other saved times): they stay apart."""
-    fa, fb = a.get("frames", []), b.get("frames", [])
-    if [f["name"] for f in fa] != [f["name"] for f in fb]:
+    if len(views) < 2:
         return None
-    na, nb = len(a["data"]), len(b["data"])
-    buttons = [
-        {**bt, "label": f"{label_a}: {bt['label']}",
-         "args": [{"visible": [*bt["args"][0]["visible"], *[False] * nb]}]}
-        for bt in _view_buttons(a)
-    ] + [
-        {**bt, "label": f"{label_b}: {bt['label']}",
-         "args": [{"visible": [*[False] * na, *bt["args"][0]["visible"]]}]}
-        for bt in _view_buttons(b)
-    ]  # fmt: skip
-    for t in b["data"]:
-        t["visible"] = False
-    out = {**a, "data": [*a["data"], *b["data"]]}
-    out["frames"] = []
-    for x, y in zip(fa, fb, strict=True):
-        traces = [*x["traces"], *(i + na for i in y["traces"])]
-        out["frames"].append({**x, "data": [*x["data"], *y["data"]], "traces": traces})
+    names = [[f["name"] for f in v.get("frames", [])] for _, v in views]
+    if any(n != names[0] for n in names[1:]):
+        return None
+    sizes = [len(v["data"]) for _, v in views]
+    total, starts = sum(sizes), np.cumsum([0, *sizes[:-1]]).tolist()
+    buttons = []
+    for (label, v), n0, n in zip(views, starts, sizes, strict=True):
+        for bt in _view_buttons(v):
+            vis = [*[False] * n0, *bt["args"][0]["visible"], *[False] * (total - n0 - n)]
+            buttons.append({**bt, "label": f"{label}: {bt['label']}", "args": [{"visible": vis}]})
+    for _, v in views[1:]:
+        for t in v["data"]:
+            t["visible"] = False
+    a = views[0][1]
+    out = {**a, "data": [t for _, v in views for t in v["data"]]}
+    out["frames"] = [
+        {
+            **fs[0],
+            "data": [t for f in fs for t in f["data"]],
+            "traces": [i + n0 for f, n0 in zip(fs, starts, strict=True) for i in f["traces"]],
+        }
+        for fs in zip(*(v.get("frames", []) for _, v in views), strict=True)
+    ]
     layout = out["layout"] = {**a["layout"]}
     menus = [m for m in layout.get("updatemenus", []) if m.get("name") != "views"]
     menus.append(
@@ -604,9 +615,12 @@ def merge_runs(a: dict, b: dict, label_a: str, label_b: str) -> dict | None:
         }
     )
     layout["updatemenus"] = menus
-    sb = b["layout"]["scene"]
-    corners = np.array([[sb[f"{x}axis"]["range"][i] for x in "xyz"] for i in (0, 1)])
-    extend_range(out, corners)
+    for _, v in views[1:]:
+        sv = v["layout"]["scene"]
+        corners = np.array([[sv[f"{x}axis"]["range"][i] for x in "xyz"] for i in (0, 1)])
+        extend_range(out, corners)
     name = a["data"][0].get("name", "cable")
-    layout["title"] = {"text": f"{name}: runs {label_a} and {label_b} (choose run and view)"}
+    labels = [lab for lab, _ in views]
+    runs = " and ".join([", ".join(labels[:-1]), labels[-1]])
+    layout["title"] = {"text": f"{name}: runs {runs} (choose run and view)"}
     return out
