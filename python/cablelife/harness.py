@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from cablelife.results import CableResult, ClipReaction, JunctionResult
+from cablelife.results import CONTACT_KEYS, CableResult, ClipReaction, JunctionResult
 
 if TYPE_CHECKING:
     from cablelife.scene import Cable, Junction, Scene
@@ -181,10 +181,12 @@ def run_harness(scene: Scene, times: np.ndarray, mode: str, progress, stop):
             f"mode = {mode!r}: {mode} analysis of harnesses (scenes with [[junctions]]) is not "
             "supported yet; allowed for harnesses: 'static', 'quasistatic', 'dynamic'"
         )
-    if scene.contact is not None:
+    contact = scene.contact is not None and scene.contact.enabled
+    if contact:
         raise SceneError(
             "contact with the geometry is not supported yet for harnesses (scenes with "
-            "[[junctions]]); remove [contact] or the junctions"
+            "[[junctions]]); set contact.enabled = false (clearance is computed without it) "
+            "or remove the junctions"
         )
     if mode == "dynamic":
         held = [j.name for j in scene.junctions if j.clip is not None]
@@ -289,6 +291,8 @@ def run_harness(scene: Scene, times: np.ndarray, mode: str, progress, stop):
             **extra,
         )
         energies = {"elastic_energy": o["elastic_energy"]}
+        if "contact_gap" in o:
+            energies["contact_energy"] = o["contact_energy"]
         if mode == "dynamic":
             tau_shear, tau_bend, info = taus[k]
             solver.update(
@@ -315,6 +319,7 @@ def run_harness(scene: Scene, times: np.ndarray, mode: str, progress, stop):
             section=c.properties().as_attrs(),
             solver=solver,
             energies=energies,
+            contact={k: o[k] for k in CONTACT_KEYS if k in o},
         )
     junctions: dict[str, JunctionResult] = {}
     ends = core.ends

@@ -11,6 +11,7 @@ pub mod dynamics;
 #[cfg(test)]
 mod fd_check;
 pub mod harness;
+pub mod harness_contact;
 pub mod harness_dynamics;
 pub mod harness_modal;
 pub mod harness_solver;
