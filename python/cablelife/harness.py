@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from cablelife.results import CableResult, ClipReaction, JunctionResult
+from cablelife.results import CONTACT_KEYS, CableResult, ClipReaction, JunctionResult
 
 if TYPE_CHECKING:
     from cablelife.scene import Cable, Junction, Scene
@@ -230,10 +230,12 @@ def run_harness(scene: Scene, times: np.ndarray, mode: str, progress, stop):
             f"mode = {mode!r}: {mode} analysis of harnesses (scenes with [[junctions]]) is not "
             "supported yet; allowed for harnesses: 'static', 'quasistatic', 'dynamic'"
         )
-    if scene.contact is not None:
+    contact = scene.contact is not None and scene.contact.enabled
+    if contact:
         raise SceneError(
             "contact with the geometry is not supported yet for harnesses (scenes with "
-            "[[junctions]]); remove [contact] or the junctions"
+            "[[junctions]]); set contact.enabled = false (clearance is computed without it) "
+            "or remove the junctions"
         )
     cables, specs = harness_cables(scene)
     cores = [build_cable(scene, c) for c in cables]
@@ -330,6 +332,8 @@ def run_harness(scene: Scene, times: np.ndarray, mode: str, progress, stop):
             **extra,
         )
         energies = {"elastic_energy": o["elastic_energy"]}
+        if "contact_gap" in o:
+            energies["contact_energy"] = o["contact_energy"]
         if mode == "dynamic":
             tau_shear, tau_bend, info = taus[k]
             solver.update(
@@ -358,6 +362,7 @@ def run_harness(scene: Scene, times: np.ndarray, mode: str, progress, stop):
             section=c.properties().as_attrs(),
             solver=solver,
             energies=energies,
+            contact={k: o[k] for k in CONTACT_KEYS if k in o},
         )
     junctions: dict[str, JunctionResult] = {}
     ends = core.ends
