@@ -611,22 +611,14 @@ class Session:
                         f"{value!r}; give a number in m"
                     )
                 value = float(value)
-            self._push_undo()
-            old_doc = self.doc
-            import tomlkit
 
-            self.doc = tomlkit.parse(old_doc.as_string())
-            entry = self._toml_clip(cable, item) if item else self._toml_cable(cable)
-            entry[key] = value
-            if key == "type":
-                _type_needs(entry, value, spec)
-            try:
-                self._reload(cable)
-            except (SceneError, WorkbenchError):
-                self.doc = old_doc
-                self.undo_stack.pop()
-                self._reload(cable)
-                raise
+            def change(doc) -> None:
+                entry = self._toml_clip(cable, item) if item else self._toml_cable(cable)
+                entry[key] = value
+                if key == "type":
+                    _type_needs(entry, value, spec)
+
+            self._change_document(cable, change)
 
     def add_clip(self, cable: str, s, kind: str = "fixed", body: str = "world") -> str:
         """Adds a clip of type ``kind`` on ``body`` at arc length ``s`` of ``cable``, posed
@@ -720,8 +712,8 @@ class Session:
         self._push_undo()
         old_doc = self.doc
         self.doc = tomlkit.parse(old_doc.as_string())
-        change(self.doc)
         try:
+            change(self.doc)
             self._reload(cable)
         except (SceneError, WorkbenchError):
             self.doc = old_doc
