@@ -85,20 +85,21 @@ def test_set_damping_ratio_gives_the_logarithmic_decrement(scene_dict):
     d["simulation"].update(mode="dynamic", duration=1.2, time_step=0.001)
     scene = scene_from_dict(d)
     res = simulate(scene).cable
-    omega1 = res.solver["omega1"]
-    z = res.positions[:, -1, 2]
-    peaks = [
-        i
-        for i in range(1, z.size - 1)
-        if z[i] > z[i - 1] and z[i] >= z[i + 1] and res.time[i] > 0.05
-    ]
-    amps = z[peaks]
+    zeta, period = free_decay(res.time, res.positions[:, -1, 2], after=0.05)
+    assert zeta == pytest.approx(0.05, rel=0.1)
+    assert 2 * math.pi / res.solver["omega1"] == pytest.approx(period, rel=0.03)
+
+
+def free_decay(time, y, after: float) -> tuple[float, float]:
+    """Damping ratio (logarithmic decrement over the peaks of ``y`` after ``after`` s) and the
+    mean period of a free decay."""
+    peaks = [i for i in range(1, y.size - 1)
+             if y[i] > y[i - 1] and y[i] >= y[i + 1] and time[i] > after]  # fmt: skip
+    amps = y[peaks]
     n = len(amps) - 1
     assert n >= 3, "need several periods"
     delta = math.log(amps[0] / amps[n]) / n
-    zeta = delta / math.sqrt(4 * math.pi**2 + delta**2)
-    assert zeta == pytest.approx(0.05, rel=0.1)
-    assert 2 * math.pi / omega1 == pytest.approx(np.diff(res.time[peaks]).mean(), rel=0.03)
+    return delta / math.sqrt(4 * math.pi**2 + delta**2), float(np.diff(time[peaks]).mean())
 
 
 def test_slow_excitation_gives_the_quasistatic_result(scene_dict):
@@ -219,12 +220,6 @@ def test_set_damping_ratio_holds_on_a_sagging_hose(scene_dict):
         res = simulate(scene).cable
     chord = np.array([-0.2, 0.8, 0.0]) / np.hypot(0.2, 0.8)  # horizontal, across the chord
     y = (res.positions[:, 10] - res.positions[0, 10]) @ chord
-    peaks = [i for i in range(1, y.size - 1)
-             if y[i] > y[i - 1] and y[i] >= y[i + 1] and res.time[i] > 1.0]  # fmt: skip
-    amps = y[peaks]
-    n = len(amps) - 1
-    assert n >= 3, "need several periods"
-    delta = math.log(amps[0] / amps[n]) / n
-    zeta = delta / math.sqrt(4 * math.pi**2 + delta**2)
+    zeta, period = free_decay(res.time, y, after=1.0)
     assert zeta == pytest.approx(0.05, rel=0.1)
-    assert 2 * math.pi / info["omega1"] == pytest.approx(np.diff(res.time[peaks]).mean(), rel=0.03)
+    assert 2 * math.pi / info["omega1"] == pytest.approx(period, rel=0.03)
