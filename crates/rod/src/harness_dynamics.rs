@@ -144,7 +144,7 @@ impl HarnessDynamics {
     }
 
     fn cable_err(h: &Harness, c: usize, e: SolveError) -> HarnessError {
-        HarnessError(format!("cable '{}': {e}", h.names[c]))
+        crate::harness_solver::cable_error(h, c, e)
     }
 
     fn kink(h: &Harness, c: usize, k: KinkAt) -> HarnessError {
@@ -449,19 +449,8 @@ impl HarnessDynamics {
     /// Fails naming the cable and the clip if a sliding clip's guide reaches beyond a cable
     /// end at `st` (after a step).
     pub fn check_sliding(&mut self, h: &Harness, st: &HarnessState) -> Result<(), HarnessError> {
-        for (c, rod) in h.cables.iter().enumerate() {
-            if let Some(Err(k)) = self.cables[c]
-                .sliding
-                .as_mut()
-                .map(|s| s.check(rod, &st.cables[c]))
-            {
-                let e = SolveError::SlidOff {
-                    clip: rod.spec.clips[k].name.clone(),
-                };
-                return Err(Self::cable_err(h, c, e));
-            }
-        }
-        Ok(())
+        let guides = self.cables.iter_mut().map(|c| &mut c.sliding);
+        crate::harness_solver::check_guides(h, st, guides)
     }
 
     /// Force and moment (about the junction point, global) of the clip on each junction held

@@ -172,7 +172,7 @@ impl HarnessStatics {
     }
 
     fn cable_err(h: &Harness, c: usize, e: SolveError) -> HarnessError {
-        HarnessError(format!("cable '{}': {e}", h.names[c]))
+        cable_error(h, c, e)
     }
 
     /// Assembles every cable (internal forces, loads, coupling blocks of the held ends) and
@@ -749,18 +749,7 @@ impl HarnessStatics {
     /// Fails naming the cable and the clip if a sliding clip's guide reaches beyond a cable
     /// end at `st`.
     pub fn check_sliding(&mut self, h: &Harness, st: &HarnessState) -> Result<(), HarnessError> {
-        for (c, rod) in h.cables.iter().enumerate() {
-            if let Some(Err(k)) = self.sliding[c]
-                .as_mut()
-                .map(|s| s.check(rod, &st.cables[c]))
-            {
-                let e = SolveError::SlidOff {
-                    clip: rod.spec.clips[k].name.clone(),
-                };
-                return Err(Self::cable_err(h, c, e));
-            }
-        }
-        Ok(())
+        check_guides(h, st, &mut self.sliding)
     }
 
     fn solve_static_inner(
@@ -980,4 +969,27 @@ impl HarnessStatics {
             })
             .collect()
     }
+}
+
+/// `e` of cable `c` of `h`, naming the cable.
+pub(crate) fn cable_error(h: &Harness, c: usize, e: SolveError) -> HarnessError {
+    HarnessError(format!("cable '{}': {e}", h.names[c]))
+}
+
+/// Fails naming the cable and the clip if a sliding clip's guide (`guides`, one per cable)
+/// reaches beyond a cable end at `st`; static and dynamic harness runs.
+pub(crate) fn check_guides<'a>(
+    h: &Harness,
+    st: &HarnessState,
+    guides: impl IntoIterator<Item = &'a mut Option<SlidingClips>>,
+) -> Result<(), HarnessError> {
+    for ((c, rod), guide) in h.cables.iter().enumerate().zip(guides) {
+        if let Some(Err(k)) = guide.as_mut().map(|s| s.check(rod, &st.cables[c])) {
+            let e = SolveError::SlidOff {
+                clip: rod.spec.clips[k].name.clone(),
+            };
+            return Err(cable_error(h, c, e));
+        }
+    }
+    Ok(())
 }
