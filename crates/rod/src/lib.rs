@@ -12,7 +12,6 @@ mod escape;
 #[cfg(test)]
 mod fd_check;
 pub mod harness;
-pub mod harness_contact;
 pub mod harness_dynamics;
 mod harness_escape;
 pub mod harness_modal;
