@@ -13,9 +13,12 @@
 use crate::block_tridiag::Block;
 use crate::harness::{Harness, HarnessError, HarnessState};
 use crate::harness_solver::HarnessStatics;
-use crate::modal::{energy_shares, lowest_pairs, lumped_mass, ModalError, ModeKind, ShiftInvert};
+use crate::modal::{
+    dissipated_power, energy_shares, lowest_pairs, lumped_mass, modal_mass, HeldRate, ModalError,
+    ModeKind, ShiftInvert,
+};
 use crate::statics::NewtonOptions;
-use nalgebra::{Matrix6, Vector6};
+use nalgebra::{Matrix6, Vector3, Vector6};
 
 /// One natural mode of a harness, mass-normalised over the whole harness (φᵀ M φ = 1).
 #[derive(Clone, Debug)]
@@ -48,6 +51,19 @@ pub struct ModalSystem {
     xj: Vec<Vector6<f64>>,
 }
 
+/// The lumped mass of junction `j` on its unknowns: its own mass plus the node masses of the
+/// cable ends it holds (translations), its rotary inertia (body-frame rotations).
+fn junction_mass(h: &Harness, j: usize) -> Vector6<f64> {
+    let js = &h.junctions[j];
+    let ends: f64 = h.junction_ends[j]
+        .iter()
+        .map(|&e| h.cables[h.ends[e].cable].node_mass[h.ends[e].topo.node])
+        .sum();
+    let mt = js.mass + ends;
+    let r = js.rotary_inertia;
+    Vector6::new(mt, mt, mt, r.x, r.y, r.z)
+}
+
 /// The pencil (K, M) of a harness on its buffers.
 struct HarnessPencil<'a> {
     h: &'a Harness,
@@ -66,15 +82,7 @@ impl ModalSystem {
             m.extend(lumped_mass(rod));
         }
         offsets.push(m.len());
-        for (j, js) in h.junctions.iter().enumerate() {
-            let ends: f64 = h.junction_ends[j]
-                .iter()
-                .map(|&e| h.cables[h.ends[e].cable].node_mass[h.ends[e].topo.node])
-                .sum();
-            let mt = js.mass + ends;
-            let r = js.rotary_inertia;
-            m.push(Vector6::new(mt, mt, mt, r.x, r.y, r.z));
-        }
+        m.extend((0..h.junctions.len()).map(|j| junction_mass(h, j)));
         let xc = h
             .cables
             .iter()
@@ -389,6 +397,56 @@ pub fn harness_lowest_modes(
             }
         })
         .collect())
+}
+
+/// The modal damping ratio of a harness mode with the Kelvin–Voigt section law of each cable
+/// (`shear_tau[c]`, `bend_tau[c]` the retardation times of cable c's (GA₁, GA₂, EA) and
+/// (EI₁, EI₂, GJ)): the Rayleigh quotient ζ = φᵀCφ / (2ω φᵀMφ) over the whole tree, as
+/// `modal::damping_ratio` for one cable. The ends a junction holds move with it in the mode
+/// (node velocity = the junction's displacement, ghost angular velocity = its rotation in the
+/// end's frame), so the half cells and edges next to a junction dissipate as in a continuous
+/// cable; the junction itself carries no damping.
+pub fn harness_damping_ratio(
+    h: &Harness,
+    st: &HarnessState,
+    mode: &HarnessMode,
+    shear_tau: &[Vector3<f64>],
+    bend_tau: &[Vector3<f64>],
+) -> Result<f64, HarnessError> {
+    let nc = h.cables.len();
+    if shear_tau.len() != nc || bend_tau.len() != nc {
+        return Err(HarnessError(format!(
+            "damping ratios: {} shear and {} bending retardation time triples for {nc} cables",
+            shear_tau.len(),
+            bend_tau.len()
+        )));
+    }
+    let mut power = 0.0;
+    let mut mass = 0.0;
+    let mut held = Vec::new();
+    for (c, rod) in h.cables.iter().enumerate() {
+        held.clear();
+        held.extend(h.ends.iter().filter(|e| e.cable == c).map(|e| {
+            let x = mode.junctions[e.junction];
+            HeldRate {
+                node: e.topo.node,
+                velocity: x.fixed_rows::<3>(0).into_owned(),
+                ghost: e.topo.ghost,
+                angular_velocity: e.rel.transpose() * x.fixed_rows::<3>(3),
+            }
+        }));
+        let shape = &mode.cables[c];
+        power += dissipated_power(rod, &st.cables[c], shape, shear_tau[c], bend_tau[c], &held)
+            .map_err(|e| HarnessError(format!("damping ratio of cable '{}': {e}", h.names[c])))?;
+        mass += modal_mass(rod, shape);
+    }
+    for (j, x) in mode.junctions.iter().enumerate() {
+        mass += x.component_mul(x).dot(&junction_mass(h, j));
+    }
+    if !(mode.omega > 0.0 && mass > 0.0) {
+        return Ok(0.0);
+    }
+    Ok(power / (2.0 * mode.omega * mass))
 }
 
 #[cfg(test)]

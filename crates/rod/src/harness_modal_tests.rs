@@ -331,3 +331,90 @@ fn junction_mass_on_a_clamped_pair_matches_the_point_mass_beam() {
     }
     assert!(richardson < 0.05 * errors[2], "{richardson} vs {errors:?}");
 }
+
+/// One retardation time τ on every stiffness of an unstressed harness makes the damping
+/// matrix τK (the junction coupling is the cables' own end cells), so every mode is damped by
+/// exactly ζ = τω/2 — in an L-frame whose junction turns and translates in the modes and
+/// carries rotary inertia (mass only in M). Without the junction's motion in the held ends'
+/// velocities the cells next to it would dissipate as if clamped (checked below).
+#[test]
+fn harness_damping_ratio_is_tau_omega_over_two_with_one_retardation_time() {
+    // The bound is the mode shapes' accuracy: the subspace iteration stops at a relative
+    // change of the Ritz values of 1e-11 per iteration, and its error is that change over
+    // (1 − convergence ratio) — up to ~1e2 times it for the in-plane modes (measured ≤ 1.6e-9;
+    // out-of-plane ≤ 2e-12). A moderately stiff section (GA L²/EI ≈ 1e5) keeps the
+    // cancellation of the assembled shear and axial forces below that.
+    let sec = Section {
+        shear_stiffness: Vector3::new(1e4, 1e4, 2e4),
+        bend_stiffness: Vector3::new(EI, EI, 0.015),
+        mass_per_length: RHO_A,
+        rotary_inertia: Vector3::new(1e-6, 1e-6, 2e-6),
+    };
+    let cable = |a, b, n| {
+        crate::harness::tests::straight_with(a, b, n, sec.clone(), vec![], Vector3::zeros())
+    };
+    let a = cable([-0.5, 0.0, 0.0], [0.0, 0.0, 0.0], 16);
+    let b = cable([0.0, 0.0, 0.0], [0.0, 0.3, 0.0], 12);
+    let h = harness_with_inertia(vec![a, b], vec![(0, 1), (1, 0)], 1e-4);
+    let st = initial(&h);
+    let modes = harness_lowest_modes(&h, &st, 8).unwrap();
+    let tau = vec![Vector3::repeat(3e-3); 2];
+    let mut moving_junction = 0;
+    for m in &modes {
+        let zeta = harness_damping_ratio(&h, &st, m, &tau, &tau).unwrap();
+        let exact = 0.5 * 3e-3 * m.omega;
+        assert!(
+            (zeta - exact).abs() < 1e-8 * exact,
+            "ω {}: ζ {zeta} vs τω/2 {exact}",
+            m.omega
+        );
+        // The same mode with the junction held still in the damping: not τω/2.
+        let mut still = m.clone();
+        if m.junctions[0].norm() > 1e-3 * m.cables.iter().flatten().map(|v| v.norm()).sum::<f64>() {
+            moving_junction += 1;
+            still.junctions[0] = Vector6::zeros();
+            let wrong = harness_damping_ratio(&h, &st, &still, &tau, &tau).unwrap();
+            assert!((wrong - exact).abs() > 1e-3 * exact, "{wrong} vs {exact}");
+        }
+    }
+    assert!(
+        moving_junction >= 4,
+        "{moving_junction} modes move the junction"
+    );
+    // A wrong number of retardation times is an error naming the counts.
+    let err = harness_damping_ratio(&h, &st, &modes[0], &tau[..1], &tau).unwrap_err();
+    assert!(err.0.contains("2 cables"), "{}", err.0);
+}
+
+/// Two collinear cables joined by a massless junction are the single cable (same discrete
+/// model): their modes have the single cable's damping ratios with retardation times that
+/// differ per deformation (C not proportional to K: bending, torsion, extension and shear
+/// each their own τ).
+#[test]
+fn collinear_pair_has_the_damping_ratios_of_the_single_cable() {
+    use crate::modal::damping_ratio;
+    let n = 20;
+    let single = straight([0.0, 0.0, 0.0], [1.0, 0.0, 0.0], 2 * n);
+    let st1 = route(&single, None).unwrap();
+    let reference = crate::modal::lowest_modes(&single, &st1, 8).unwrap();
+    let a = straight([0.0, 0.0, 0.0], [0.5, 0.0, 0.0], n);
+    let b = straight([0.5, 0.0, 0.0], [1.0, 0.0, 0.0], n);
+    let h = harness(vec![a, b], vec![(0, 1), (1, 0)]);
+    let st = initial(&h);
+    let modes = harness_lowest_modes(&h, &st, 8).unwrap();
+    let (shear, bend) = (
+        Vector3::new(2e-3, 2e-3, 1e-4),
+        Vector3::new(4e-3, 4e-3, 5e-4),
+    );
+    for (m, r) in modes.iter().zip(&reference) {
+        let zeta = harness_damping_ratio(&h, &st, m, &[shear; 2], &[bend; 2]).unwrap();
+        let exact = damping_ratio(&single, &st1, &r.shape, r.omega, shear, bend).unwrap();
+        // Round section, equal τ in both bending planes: any mix of the degenerate pair has
+        // the same ratio. Agreement to the modal solver's tolerance on ω (1e-6).
+        assert!(
+            (zeta - exact).abs() < 1e-6 * exact,
+            "ω {}: harness ζ {zeta} single {exact}",
+            m.omega
+        );
+    }
+}

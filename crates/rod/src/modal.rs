@@ -573,6 +573,44 @@ pub fn damping_ratio(
     shear_tau: Vector3<f64>,
     bend_tau: Vector3<f64>,
 ) -> Result<f64, ModalError> {
+    let power = dissipated_power(rod, st, shape, shear_tau, bend_tau, &[])?;
+    let mass = modal_mass(rod, shape);
+    if !(omega > 0.0 && mass > 0.0) {
+        return Ok(0.0);
+    }
+    Ok(power / (2.0 * omega * mass))
+}
+
+/// φᵀMφ of one cable's part of a mode shape (lumped mass).
+pub(crate) fn modal_mass(rod: &Rod, shape: &[Vector6<f64>]) -> f64 {
+    lumped_mass(rod)
+        .iter()
+        .zip(shape)
+        .map(|(m, s)| (0..6).map(|k| m[k] * s[k] * s[k]).sum::<f64>())
+        .sum()
+}
+
+/// The velocity of a node held by something that moves in the mode (a harness junction): the
+/// node's velocity (global) and its ghost rotation's body angular velocity.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct HeldRate {
+    pub node: usize,
+    pub velocity: Vector3<f64>,
+    pub ghost: usize,
+    pub angular_velocity: Vector3<f64>,
+}
+
+/// φᵀCφ: the power the section law's viscous forces dissipate with the mode shape `shape` as
+/// velocities (ẋ, ω) — one assembly, no matrix. Held nodes do not move, except those of `held`
+/// (given velocities, e.g. the ends a harness junction carries).
+pub(crate) fn dissipated_power(
+    rod: &Rod,
+    st: &State,
+    shape: &[Vector6<f64>],
+    shear_tau: Vector3<f64>,
+    bend_tau: Vector3<f64>,
+    held: &[HeldRate],
+) -> Result<f64, ModalError> {
     use crate::assembly::{Elastic, Eval, Part, Rates, Term};
     let sec = &rod.spec.section;
     let mut v: Vec<Vector6<f64>> = shape.to_vec();
@@ -588,7 +626,7 @@ pub fn damping_ratio(
             }
         }
     }
-    let ghost_omega = rod
+    let mut ghost_omega: Vec<Vector3<f64>> = rod
         .ghosts
         .iter()
         .map(|g| match g.free_axis {
@@ -596,6 +634,10 @@ pub fn damping_ratio(
             None => Vector3::zeros(),
         })
         .collect();
+    for e in held {
+        v[e.node].fixed_rows_mut::<3>(0).copy_from(&e.velocity);
+        ghost_omega[e.ghost] = e.angular_velocity;
+    }
     let rates = Rates {
         v,
         ghost_omega,
@@ -615,13 +657,5 @@ pub fn damping_ratio(
     Elastic
         .add_residual_jacobian(rod, st, &ev, &mut ws)
         .map_err(|k| ModalError::Kink { node: k.node })?;
-    let mass: f64 = lumped_mass(rod)
-        .iter()
-        .zip(shape)
-        .map(|(m, s)| (0..6).map(|k| m[k] * s[k] * s[k]).sum::<f64>())
-        .sum();
-    if !(omega > 0.0 && mass > 0.0) {
-        return Ok(0.0);
-    }
-    Ok(ws.dissipation / (2.0 * omega * mass))
+    Ok(ws.dissipation)
 }
