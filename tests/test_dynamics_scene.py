@@ -12,6 +12,7 @@ import pytest
 from cablelife.modal import cable_modes, retardation_times
 from cablelife.scene import scene_from_dict
 from cablelife.simulate import simulate
+from decay import free_decay
 
 BETA_L = [1.875104, 4.694091, 7.854757]
 
@@ -88,18 +89,6 @@ def test_set_damping_ratio_gives_the_logarithmic_decrement(scene_dict):
     zeta, period = free_decay(res.time, res.positions[:, -1, 2], after=0.05)
     assert zeta == pytest.approx(0.05, rel=0.1)
     assert 2 * math.pi / res.solver["omega1"] == pytest.approx(period, rel=0.03)
-
-
-def free_decay(time, y, after: float) -> tuple[float, float]:
-    """Damping ratio (logarithmic decrement over the peaks of ``y`` after ``after`` s) and the
-    mean period of a free decay."""
-    peaks = [i for i in range(1, y.size - 1)
-             if y[i] > y[i - 1] and y[i] >= y[i + 1] and time[i] > after]  # fmt: skip
-    amps = y[peaks]
-    n = len(amps) - 1
-    assert n >= 3, "need several periods"
-    delta = math.log(amps[0] / amps[n]) / n
-    return delta / math.sqrt(4 * math.pi**2 + delta**2), float(np.diff(time[peaks]).mean())
 
 
 def test_slow_excitation_gives_the_quasistatic_result(scene_dict):

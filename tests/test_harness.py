@@ -167,13 +167,10 @@ def test_dynamic_y_stays_symmetric_and_saves_its_junction(tmp_path):
     result.save(path)
     back = load_result(path)
     np.testing.assert_array_equal(back.junctions["y"].position, j.position)
-    # The default bending damping comes from the first mode of the whole harness: τ = 2ζ/ω₁
-    # (ζ = 1), the same for every branch.
-    from cablelife.modal import harness_modes
-
-    omega1 = next(iter(harness_modes(scene_from_dict(sc), 1).values())).omega[0]
-    for cable in result.cables.values():
-        np.testing.assert_allclose(cable.solver["tau_bend"][:2], 2.0 / omega1, rtol=1e-12)
+    # The default bending damping is calibrated on the first mode of the whole harness
+    # (ζ = 1 from bending, tests/test_harness_damping.py), the same τ on every branch.
+    taus = {cable.solver["tau_bend"][0] for cable in result.cables.values()}
+    assert len(taus) == 1 and taus.pop() > 0
 
 
 def pair_scene(joined: bool) -> dict:

@@ -158,14 +158,16 @@ class Harness:
         keeps the previous (the workbench's drags).
         """
         ...
-    def modes(self, count) -> Any:
+    def modes(self, count, shear_tau=None, bend_tau=None) -> Any:
         """The `count` lowest natural modes of the whole harness about the last step of
         `run_sequence` (a static equilibrium): shift-invert on the tree elimination
         (`rod::harness_modal`). Returns `omega` (k,) rad/s, `cables` (one dict per cable:
         `displacements` (k, N+1, 3) and `rotations` (k, N, 3), global, mass-normalised over
         the harness), `junction_displacements` and `junction_rotations` (k, J, 3, global),
         `shares` (k, 4) and `kind` (k,) as `Cable.modes`. An unstable equilibrium is a
-        ValueError.
+        ValueError. With per-cable Kelvin–Voigt retardation times `shear_tau` and `bend_tau`
+        (one triple per cable, as `Cable.modes`), also `damping_ratio` (k,): each mode's
+        Rayleigh quotient over the whole harness (`rod::harness_modal::harness_damping_ratio`).
         """
         ...
     def run_dynamic(

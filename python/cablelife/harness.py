@@ -255,23 +255,20 @@ def run_harness(scene: Scene, times: np.ndarray, mode: str, progress, stop):
     callback = (lambda k, n: progress("harness", k, n)) if progress else None
     extra: dict = {}
     if mode == "dynamic":
-        from cablelife.modal import retardation_times
+        from cablelife.modal import mode1_bending_damping, retardation_times, uses_mode1
 
         every = output_every(scene)
-        # Default bending damping from the first mode of the whole harness (docs/harness.md).
-        needs_mode = any(
-            c.damping.retardation_time is None and c.damping.bending is None for c in cables
-        )
-        omega1 = None
-        if needs_mode:  # on this harness (not built again: harness_modes) at t = 0
+        # Default bending damping calibrated on mode 1 of the whole harness (docs/harness.md).
+        mode1 = None
+        if any(map(uses_mode1, cables)):  # on this harness (not built again) at t = 0
             first = core.run_sequence([p[:1] for p, _ in poses], [q[:1] for _, q in poses])
             if first["error"]:
                 raise SceneError(f"harness: no static equilibrium: {first['error']}")
             try:
-                omega1 = float(core.modes(1)["omega"][0])
+                mode1 = mode1_bending_damping(core, len(cables))
             except ValueError as err:
                 raise SceneError(f"harness: {err}") from None
-        taus = [retardation_times(scene, c, omega1) for c in cables]
+        taus = [retardation_times(scene, c, mode1) for c in cables]
         names = ("positions", "quaternions", "velocities", "angular_velocities")
         names += ("accelerations", "angular_accelerations")
         start = _time.perf_counter()

@@ -61,13 +61,12 @@ def cable_modes(scene: Scene, cable: Cable, count: int = 6, damping: bool = Fals
     """The ``count`` lowest modes of ``cable`` at its static equilibrium with the clip poses
     of t = 0 (the banded Rust solver). With ``damping``, also each mode's damping ratio of the
     cable's Kelvin–Voigt damping (``retardation_times``): the Rayleigh quotient
-    φᵀCφ / (2ω φᵀMφ) with the section law's damping matrix C (``rod::modal::damping_ratio``)."""
+    φᵀCφ / (2ω φᵀMφ) with the section law's damping matrix C (``rod::modal::damping_ratio``).
+    A cable of a harness gets the harness's modes (``harness_modes``)."""
     if count < 1:
         raise SceneError(f"count = {count}: ask for at least 1 mode")
     if scene.junctions:
-        if damping:
-            raise SceneError("cable_modes(damping=True): harnesses are not supported yet")
-        return harness_modes(scene, count)[cable.name]
+        return harness_modes(scene, count, damping)[cable.name]
     taus = {}
     if damping:
         shear, bend, _ = retardation_times(scene, cable)
@@ -90,18 +89,31 @@ def cable_modes(scene: Scene, cable: Cable, count: int = 6, damping: bool = Fals
     )
 
 
-def harness_modes(scene: Scene, count: int = 6) -> dict[str, Modes]:
+def harness_modes(scene: Scene, count: int = 6, damping: bool = False) -> dict[str, Modes]:
     """The ``count`` lowest modes of a harness (a scene with ``[[junctions]]``) about its
     static equilibrium with the clip poses of t = 0: modes of the whole tree (``rod::
     harness_modal``), so every cable's ``Modes`` has the same frequencies and its part of each
-    mode shape (mass-normalised over the harness; ``shares`` and ``kind`` of the whole)."""
+    mode shape (mass-normalised over the harness; ``shares`` and ``kind`` of the whole). With
+    ``damping``, also each mode's damping ratio with every cable's Kelvin–Voigt damping
+    (``retardation_times``): the Rayleigh quotient over the whole harness
+    (``rod::harness_modal::harness_damping_ratio``)."""
     from cablelife.harness import harness_equilibrium
 
     if count < 1:
         raise SceneError(f"count = {count}: ask for at least 1 mode")
     core, cables, cores, out = harness_equilibrium(scene)
     try:
-        found = core.modes(count)
+        taus = {}
+        if damping:
+            mode1 = None
+            if any(map(uses_mode1, cables)):
+                mode1 = mode1_bending_damping(core, len(cables))
+            times = [retardation_times(scene, c, mode1) for c in cables]
+            taus = {
+                "shear_tau": [list(t[0]) for t in times],
+                "bend_tau": [list(t[1]) for t in times],
+            }
+        found = core.modes(count, **taus)
     except ValueError as err:
         raise SceneError(f"harness: {err}") from None
     return {
@@ -114,6 +126,7 @@ def harness_modes(scene: Scene, count: int = 6) -> dict[str, Modes]:
             rotations=fc["rotations"],
             shares=found["shares"],
             kind=list(found["kind"]),
+            damping_ratio=found.get("damping_ratio"),
         )
         for c, co, o, fc in zip(cables, cores, out["cables"], found["cables"], strict=True)
     }
@@ -205,37 +218,54 @@ def lowest_frequencies(cable: Cable) -> dict[str, float]:
     }
 
 
-def bending_damping_of_mode1(scene: Scene, cable: Cable) -> tuple[float, float]:
-    """ω₁ of the mounted cable at t = 0 and its Rayleigh damping ratio per second of bending
-    retardation time: ζ₁ for τ = 1 s on EI₁ and EI₂ only (torsion, extension, shear undamped).
-    ζ₁ is linear in τ, so τ = ζ / (this value) damps mode 1 at ζ."""
-    core, _ = _equilibrium(scene, cable)
-    try:
-        found = core.modes(1, shear_tau=[0.0, 0.0, 0.0], bend_tau=[1.0, 1.0, 0.0])
-    except ValueError as err:
-        raise SceneError(f"cable '{cable.name}': {err}") from None
+def uses_mode1(cable: Cable) -> bool:
+    """Whether the cable's default bending damping needs the first mode (a damping ratio, no
+    retardation time given for bending)."""
+    return cable.damping.retardation_time is None and cable.damping.bending is None
+
+
+def mode1_bending_damping(core, cables: int | None = None) -> tuple[float, float]:
+    """ω₁ of the solver object ``core`` at its last static equilibrium (a ``Cable``, or a
+    ``Harness`` of ``cables`` cables) and mode 1's Rayleigh damping ratio per second of bending
+    retardation time: ζ₁ for τ = 1 s on EI₁ and EI₂ of every cable (torsion, extension, shear
+    undamped). ζ₁ is linear in τ, so τ = ζ / (this value) damps mode 1 at ζ. A ValueError of
+    the modal solver passes through."""
+    shear, bend = [0.0, 0.0, 0.0], [1.0, 1.0, 0.0]
+    if cables is not None:
+        shear, bend = [shear] * cables, [bend] * cables
+    found = core.modes(1, shear_tau=shear, bend_tau=bend)
     return float(found["omega"][0]), float(found["damping_ratio"][0])
 
 
+def bending_damping_of_mode1(scene: Scene, cable: Cable) -> tuple[float, float]:
+    """``mode1_bending_damping`` of the mounted cable at t = 0."""
+    core, _ = _equilibrium(scene, cable)
+    try:
+        return mode1_bending_damping(core)
+    except ValueError as err:
+        raise SceneError(f"cable '{cable.name}': {err}") from None
+
+
 def retardation_times(
-    scene: Scene, cable: Cable, omega1: float | None = None
+    scene: Scene, cable: Cable, mode1: tuple[float, float] | None = None
 ) -> tuple[list[float], list[float], dict]:
     """Kelvin–Voigt retardation times (GA₁, GA₂, EA) and (EI₁, EI₂, GJ) of a cable, with how
     they were set.
 
     Default (``ratio`` ζ, 1 unless given): bending gets the τ that gives the first natural
     mode of the mounted cable the damping ratio ζ (ζ = 1: critical), τ = ζ / ζ₁(τ = 1 s) with
-    ζ₁ the mode's Rayleigh damping ratio φᵀC_bφ / (2ω φᵀMφ) (``bending_damping_of_mode1``);
+    ζ₁ the mode's Rayleigh damping ratio φᵀC_bφ / (2ω φᵀMφ) (``mode1_bending_damping``);
     τ = 2ζ/ω₁ only where the mode's bending stiffness is its whole stiffness: where the
     loads' geometric stiffness lowers ω₁ (a slack, curved or compressed span) it would give
-    several times ζ. Harnesses keep τ = 2ζ/ω₁ of the whole tree's ω₁ (no harness damping
-    ratios yet). Extension, torsion and shear get a material-like damping: the loss factor
+    several times ζ. A harness's cables are calibrated on the whole tree's mode 1 (``mode1``
+    of the harness): with one ζ on every cable that mode gets ζ exactly. Extension, torsion and
+    shear get a material-like damping: the loss factor
     η = ``DEFAULT_LOSS_FACTOR`` on their own lowest mode, τ_i = min(τ, η/ω_i)
     (``lowest_frequencies``). One τ on all modes would damp extension, torsion and shear
     hundreds of times over-critically and let the viscous forces dominate the section loads
     (docs/dynamics.md). A given ``retardation_time`` applies to all modes. Per-mode values
-    override either. ``omega1``: the first natural frequency when known (a harness: the whole
-    tree's), else computed."""
+    override either. ``mode1``: (ω₁, ζ₁ per second of bending τ) when known (a harness: the
+    whole tree's), else computed for the cable alone."""
     from cablelife.scene import DEFAULT_DAMPING_RATIO
 
     d = cable.damping
@@ -246,12 +276,10 @@ def retardation_times(
         own = {"extension": tau, "torsion": tau, "shear": tau}
     else:
         zeta = d.ratio if d.ratio is not None else DEFAULT_DAMPING_RATIO
-        per_tau = None
-        if omega1 is None:
-            omega1, per_tau = bending_damping_of_mode1(scene, cable)
-        if per_tau is not None and per_tau > 0:
+        omega1, per_tau = mode1 if mode1 is not None else bending_damping_of_mode1(scene, cable)
+        if per_tau > 0:
             tau = zeta / per_tau  # mode 1's Rayleigh damping ratio from bending is ζ exactly
-        else:  # a harness (its modes carry no damping ratios yet): τ = 2ζ/ω₁
+        else:  # mode 1 bends nothing (no bending stiffness in it): the beam rule
             tau = 2 * zeta / omega1 if omega1 > 0 else 0.0
         info.update(source="ratio", ratio=zeta, omega1=omega1)
         own = {k: min(tau, DEFAULT_LOSS_FACTOR / w) for k, w in lowest_frequencies(cable).items()}

@@ -976,32 +976,13 @@ impl Cable {
         )?;
         d.set_item("shares", PyArray1::from_vec(py, shares).reshape([k, 4])?)?;
         d.set_item("kind", kinds)?;
-        match (shear_tau, bend_tau) {
-            (Some(ts), Some(tb)) => {
-                let (ts, tb) = (Vector3::from(ts), Vector3::from(tb));
-                if !(ts
-                    .iter()
-                    .chain(tb.iter())
-                    .all(|t| t.is_finite() && *t >= 0.0))
-                {
-                    return Err(PyValueError::new_err(format!(
-                        "retardation times shear_tau {ts:?}, bend_tau {tb:?}: each must be a \
-                         finite number >= 0 s"
-                    )));
-                }
-                let zeta = modes
-                    .iter()
-                    .map(|m| rod::modal::damping_ratio(rod, st, &m.shape, m.omega, ts, tb))
-                    .collect::<Result<Vec<f64>, _>>()
-                    .map_err(|e| PyValueError::new_err(e.to_string()))?;
-                d.set_item("damping_ratio", PyArray1::from_vec(py, zeta))?;
-            }
-            (None, None) => {}
-            _ => {
-                return Err(PyValueError::new_err(
-                    "modes: give both shear_tau and bend_tau (or neither)",
-                ))
-            }
+        if let Some((ts, tb)) = retardation_times(shear_tau, bend_tau)? {
+            let zeta = modes
+                .iter()
+                .map(|m| rod::modal::damping_ratio(rod, st, &m.shape, m.omega, ts, tb))
+                .collect::<Result<Vec<f64>, _>>()
+                .map_err(|e| PyValueError::new_err(e.to_string()))?;
+            d.set_item("damping_ratio", PyArray1::from_vec(py, zeta))?;
         }
         Ok(d)
     }
@@ -1101,4 +1082,32 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
         DynamicOptions::default().tolerance,
     )?;
     Ok(())
+}
+
+pub(crate) const BOTH_TAUS: &str = "modes: give both shear_tau and bend_tau (or neither)";
+
+/// The Kelvin–Voigt retardation times of a modal damping request: both or neither, each
+/// finite and >= 0 s.
+pub(crate) fn retardation_times(
+    shear_tau: Option<[f64; 3]>,
+    bend_tau: Option<[f64; 3]>,
+) -> PyResult<Option<(Vector3<f64>, Vector3<f64>)>> {
+    match (shear_tau, bend_tau) {
+        (Some(ts), Some(tb)) => {
+            let (ts, tb) = (Vector3::from(ts), Vector3::from(tb));
+            if !(ts
+                .iter()
+                .chain(tb.iter())
+                .all(|t| t.is_finite() && *t >= 0.0))
+            {
+                return Err(PyValueError::new_err(format!(
+                    "retardation times shear_tau {ts:?}, bend_tau {tb:?}: each must be a \
+                     finite number >= 0 s"
+                )));
+            }
+            Ok(Some((ts, tb)))
+        }
+        (None, None) => Ok(None),
+        _ => Err(PyValueError::new_err(BOTH_TAUS)),
+    }
 }

@@ -1,6 +1,6 @@
 //! Bindings of the harness solver (docs/harness.md): cables joined at junctions, static and
 //! quasistatic sequences. Runs release the GIL, poll Ctrl-C and report progress like `Cable`.
-use crate::cable::{read_poses, vec3, Cable, Record};
+use crate::cable::{read_poses, retardation_times, vec3, Cable, Record, BOTH_TAUS};
 use crate::stop::{Poller, StopFlag};
 use nalgebra::Vector3;
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray3};
@@ -9,7 +9,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use rod::harness::{Harness as Tree, HarnessState, HarnessStatics, JunctionSpec};
 use rod::harness_dynamics::HarnessDynamics;
-use rod::harness_modal::{harness_lowest_modes, ModalSystem};
+use rod::harness_modal::{harness_damping_ratio, harness_lowest_modes, ModalSystem};
 use rod::routing::route;
 use rod::{ClipMotion, DynamicOptions, NewtonOptions, Pose};
 
@@ -299,8 +299,39 @@ impl Harness {
     /// `displacements` (k, N+1, 3) and `rotations` (k, N, 3), global, mass-normalised over
     /// the harness), `junction_displacements` and `junction_rotations` (k, J, 3, global),
     /// `shares` (k, 4) and `kind` (k,) as `Cable.modes`. An unstable equilibrium is a
-    /// ValueError.
-    fn modes<'py>(&mut self, py: Python<'py>, count: usize) -> PyResult<Bound<'py, PyDict>> {
+    /// ValueError. With per-cable Kelvin–Voigt retardation times `shear_tau` and `bend_tau`
+    /// (one triple per cable, as `Cable.modes`), also `damping_ratio` (k,): each mode's
+    /// Rayleigh quotient over the whole harness (`rod::harness_modal::harness_damping_ratio`).
+    #[pyo3(signature = (count, shear_tau=None, bend_tau=None))]
+    fn modes<'py>(
+        &mut self,
+        py: Python<'py>,
+        count: usize,
+        shear_tau: Option<Vec<[f64; 3]>>,
+        bend_tau: Option<Vec<[f64; 3]>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let nc = self.tree.cables.len();
+        let taus = match (shear_tau, bend_tau) {
+            (Some(ts), Some(tb)) if ts.len() != nc || tb.len() != nc => {
+                return Err(PyValueError::new_err(format!(
+                    "modes: {} shear_tau and {} bend_tau triples for {nc} cables (give one per \
+                     cable)",
+                    ts.len(),
+                    tb.len()
+                )))
+            }
+            (Some(ts), Some(tb)) => {
+                let mut both = (Vec::with_capacity(nc), Vec::with_capacity(nc));
+                for (s, b) in ts.into_iter().zip(tb) {
+                    let (s, b) = retardation_times(Some(s), Some(b))?.expect("both given");
+                    both.0.push(s);
+                    both.1.push(b);
+                }
+                Some(both)
+            }
+            (None, None) => None,
+            _ => return Err(PyValueError::new_err(BOTH_TAUS)),
+        };
         let st = self.state.as_ref().ok_or_else(|| {
             PyValueError::new_err("run a static solve (run_sequence) of the harness first")
         })?;
@@ -371,6 +402,14 @@ impl Harness {
             "kind",
             modes.iter().map(|m| m.kind.name()).collect::<Vec<_>>(),
         )?;
+        if let Some((ts, tb)) = taus {
+            let zeta = modes
+                .iter()
+                .map(|m| harness_damping_ratio(tree, st, m, &ts, &tb))
+                .collect::<Result<Vec<f64>, _>>()
+                .map_err(|e| PyValueError::new_err(e.0))?;
+            d.set_item("damping_ratio", PyArray1::from_vec(py, zeta))?;
+        }
         Ok(d)
     }
 
