@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from cablelife.results import CableResult, ClipReaction, JunctionResult
+from cablelife.results import CONTACT_KEYS, CableResult, ClipReaction, JunctionResult
 
 if TYPE_CHECKING:
     from cablelife.scene import Cable, Junction, Scene
@@ -329,6 +329,8 @@ def run_harness(scene: Scene, times: np.ndarray, mode: str, progress, stop):
             **extra,
         )
         energies = {"elastic_energy": o["elastic_energy"]}
+        if "contact_gap" in o:
+            energies["contact_energy"] = o["contact_energy"]
         if mode == "dynamic":
             tau_shear, tau_bend, info = taus[k]
             solver.update(
@@ -357,6 +359,7 @@ def run_harness(scene: Scene, times: np.ndarray, mode: str, progress, stop):
             section=c.properties().as_attrs(),
             solver=solver,
             energies=energies,
+            contact={k: o[k] for k in CONTACT_KEYS if k in o},
         )
     junctions: dict[str, JunctionResult] = {}
     ends = core.ends

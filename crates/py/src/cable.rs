@@ -173,7 +173,7 @@ impl Record {
         self.contact_gap.reserve(n);
     }
 
-    fn push_contact(&mut self, c: &Contact) {
+    pub(crate) fn push_contact(&mut self, c: &Contact) {
         for (f, t) in c.normal_force.iter().zip(&c.friction_force) {
             self.contact_normal.extend_from_slice(f.as_slice());
             self.contact_friction.extend_from_slice(t.as_slice());
@@ -296,7 +296,7 @@ pub(crate) fn read_poses(
 type SpanTuple = (String, String, f64, f64);
 
 /// The obstacle poses at step k (the last given for later steps; None without contact).
-fn obstacle_at(poses: &[Vec<Pose>], k: usize) -> Option<&[Pose]> {
+pub(crate) fn obstacle_at(poses: &[Vec<Pose>], k: usize) -> Option<&[Pose]> {
     poses.get(k).or(poses.last()).map(|p| p.as_slice())
 }
 
@@ -305,16 +305,9 @@ fn obstacle_at(poses: &[Vec<Pose>], k: usize) -> Option<&[Pose]> {
 pub struct Cable {
     pub(crate) rod: Rod,
     state: Option<State>,
-    solver: Statics,
+    pub(crate) solver: Statics,
     /// Global poses of the contact obstacles per time step (T, O) (empty: no contact).
-    obstacle_poses: Vec<Vec<Pose>>,
-}
-
-impl Cable {
-    /// Whether contact with the geometry is set on this cable (`set_contact`).
-    pub(crate) fn has_contact(&self) -> bool {
-        self.solver.contact.is_some()
-    }
+    pub(crate) obstacle_poses: Vec<Vec<Pose>>,
 }
 
 /// (name, body index, kind, dimensions, friction): plane [], sphere [radius], cylinder

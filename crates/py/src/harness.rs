@@ -1,6 +1,6 @@
 //! Bindings of the harness solver (docs/harness.md): cables joined at junctions, static and
 //! quasistatic sequences. Runs release the GIL, poll Ctrl-C and report progress like `Cable`.
-use crate::cable::{read_poses, retardation_times, vec3, Cable, Record, BOTH_TAUS};
+use crate::cable::{obstacle_at, read_poses, retardation_times, vec3, Cable, Record, BOTH_TAUS};
 use crate::stop::{Poller, StopFlag};
 use nalgebra::Vector3;
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray3};
@@ -28,6 +28,8 @@ pub struct Harness {
     /// The last equilibrium of `run_sequence`: for `modes`, and the start of a `warm` run
     /// (the workbench's warm start).
     state: Option<HarnessState>,
+    /// Per cable: the global poses of its contact obstacles per time step (empty: none).
+    obstacle_poses: Vec<Vec<Vec<Pose>>>,
 }
 
 #[pymethods]
@@ -70,26 +72,29 @@ impl Harness {
             step_tolerance,
             ..Default::default()
         };
-        // Contact set on a cable (`Cable.set_contact`) is not part of the harness assembly
-        // yet (the junction coupling lacks the contact stiffness of joined ends,
-        // docs/harness.md): refused, not ignored.
-        if let Some((_, name)) = cables
-            .iter()
-            .zip(&tree.names)
-            .find(|(c, _)| c.has_contact())
-        {
-            return Err(PyValueError::new_err(format!(
-                "cable '{name}': contact with the geometry is not supported yet on harness \
-                 cables (the junction coupling lacks the contact stiffness of joined ends)"
-            )));
+        let mut solver = HarnessStatics::new(&tree, opts);
+        // Contact set on a cable (`Cable.set_contact`) is a term of its harness assembly, but
+        // not yet coupled into the junctions: the contact stiffness at a joined end's node
+        // is missing from the junction blocks (HeldEnds), so Newton stalls when an end
+        // touches the geometry. Refused until that is in (docs/harness.md).
+        for ((slot, c), name) in solver.contact.iter_mut().zip(&cables).zip(&tree.names) {
+            if c.solver.contact.is_some() {
+                return Err(PyValueError::new_err(format!(
+                    "cable '{name}': contact with the geometry is not supported yet on \
+                     harness cables (the junction coupling lacks the contact stiffness of \
+                     joined ends)"
+                )));
+            }
+            slot.clone_from(&c.solver.contact);
         }
-        let solver = HarnessStatics::new(&tree, opts);
+        let obstacle_poses = cables.iter().map(|c| c.obstacle_poses.clone()).collect();
         let stability = ModalSystem::new(&tree);
         Ok(Harness {
             tree,
             solver,
             stability,
             state: None,
+            obstacle_poses,
         })
     }
 
@@ -185,6 +190,7 @@ impl Harness {
         };
         let solver = &mut self.solver;
         let stability = &mut self.stability;
+        let obstacle_poses = &self.obstacle_poses;
         let mut poller = Poller::new(stop.as_ref(), progress, progress_every, t);
         let (nj, ne) = (tree.junctions.len(), tree.ends.len());
         struct Out {
@@ -220,6 +226,11 @@ impl Harness {
                 for (tc, pc) in target.iter_mut().zip(&poses) {
                     tc.clone_from(&pc[k]);
                 }
+                for (c, contact) in solver.contact.iter_mut().enumerate() {
+                    if let (Some(c), Some(p)) = (contact, obstacle_at(&obstacle_poses[c], k)) {
+                        c.set_obstacle_poses(p);
+                    }
+                }
                 let result = if k == 0 && !from_previous {
                     st.set_clip_poses(tree, &target);
                     solver.solve_static(tree, &mut st)
@@ -231,8 +242,9 @@ impl Harness {
                     Err(e) => return (out, Some(format!("step {k}: {e}")), None),
                 };
                 // (the solver has counted at its result already unless the loads are not
-                // conservative: harness_escape)
-                if stats.unstable.is_none() {
+                // conservative: harness_escape). With contact the stability count (of the
+                // harness without it) is skipped: `unstable` −1, not checked (docs/harness.md).
+                if stats.unstable.is_none() && !solver.has_contact() {
                     match stability.negative_count(tree, &st) {
                         Ok(n) => stats.unstable = Some(n),
                         Err(e) => return (out, Some(format!("step {k}: {e}")), None),
@@ -244,6 +256,9 @@ impl Harness {
                 for (c, rod) in tree.cables.iter().enumerate() {
                     out.records[c].push(rod, &st.cables[c], &solver.ws[c], &stats);
                     out.records[c].push_sliding(rod, solver.sliding[c].as_ref());
+                    if let Some(contact) = &solver.contact[c] {
+                        out.records[c].push_contact(contact);
+                    }
                 }
                 for pose in &st.junctions {
                     out.jpos.extend_from_slice(pose.position.as_slice());
@@ -448,6 +463,12 @@ impl Harness {
         progress_every: usize,
         stop: Option<Bound<'py, StopFlag>>,
     ) -> PyResult<Bound<'py, PyDict>> {
+        if self.solver.has_contact() {
+            return Err(PyValueError::new_err(
+                "contact with the geometry is not supported yet in dynamic harness runs; \
+                 allowed: static and quasistatic",
+            ));
+        }
         if !(newton_tolerance > 0.0 && newton_tolerance < 1.0) {
             return Err(PyValueError::new_err(format!(
                 "newton_tolerance = {newton_tolerance}: allowed is 0 < tolerance < 1"

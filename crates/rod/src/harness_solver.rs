@@ -4,6 +4,7 @@
 //! pseudo-transient and load continuation, sequences.
 use crate::assembly::Workspace;
 use crate::block_tridiag::{pivot_inertia, Inertia};
+use crate::contact::Contact;
 use crate::harness::{Harness, HarnessError, HarnessState};
 use crate::junction::HeldEnds;
 use crate::model::{Pose, Rod};
@@ -53,6 +54,10 @@ pub struct HarnessStatics {
     pub held: Vec<HeldEnds>,
     /// Per cable: the sliding clips' term (None without sliding clips).
     pub sliding: Vec<Option<SlidingClips>>,
+    /// Per cable: contact with the surroundings (None without; `harness_contact`).
+    pub contact: Vec<Option<Contact>>,
+    /// Per cable: the smallest gap before a Newton trial (`contact_bound`).
+    pub(crate) gap0: Vec<f64>,
     pub opts: NewtonOptions,
     pub(crate) delta: Vec<Vec<Vector6<f64>>>,
     trial: Vec<Vec<Vector6<f64>>>,
@@ -128,6 +133,8 @@ impl HarnessStatics {
             ws: h.cables.iter().map(Workspace::new).collect(),
             held: h.held_ends(),
             sliding: h.cables.iter().map(SlidingClips::of).collect(),
+            contact: vec![None; h.cables.len()],
+            gap0: vec![f64::INFINITY; h.cables.len()],
             opts,
             delta: per_cable(),
             trial: per_cable(),
@@ -185,7 +192,11 @@ impl HarnessStatics {
                     &st.cables[c],
                     lf,
                     want_jac,
-                    &mut [&mut self.held[c], &mut self.sliding[c]],
+                    &mut [
+                        &mut self.held[c],
+                        &mut self.sliding[c],
+                        &mut self.contact[c],
+                    ],
                 )
                 .map_err(|k| {
                     Self::cable_err(
@@ -558,6 +569,7 @@ impl HarnessStatics {
                 .map(|d| d.fixed_rows::<3>(0).amax())
                 .fold(0.0, f64::max);
             alpha = alpha.min(JUNCTION_STEP * self.length / djx.max(1e-300));
+            self.contact_bound(h, st, &mut alpha);
             self.base.clone_from(st);
             let mut accepted = false;
             for _ in 0..16 {
@@ -567,7 +579,7 @@ impl HarnessStatics {
                     let theta = self.scaled_norm(&self.trial, &self.trial_j) / norm0.max(1e-300);
                     let monotone =
                         theta <= 1.0 - 0.25 * alpha || step * alpha < self.opts.step_tolerance;
-                    if theta.is_finite() && (!damped || monotone) {
+                    if theta.is_finite() && (!damped || monotone) && self.contact_feasible() {
                         accepted = true;
                         break;
                     }
@@ -650,10 +662,11 @@ impl HarnessStatics {
                 self.junction_shift = (0.0, 0.0);
                 let (dx, dth) = self.solve(h, false);
                 let step = (dx / self.length).max(dth);
-                let alpha = 1.0f64.min(self.opts.max_rotation_step / dth.max(1e-300));
+                let mut alpha = 1.0f64.min(self.opts.max_rotation_step / dth.max(1e-300));
+                self.contact_bound(h, st, &mut alpha);
                 self.base.clone_from(st);
                 st.apply_increment(h, &self.delta, &self.dj, alpha);
-                let ok = self.assemble(h, st, lf, true).is_ok();
+                let ok = self.assemble(h, st, lf, true).is_ok() && self.contact_feasible();
                 let (r_new, r_inf_new) = if ok {
                     self.residual_norms()
                 } else {
@@ -704,21 +717,33 @@ impl HarnessStatics {
     ) -> Result<SolveStats, HarnessError> {
         st.sync_ends(h);
         self.has_prev = false; // a new sequence starts here
-        self.begin_step(h, st); // friction acts against the motion from the start
-        let result = self.solve_static_inner(h, st).and_then(|mut s| {
-            self.ensure_stable(h, st, &mut s)?; // an unstable equilibrium is left (harness_escape)
+        let result = if self.has_contact() {
+            self.solve_static_with_contact(h, st, |s, h, st| {
+                s.begin_step(h, st); // friction acts against the motion from the start
+                s.solve_static_inner(h, st)
+            })
+        } else {
+            self.begin_step(h, st); // friction acts against the motion from the start
+            self.solve_static_inner(h, st)
+        }
+        .and_then(|mut s| {
+            // an unstable equilibrium is left (harness_escape); the count has no contact term
+            if !self.has_contact() {
+                self.ensure_stable(h, st, &mut s)?;
+            }
             Ok(s)
         });
         result.and_then(|s| self.check_sliding(h, st).map(|_| s))
     }
 
-    /// Starts a step of the sliding clips' friction from `st`.
+    /// Starts a step of the sliding clips' and the contacts' friction from `st`.
     fn begin_step(&mut self, h: &Harness, st: &HarnessState) {
         for (c, rod) in h.cables.iter().enumerate() {
             if let Some(s) = &mut self.sliding[c] {
                 s.begin_step(rod, &st.cables[c], None);
             }
         }
+        self.begin_contact_step(st);
     }
 
     /// Fails naming the cable and the clip if a sliding clip's guide reaches beyond a cable

@@ -12,6 +12,7 @@ mod escape;
 #[cfg(test)]
 mod fd_check;
 pub mod harness;
+pub mod harness_contact;
 pub mod harness_dynamics;
 mod harness_escape;
 pub mod harness_modal;

@@ -1,0 +1,152 @@
+//! Contact with the surroundings on harness cables (docs/harness.md, "Contact"): each cable's
+//! `Contact` is one more term of its assembly (`HarnessStatics::assemble`); this module holds
+//! what the harness Newton adds around it, with the rules of the single cable
+//! (`Statics::newton`): the step bound "close at most 90 % of a gap" over every cable (a joined
+//! end node moves with its junction), the trial's gap test, the lagged friction reference
+//! (the last equilibrium) and the penetration check.
+use crate::harness::{Harness, HarnessError, HarnessState};
+use crate::harness_solver::HarnessStatics;
+use crate::statics::{SolveError, SolveStats};
+use nalgebra::Vector3;
+
+impl HarnessStatics {
+    /// Whether any cable has contact.
+    pub fn has_contact(&self) -> bool {
+        self.contact.iter().any(Option::is_some)
+    }
+
+    /// Limits the step fraction `alpha` of the Newton correction (`delta`, `dj`) so that no
+    /// cable dives through the contact barrier; stores each cable's smallest gap at `st` (from
+    /// its assembly) for `contact_feasible`.
+    pub(crate) fn contact_bound(&mut self, h: &Harness, st: &HarnessState, alpha: &mut f64) {
+        let a = *alpha;
+        let mut bound = 1.0f64;
+        for (c, contact) in self.contact.iter().enumerate() {
+            let Some(contact) = contact else {
+                self.gap0[c] = f64::INFINITY;
+                continue;
+            };
+            let rod = &h.cables[c];
+            let delta = &self.delta[c];
+            let dj = &self.dj;
+            let dx = |n: usize| {
+                if rod.mask[n][0] {
+                    return a * delta[n].fixed_rows::<3>(0).into_owned();
+                }
+                // A joined end's node sits at its junction's point and moves with it.
+                for &k in &h.cable_ends[c] {
+                    let e = &h.ends[k];
+                    if e.topo.node == n {
+                        return a * dj[e.junction].fixed_rows::<3>(0).into_owned();
+                    }
+                }
+                Vector3::zeros()
+            };
+            bound = bound.min(contact.step_bound(&st.cables[c].x, dx, 0..rod.n_edges()));
+            self.gap0[c] = contact.min_gap;
+        }
+        *alpha *= bound;
+    }
+
+    /// Whether the trial just assembled keeps every cable's gap acceptable against the gaps
+    /// stored by `contact_bound`.
+    pub(crate) fn contact_feasible(&self) -> bool {
+        self.contact
+            .iter()
+            .zip(&self.gap0)
+            .all(|(c, &g)| c.as_ref().is_none_or(|c| c.gap_acceptable(g)))
+    }
+
+    /// Friction reference of every cable's contact: the positions of `st` (the last
+    /// equilibrium of a sequence; the start of a static solve).
+    pub(crate) fn begin_contact_step(&mut self, st: &HarnessState) {
+        for (c, contact) in self.contact.iter_mut().enumerate() {
+            if let Some(contact) = contact {
+                contact.begin_step(&st.cables[c].x, None);
+            }
+        }
+    }
+
+    /// Whether a free node of some cable lies inside an obstacle at `st`.
+    pub(crate) fn contact_penetrates(&self, h: &Harness, st: &HarnessState) -> bool {
+        self.contact.iter().enumerate().any(|(c, contact)| {
+            contact
+                .as_ref()
+                .is_some_and(|k| k.penetrates(&h.cables[c], &st.cables[c]))
+        })
+    }
+
+    /// Marks the edges at nodes inside an obstacle for exact distances (`Some(st)`) or clears
+    /// the marks (`None`), on every cable.
+    pub(crate) fn mark_deep_edges(&mut self, st: Option<&HarnessState>) {
+        for (c, contact) in self.contact.iter_mut().enumerate() {
+            if let Some(contact) = contact {
+                contact.mark_deep_edges(st.map(|s| s.cables[c].x.as_slice()));
+            }
+        }
+    }
+
+    /// A cable left inside the geometry deeper than the tolerance (1 % of r) at `st`: the
+    /// error naming the cable, the geometry, the node and the depth.
+    pub(crate) fn penetration_error(
+        &mut self,
+        h: &Harness,
+        st: &HarnessState,
+    ) -> Option<HarnessError> {
+        self.mark_deep_edges(Some(st));
+        let mut found = None;
+        for (c, contact) in self.contact.iter().enumerate() {
+            let Some(p) = contact
+                .as_ref()
+                .and_then(|k| k.deepest_penetration(&st.cables[c]))
+            else {
+                continue;
+            };
+            let e = SolveError::Penetration {
+                node: p.node,
+                s: h.cables[c].arc[p.node],
+                obstacle: p.name,
+                depth: p.depth,
+            };
+            found = Some(HarnessError(format!("cable '{}': {e}", h.names[c])));
+            break;
+        }
+        self.mark_deep_edges(None);
+        found
+    }
+
+    /// `solve_static` with contact: a start that runs through the geometry (a routed shape) is
+    /// first solved without contact (as `Statics::solve`); the barrier then pushes it out. A
+    /// cable left inside is an error naming it.
+    pub(crate) fn solve_static_with_contact(
+        &mut self,
+        h: &Harness,
+        st: &mut HarnessState,
+        mut solve: impl FnMut(
+            &mut Self,
+            &Harness,
+            &mut HarnessState,
+        ) -> Result<SolveStats, HarnessError>,
+    ) -> Result<SolveStats, HarnessError> {
+        let inside = self.contact_penetrates(h, st);
+        if inside {
+            let contact = std::mem::take(&mut self.contact);
+            self.contact = vec![None; contact.len()];
+            let start = st.clone();
+            if solve(self, h, st).is_err() {
+                st.clone_from(&start);
+            }
+            self.contact = contact;
+            self.mark_deep_edges(Some(st));
+        }
+        let result = solve(self, h, st);
+        self.mark_deep_edges(None);
+        let stats = result?;
+        if inside {
+            if let Some(e) = self.penetration_error(h, st) {
+                return Err(e);
+            }
+        }
+        Ok(stats)
+    }
+}
