@@ -42,10 +42,23 @@ pub struct Workspace {
     pub contact_energy: f64,
     /// Reactions of clips that hold no node (sliding clips), set by their term.
     pub held_reaction: Vec<Option<(Vector3<f64>, Vector3<f64>)>>,
+    /// Jacobian entries of the terms at the cable's two end nodes (start, end) where such a
+    /// node is held (the cable's own matrix has no rows or columns for it): a junction end,
+    /// whose node is the junction's unknown, takes them into its blocks (`junction::EndBlocks`).
+    pub end_jac: [EndNodeJacobian; 2],
     /// Whether `Part::All` assemblies store the section forces and moments and sum the elastic
     /// energy (true by default; false: residual and Jacobian only, 13 % cheaper — the Newton
     /// iterations of a harness, whose outputs are assembled on the saved steps).
     pub section_outputs: bool,
+}
+
+/// Jacobian entries at a held end node of a cable (`Workspace::end_jac`): `diag` ∂r_end/∂x_end,
+/// `row` ∂r_end/∂x_next, `col` ∂r_next/∂x_end with `next` the adjacent node (1 or N − 1).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct EndNodeJacobian {
+    pub diag: Matrix3<f64>,
+    pub row: Matrix3<f64>,
+    pub col: Matrix3<f64>,
 }
 
 /// What an assembly evaluates: the part of the cable, whether the Jacobian is wanted, the
@@ -207,7 +220,34 @@ impl Workspace {
             load_potential: 0.0,
             contact_energy: 0.0,
             held_reaction: vec![None; rod.spec.clips.len()],
+            end_jac: [EndNodeJacobian::default(); 2],
             section_outputs: true,
+        }
+    }
+
+    /// Adds ∂r_n/∂x_m (3×3, node rows n, node columns m, n and m equal or adjacent) of a term
+    /// acting on node positions: into the cable's matrix when both nodes are free, into
+    /// `end_jac` when one is a held end node, else nowhere (a clip prescribes it).
+    pub fn add_node_block(&mut self, rod: &Rod, n: usize, m: usize, block: &Matrix3<f64>) {
+        let free = |k: usize| rod.node_kind[k] == NodeKind::Free;
+        match (free(n), free(m)) {
+            (true, true) => self.jac.add3(n, 0, m, 0, block),
+            (false, false) if n != m => {}
+            (held_row, _) => {
+                let end = if held_row { m } else { n };
+                let last = rod.n_edges();
+                let Some(j) = (end == 0).then_some(0).or((end == last).then_some(1)) else {
+                    return;
+                };
+                let e = &mut self.end_jac[j];
+                if n == m {
+                    e.diag += block;
+                } else if n == end {
+                    e.row += block;
+                } else {
+                    e.col += block;
+                }
+            }
         }
     }
 
@@ -221,6 +261,7 @@ impl Workspace {
             Part::All => {
                 if want_jac {
                     self.jac.clear();
+                    self.end_jac = [EndNodeJacobian::default(); 2];
                 }
                 self.node_grad.iter_mut().for_each(|v| v.fill(0.0));
                 self.edge_grad.iter_mut().for_each(|v| v.fill(0.0));
@@ -234,6 +275,12 @@ impl Workspace {
             Part::Segment(seg) => {
                 if want_jac {
                     self.jac.clear_range(seg.blocks.clone());
+                    if seg.blocks.start == 0 {
+                        self.end_jac[0] = EndNodeJacobian::default();
+                    }
+                    if seg.blocks.end >= self.edge_grad.len() {
+                        self.end_jac[1] = EndNodeJacobian::default();
+                    }
                 }
                 let n_edges = self.edge_grad.len();
                 for b in seg.blocks.clone() {

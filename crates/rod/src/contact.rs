@@ -942,8 +942,6 @@ impl Contact {
         let stride = self.opts.max_samples.max(1) + 1;
         let kk = self.samples[k];
         let (ra, rb) = (self.reference[e], self.reference[e + 1]);
-        let a_free = rod.node_kind[e] == NodeKind::Free;
-        let b_free = rod.node_kind[e + 1] == NodeKind::Free;
         for i in 0..=kk {
             let t = i as f64 / kk as f64;
             let w = if i == 0 || i == kk { 0.5 } else { 1.0 } * ds / kk as f64;
@@ -978,16 +976,16 @@ impl Contact {
             ws.node_grad[e] += ta * grad;
             ws.node_grad[e + 1] += t * grad;
             if want_jac {
-                if a_free {
-                    ws.jac.add3(e, 0, e, 0, &(ta * ta * s.jac));
+                if ta > 0.0 {
+                    ws.add_node_block(rod, e, e, &(ta * ta * s.jac));
                 }
-                if b_free {
-                    ws.jac.add3(e + 1, 0, e + 1, 0, &(t * t * s.jac));
+                if t > 0.0 {
+                    ws.add_node_block(rod, e + 1, e + 1, &(t * t * s.jac));
                 }
-                if a_free && b_free && t > 0.0 && t < 1.0 {
+                if t > 0.0 && t < 1.0 {
                     let m = ta * t * s.jac;
-                    ws.jac.add3(e, 0, e + 1, 0, &m);
-                    ws.jac.add3(e + 1, 0, e, 0, &m);
+                    ws.add_node_block(rod, e, e + 1, &m);
+                    ws.add_node_block(rod, e + 1, e, &m);
                 }
             }
             if outputs {

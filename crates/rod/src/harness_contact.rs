@@ -150,3 +150,7 @@ impl HarnessStatics {
         Ok(stats)
     }
 }
+
+#[cfg(test)]
+#[path = "harness_contact_tests.rs"]
+mod tests;

@@ -192,10 +192,12 @@ impl HarnessStatics {
                     &st.cables[c],
                     lf,
                     want_jac,
+                    // The held ends last: their blocks take the other terms' entries at the
+                    // end nodes (`Workspace::end_jac`) and the complete ghost gradients.
                     &mut [
-                        &mut self.held[c],
                         &mut self.sliding[c],
                         &mut self.contact[c],
+                        &mut self.held[c],
                     ],
                 )
                 .map_err(|k| {

@@ -216,7 +216,7 @@ fn two_junctions(n: usize) -> Harness {
 }
 
 /// A deterministic pseudo-random number in [−1, 1].
-fn rnd(k: &mut u64) -> f64 {
+pub(crate) fn rnd(k: &mut u64) -> f64 {
     *k = k
         .wrapping_mul(6364136223846793005)
         .wrapping_add(1442695040888963407);

@@ -220,6 +220,13 @@ impl EndBlocks {
             v += h[ig][ig] + 0.5 * skew(&ws.ghost_grad[t.ghost]);
         }
         self.put(1, edge_var, &h[ig][io], &h[io][ig]);
+        // Terms acting on the end node's position (contact): their entries at the held node.
+        let held = &ws.end_jac[usize::from(!t.at_start)];
+        {
+            let mut v = self.ee.fixed_view_mut::<3, 3>(0, 0);
+            v += held.diag;
+        }
+        self.put(0, other_var, &held.row, &held.col);
         // Inactive slots of the cable blocks carry no coupling.
         for (i, &b) in blocks.iter().enumerate() {
             for k in 0..6 {
