@@ -1,5 +1,7 @@
 """Surroundings on harnesses (docs/harness.md, "Surroundings"): clearance of every branch
-(against exact distances and the cables computed alone); contact is refused by name."""
+(against exact distances and the cables computed alone); contact in static and quasistatic
+runs (against the single continuous cable, the weight carried, no penetration); contact in
+dynamic harness runs is refused by name."""
 
 from __future__ import annotations
 
@@ -152,12 +154,83 @@ def test_harness_clearance_equals_the_clearance_of_the_cables_alone():
     np.testing.assert_allclose(thin.value - a.surroundings.value, 0.003, atol=1e-12)
 
 
-@pytest.mark.parametrize("mode", ["static", "quasistatic", "dynamic"])
-def test_harness_contact_is_a_named_error(mode):
-    d = table(y_scene(mode))
+def test_dynamic_harness_contact_is_a_named_error():
+    d = table(y_scene("dynamic"))
     d["simulation"].update(duration=0.01, time_step=1e-3)
-    with pytest.raises(SceneError, match="contact with the geometry is not supported yet for harn"):
+    with pytest.raises(SceneError, match="not supported yet in dynamic harness runs"):
         simulate(scene_from_dict(d))
+
+
+def weight_carried(res, extra_mass=0.0) -> tuple[np.ndarray, float]:
+    """Σ contact forces + Σ clip reactions over every cable (N, per step) and the weight."""
+    total, weight = 0.0, extra_mass * 9.81
+    for c in res.cables.values():
+        total = total + c.contact_force.sum(axis=1) + sum(k.force for k in c.clips.values())
+        length = c.arc_length[-1]
+        weight += float(c.section["mass_per_length"]) * length * 9.81
+    return total, weight
+
+
+def test_joined_pair_on_a_table_equals_the_continuous_cable():
+    # The pair sags onto the table with its junction lying on it; it is the continuous cable's
+    # discrete model (contact included), so every node and contact force must agree.
+    pr = simulate(scene_from_dict(table(pair(16))))
+    one = simulate(scene_from_dict(table(continuous(16)))).cables["one"]
+    a, b = pr.cables["a"], pr.cables["b"]
+    x = np.concatenate([a.positions[0], b.positions[0, 1:]])
+    np.testing.assert_allclose(x, one.positions[0], rtol=0, atol=1e-9)
+    j = pr.junctions["j"].position[0]
+    assert j[2] - R - TABLE_Z == pytest.approx(0.0, abs=0.01 * R)  # on the table
+    f1 = one.contact_force[0]
+    scale = np.abs(f1).max()
+    np.testing.assert_allclose(a.contact_force[0, :-1], f1[:16], atol=1e-8 * scale)
+    np.testing.assert_allclose(b.contact_force[0, 1:], f1[17:], atol=1e-8 * scale)
+    np.testing.assert_allclose(
+        a.contact_force[0, -1] + b.contact_force[0, 0], f1[16], atol=1e-8 * scale
+    )
+    assert f1[16, 2] > 0.1 * scale  # the junction's node carries weight
+
+
+def test_y_on_a_table_carries_its_weight_and_does_not_penetrate():
+    # A Y with a 20 g junction lying on a table under gravity: the contact forces and the clamp
+    # reactions carry the weight of cables and junction (the solver's residual tolerance is far
+    # below 1e-6); no cable surface goes through the table by more than 1 % of r.
+    res = simulate(scene_from_dict(table(y_scene(mass=0.02))))
+    total, weight = weight_carried(res, extra_mass=0.02)
+    assert total[0] == pytest.approx([0.0, 0.0, weight], abs=1e-6 * weight)
+    j = res.junctions["y"].position[0]
+    assert j[2] - R - TABLE_Z == pytest.approx(0.0, abs=0.01 * R)
+    for c in res.cables.values():
+        assert c.positions[0, :, 2].min() - R - TABLE_Z > -0.01 * R, c.name
+        assert np.all(c.contact["contact_gap"] > -0.01 * R)
+        assert (c.contact["contact_state"][0] > 0).any(), c.name
+        body = c.contact["body_contact_force"][0]
+        np.testing.assert_allclose(body[1], c.contact_force[0].sum(axis=0), rtol=1e-12)
+
+
+def test_quasistatic_y_on_a_rising_table_follows_it():
+    # The table rises 5 mm and falls back (a body motion) under the lying Y: at every step the
+    # weight is carried, nothing goes through the table, and each step equals a static solve
+    # with the table where it is then (continuation = cold start, to the solver tolerance).
+    d = table(y_scene("quasistatic", mass=0.02))
+    d["simulation"].update(duration=0.5, time_step=0.05)
+    sine = {"type": "sine", "amplitude": 0.005, "frequency": 1.0}
+    d["bodies"][0]["motion"] = [{"channel": "z", "signal": sine}]
+    res = simulate(scene_from_dict(d))
+    total, weight = weight_carried(res, extra_mass=0.02)
+    np.testing.assert_allclose(total[:, 2], weight, atol=1e-6 * weight)
+    lift = 0.005 * np.sin(2 * np.pi * res.cables["trunk"].time)
+    zj = res.junctions["y"].position[:, 2]
+    np.testing.assert_allclose(zj - R - TABLE_Z - lift, 0.0, atol=0.01 * R)
+    for c in res.cables.values():
+        assert np.all(c.contact["contact_gap"] > -0.01 * R), c.name
+    k = 3  # the table 4.8 mm up
+    s = table(y_scene(mass=0.02), z=TABLE_Z + lift[k])
+    cold = simulate(scene_from_dict(s))
+    for name, c in res.cables.items():
+        np.testing.assert_allclose(
+            c.positions[k], cold.cables[name].positions[0], rtol=0, atol=1e-7
+        )
 
 
 def test_disabled_contact_runs_a_harness_with_clearance():
@@ -165,3 +238,20 @@ def test_disabled_contact_runs_a_harness_with_clearance():
     d["contact"] = {"enabled": False}
     res = simulate(scene_from_dict(d))
     assert all(c.surroundings is not None and not c.contact for c in res.cables.values())
+
+
+def test_cablelife_run_of_a_harness_on_a_table(tmp_path):
+    # The whole command: scene file → run → result file with every branch's contact outputs.
+    import tomli_w
+    from cablelife.cli import app
+    from cablelife.results import load_result
+    from typer.testing import CliRunner
+
+    path = tmp_path / "y.toml"
+    path.write_bytes(tomli_w.dumps(table(y_scene(mass=0.02))).encode())
+    out = CliRunner().invoke(app, ["run", str(path), "-o", str(tmp_path / "y.h5")])
+    assert out.exit_code == 0, out.output
+    back = load_result(tmp_path / "y.h5")
+    total, weight = weight_carried(back, extra_mass=0.02)
+    assert total[0] == pytest.approx([0.0, 0.0, weight], abs=1e-6 * weight)
+    assert all("contact_gap" in c.contact for c in back.cables.values())

@@ -216,6 +216,7 @@ def run_harness(scene: Scene, times: np.ndarray, mode: str, progress, stop):
     harness's total energies (dynamic runs: ``time`` and the energies (T,) of all cables and
     junctions; else empty)."""
     from cablelife import _core
+    from cablelife.contact_settings import set_contact
     from cablelife.scene import SceneError
     from cablelife.simulate import (
         _stability_info,
@@ -231,14 +232,19 @@ def run_harness(scene: Scene, times: np.ndarray, mode: str, progress, stop):
             "supported yet; allowed for harnesses: 'static', 'quasistatic', 'dynamic'"
         )
     contact = scene.contact is not None and scene.contact.enabled
-    if contact:
+    if contact and mode == "dynamic":
         raise SceneError(
-            "contact with the geometry is not supported yet for harnesses (scenes with "
-            "[[junctions]]); set contact.enabled = false (clearance is computed without it) "
-            "or remove the junctions"
+            "contact with the geometry is not supported yet in dynamic harness runs (scenes "
+            "with [[junctions]]); allowed with contact: mode = 'static' or 'quasistatic' "
+            "(or set contact.enabled = false: clearance is computed without it)"
         )
     cables, specs = harness_cables(scene)
     cores = [build_cable(scene, c) for c in cables]
+    for c, co in zip(cables, cores, strict=True):  # each cable's contact: a harness term
+        try:
+            set_contact(co, scene, c, times)
+        except ValueError as err:
+            raise SceneError(f"cable '{c.name}': {err}") from None
     try:
         core = _core.Harness(
             cores,

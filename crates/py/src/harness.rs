@@ -73,18 +73,9 @@ impl Harness {
             ..Default::default()
         };
         let mut solver = HarnessStatics::new(&tree, opts);
-        // Contact set on a cable (`Cable.set_contact`) is a term of its harness assembly, but
-        // not yet coupled into the junctions: the contact stiffness at a joined end's node
-        // is missing from the junction blocks (HeldEnds), so Newton stalls when an end
-        // touches the geometry. Refused until that is in (docs/harness.md).
-        for ((slot, c), name) in solver.contact.iter_mut().zip(&cables).zip(&tree.names) {
-            if c.solver.contact.is_some() {
-                return Err(PyValueError::new_err(format!(
-                    "cable '{name}': contact with the geometry is not supported yet on \
-                     harness cables (the junction coupling lacks the contact stiffness of \
-                     joined ends)"
-                )));
-            }
+        // Contact set on a cable (`Cable.set_contact`) is a term of its harness assembly
+        // (static and quasistatic; dynamic runs refuse it, `run_dynamic`).
+        for (slot, c) in solver.contact.iter_mut().zip(&cables) {
             slot.clone_from(&c.solver.contact);
         }
         let obstacle_poses = cables.iter().map(|c| c.obstacle_poses.clone()).collect();

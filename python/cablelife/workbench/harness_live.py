@@ -36,10 +36,11 @@ def build_harness(scene: Scene, live_cable) -> tuple[LiveHarness, dict]:
     from cablelife.harness import harness_cables
     from cablelife.simulate import build_cable, clip_poses
 
-    if scene.contact is not None:
+    if scene.contact is not None and scene.contact.enabled:
         raise SceneError(
-            "contact with the geometry is not supported yet for harnesses (scenes with "
-            "[[junctions]]); remove [contact] or the junctions"
+            "the workbench does not solve contact on harnesses (scenes with [[junctions]]) "
+            "yet; set contact.enabled = false here, `cablelife run` solves it (static, "
+            "quasistatic)"
         )
     cables, specs = harness_cables(scene)
     cores = [build_cable(scene, c) for c in cables]
