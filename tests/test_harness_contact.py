@@ -255,3 +255,23 @@ def test_cablelife_run_of_a_harness_on_a_table(tmp_path):
     total, weight = weight_carried(back, extra_mass=0.02)
     assert total[0] == pytest.approx([0.0, 0.0, weight], abs=1e-6 * weight)
     assert all("contact_gap" in c.contact for c in back.cables.values())
+
+
+def test_compressed_pair_on_a_table_escapes_to_a_stable_buckled_state():
+    # The joined pair clamped 2 mm short of its length (compressed ~12× beyond its Euler load)
+    # above a table: the straight equilibrium Newton finds is unstable; the stability check
+    # counts with the (frictionless) contact stiffness and the escape leaves it for the
+    # buckled state lying on the table, bent sideways (gravity keeps it down).
+    d = pair(16)
+    d["cables"][0]["clips"][0]["position"] = [-0.499, 0.0, 0.0]
+    d["cables"][1]["clips"][0]["position"] = [0.499, 0.0, 0.0]
+    res = simulate(scene_from_dict(table(d, z=-0.0041)))
+    for c in res.cables.values():
+        assert c.solver["unstable"][0] == 0, c.name
+        assert np.ptp(c.positions[0, :, 1]) > 0.01  # buckled sideways
+        assert np.all(c.contact["contact_gap"] > -0.01 * R)
+    # With friction the symmetric tangent is no stability criterion: not checked (−1).
+    res = simulate(scene_from_dict(table(y_scene(mass=0.02), friction=0.3)))
+    assert all(c.solver["unstable"][0] == -1 for c in res.cables.values())
+    res = simulate(scene_from_dict(table(y_scene(mass=0.02))))
+    assert all(c.solver["unstable"][0] == 0 for c in res.cables.values())

@@ -233,8 +233,8 @@ impl Harness {
                     Err(e) => return (out, Some(format!("step {k}: {e}")), None),
                 };
                 // (the solver has counted at its result already unless the loads are not
-                // conservative: harness_escape). With contact the stability count (of the
-                // harness without it) is skipped: `unstable` −1, not checked (docs/harness.md).
+                // conservative: harness_escape). With contact the solve counts it (frictionless
+                // contact in K) or skips it (friction: `unstable` −1, not checked).
                 if stats.unstable.is_none() && !solver.has_contact() {
                     match stability.negative_count(tree, &st) {
                         Ok(n) => stats.unstable = Some(n),

@@ -51,7 +51,13 @@ impl HarnessStatics {
             .cables
             .iter()
             .any(|r| r.edge_moment.iter().any(|m| *m != Vector3::zeros()));
-        if moments || self.sliding.iter().any(Option::is_some) {
+        // Friction in contact is not conservative (as `Statics::ensure_stable`).
+        let frictional = self
+            .contact
+            .iter()
+            .flatten()
+            .any(|c| c.active > 0 && c.obstacles.iter().any(|o| o.friction > 0.0));
+        if moments || frictional || self.sliding.iter().any(Option::is_some) {
             stats.unstable = None;
             return Ok(());
         }
@@ -72,7 +78,7 @@ impl HarnessStatics {
         stats: &mut SolveStats,
         modal: &mut ModalSystem,
     ) -> Result<(), HarnessError> {
-        let count = modal.negative_count(h, st)?;
+        let count = modal.negative_count_with_contact(h, st, &mut self.contact)?;
         stats.unstable = Some(count);
         if count == 0 {
             return Ok(());
@@ -83,7 +89,7 @@ impl HarnessStatics {
             .iter()
             .map(|r| r.spec.length)
             .fold(f64::INFINITY, f64::min);
-        let Some((_, dc, dj)) = modal.unstable_mode(h, st)? else {
+        let Some((_, dc, dj)) = modal.unstable_mode(h, st, &mut self.contact)? else {
             return Ok(());
         };
         let (mut dx, mut dth) = (0.0f64, 0.0f64);
@@ -134,7 +140,7 @@ impl HarnessStatics {
             if let Ok(s) = relaxed {
                 stats.iterations += s.iterations;
                 stats.residual = s.residual;
-                let count = modal.negative_count(h, st)?;
+                let count = modal.negative_count_with_contact(h, st, &mut self.contact)?;
                 if count == 0 {
                     stats.unstable = Some(0);
                     stats.escapes += 1;

@@ -11,6 +11,7 @@
 //! eigenvalues of K − σM is the number of negative pivots of the tree LDLᵀ — the cables' chain
 //! pivots plus the junction pivots (the Schur complements of the tree elimination).
 use crate::block_tridiag::Block;
+use crate::contact::Contact;
 use crate::harness::{Harness, HarnessError, HarnessState};
 use crate::harness_solver::HarnessStatics;
 use crate::modal::{
@@ -98,6 +99,21 @@ impl ModalSystem {
             xc,
             xj,
         }
+    }
+
+    /// `load` with each cable's contact term in K (`contact`: the solver's, per cable; swapped
+    /// in for the assembly and back, nothing copied). Only frictionless contact is
+    /// conservative: with friction the symmetric part is no stability criterion (callers skip).
+    pub fn load_with_contact(
+        &mut self,
+        h: &Harness,
+        st: &HarnessState,
+        contact: &mut Vec<Option<Contact>>,
+    ) -> Result<(), HarnessError> {
+        std::mem::swap(&mut self.k.contact, contact);
+        let result = self.load(h, st);
+        std::mem::swap(&mut self.k.contact, contact);
+        result
     }
 
     /// Assembles the symmetric tangent stiffness of `h` at `st`.
@@ -247,10 +263,25 @@ impl ModalSystem {
         st: &HarnessState,
     ) -> Result<usize, HarnessError> {
         self.load(h, st)?;
+        Ok(self.loaded_negative_count(h))
+    }
+
+    /// `negative_count` with each cable's (frictionless) contact in K (`load_with_contact`).
+    pub fn negative_count_with_contact(
+        &mut self,
+        h: &Harness,
+        st: &HarnessState,
+        contact: &mut Vec<Option<Contact>>,
+    ) -> Result<usize, HarnessError> {
+        self.load_with_contact(h, st, contact)?;
+        Ok(self.loaded_negative_count(h))
+    }
+
+    fn loaded_negative_count(&mut self, h: &Harness) -> usize {
         let scale = eigen_scale(self);
-        Ok(HarnessPencil { h, s: self }
+        HarnessPencil { h, s: self }
             .factor_near(0.0, 1e-12 * scale)
-            .1)
+            .1
     }
 }
 
@@ -268,8 +299,9 @@ impl ModalSystem {
         &mut self,
         h: &Harness,
         st: &HarnessState,
+        contact: &mut Vec<Option<Contact>>,
     ) -> Result<Option<UnstableMode>, HarnessError> {
-        self.load(h, st)?;
+        self.load_with_contact(h, st, contact)?;
         let scale = eigen_scale(self);
         let n = self.m.len();
         let mut p = HarnessPencil { h, s: self };

@@ -207,8 +207,17 @@ fn strained_pair(n: usize, strain: f64) -> (Harness, HarnessState) {
 
 /// Negative eigenvalues of the dense assembled symmetric stiffness over the active unknowns.
 fn dense_negative_count(h: &Harness, st: &HarnessState) -> usize {
+    dense_negative_count_with(h, st, &mut vec![None; h.cables.len()])
+}
+
+/// `dense_negative_count` with each cable's contact term in the stiffness.
+fn dense_negative_count_with(
+    h: &Harness,
+    st: &HarnessState,
+    contact: &mut Vec<Option<crate::contact::Contact>>,
+) -> usize {
     let mut p = ModalSystem::new(h);
-    p.load(h, st).unwrap();
+    p.load_with_contact(h, st, contact).unwrap();
     let mut slots = Vec::new(); // (cable or None for the junction, block, slot)
     for (c, rod) in h.cables.iter().enumerate() {
         for (b, m) in rod.mask.iter().enumerate() {
@@ -267,6 +276,45 @@ fn tree_inertia_counts_the_negative_eigenvalues_of_the_dense_stiffness() {
     // The modal analysis refuses the unstable equilibrium with a clear error.
     let e = harness_lowest_modes(&h, &st, 3).unwrap_err();
     assert!(e.0.contains("unstable"), "{e}");
+}
+
+/// The compressed pair (beyond its first buckling loads) lying on a table, every node inside the
+/// barrier's reach: the tree inertia with the (frictionless) contact stiffness in K equals the
+/// dense count, and contact removes the buckling modes that push into the table (those in the
+/// table's plane stay).
+#[test]
+fn tree_inertia_with_contact_counts_the_dense_stiffness_with_contact() {
+    use crate::contact::{Contact, ContactOptions, Obstacle, Plane};
+    use crate::model::Pose;
+    use crate::rotation::Quat;
+    let r = 0.005;
+    let (h, st) = strained_pair(6, -1e-6);
+    let opts = ContactOptions::for_radius(r);
+    let below = Pose {
+        position: Vector3::new(0.0, 0.0, -r - 0.1 * opts.distance),
+        orientation: Quat::identity(),
+    };
+    let mut contact: Vec<Option<Contact>> = h
+        .cables
+        .iter()
+        .map(|rod| {
+            let table = Obstacle::new("table", 0, Box::new(Plane), 0.0, &below);
+            Some(Contact::new(rod, vec![table], opts.clone(), 1).unwrap())
+        })
+        .collect();
+    let free = harness_negative_count(&h, &st).unwrap();
+    let dense = dense_negative_count_with(&h, &st, &mut contact);
+    let tree = ModalSystem::new(&h)
+        .negative_count_with_contact(&h, &st, &mut contact)
+        .unwrap();
+    eprintln!("negative eigenvalues: {free} without contact, {tree} with");
+    assert_eq!(tree, dense);
+    assert!(
+        tree >= 1 && tree < free,
+        "with contact {tree}, without {free}"
+    );
+    // The solver's contact terms are handed back.
+    assert!(contact.iter().all(Option::is_some));
 }
 
 /// The first root β of a clamped–clamped beam of length 2a with a point mass `mass` at its

@@ -729,10 +729,9 @@ impl HarnessStatics {
             self.solve_static_inner(h, st)
         }
         .and_then(|mut s| {
-            // an unstable equilibrium is left (harness_escape); the count has no contact term
-            if !self.has_contact() {
-                self.ensure_stable(h, st, &mut s)?;
-            }
+            // an unstable equilibrium is left (harness_escape; frictionless contact in the
+            // count, friction skips it)
+            self.ensure_stable(h, st, &mut s)?;
             Ok(s)
         });
         result.and_then(|s| self.check_sliding(h, st).map(|_| s))
