@@ -1419,3 +1419,35 @@ def test_time_slider_moves_the_geometry_for_clearance(near_engine_copy):
         clearance = np.array(session.state()["cables"]["hose"]["values"]["clearance"]) / 1e3
         np.testing.assert_allclose(clearance, ref.clearance[k], atol=1e-9)
     assert np.abs(ref.clearance - ref.clearance[0]).max() > 1e-3  # the engine does move
+
+
+def test_harness_on_a_table_follows_the_dragged_table(tmp_path):
+    """Contact on a harness in the workbench: the Y lies on a table (contact solved with the
+    obstacles at rest), the table dragged up 5 mm in five moves lifts it, and the harness
+    equals the quasistatic run that lifts the table through the same poses; undo brings it
+    back."""
+    import tomli_w
+    from cablelife.simulate import simulate
+    from test_harness_contact import TABLE_Z, R, table, y_scene
+
+    d = table(y_scene(mass=0.02))
+    path = tmp_path / "y.toml"
+    path.write_bytes(tomli_w.dumps(d).encode())
+    session = Session.open(path)
+    j0 = session.harness.junction_positions[0].copy()
+    assert j0[2] - R - TABLE_Z == pytest.approx(0.0, abs=0.01 * R)  # on the table
+    for k in range(1, 6):
+        moved = session.move_body("table", [0.0, 0.0, 0.001 * k])
+        assert all(m == "" for m in moved.values()), moved
+    j1 = session.harness.junction_positions[0]
+    assert j1[2] - j0[2] == pytest.approx(0.005, abs=0.01 * R)  # lifted with the table
+    d["simulation"].update(mode="quasistatic", duration=1.0, time_step=0.2)
+    lift = {"type": "table", "t": [0.0, 1.0], "value": [0.0, 0.005]}
+    d["bodies"][0]["motion"] = [{"channel": "z", "signal": lift}]
+    ref = simulate(scene_from_dict(d))
+    for name, live in session.cables.items():
+        np.testing.assert_allclose(
+            live.state.positions, ref.cables[name].positions[-1], rtol=0, atol=1e-8
+        )
+    assert all(session.undo() for _ in range(5))
+    np.testing.assert_allclose(session.harness.junction_positions[0], j0, rtol=0, atol=1e-8)

@@ -158,6 +158,12 @@ class Harness:
         keeps the previous (the workbench's drags).
         """
         ...
+    def update_contact(self, cables) -> Any:
+        """Takes each cable's contact term and obstacle poses again from `cables` (the cables it
+        was built from, after `Cable.set_contact` moved their obstacles: the workbench's body
+        drags); the harness keeps its own copies otherwise.
+        """
+        ...
     def modes(self, count, shear_tau=None, bend_tau=None) -> Any:
         """The `count` lowest natural modes of the whole harness about the last step of
         `run_sequence` (a static equilibrium): shift-invert on the tree elimination

@@ -89,6 +89,24 @@ impl Harness {
         })
     }
 
+    /// Takes each cable's contact term and obstacle poses again from `cables` (the cables it
+    /// was built from, after `Cable.set_contact` moved their obstacles: the workbench's body
+    /// drags); the harness keeps its own copies otherwise.
+    fn update_contact(&mut self, cables: Vec<PyRef<'_, Cable>>) -> PyResult<()> {
+        if cables.len() != self.tree.cables.len() {
+            return Err(PyValueError::new_err(format!(
+                "update_contact: {} cables for a harness of {}",
+                cables.len(),
+                self.tree.cables.len()
+            )));
+        }
+        for (c, cable) in cables.iter().enumerate() {
+            self.solver.contact[c].clone_from(&cable.solver.contact);
+            self.obstacle_poses[c].clone_from(&cable.obstacle_poses);
+        }
+        Ok(())
+    }
+
     /// (cable index, clip index, junction index) of every joined end, in the order of the
     /// branch outputs.
     #[getter]

@@ -29,21 +29,19 @@ class LiveHarness:
     message: str = ""
 
 
-def build_harness(scene: Scene, live_cable) -> tuple[LiveHarness, dict]:
+def build_harness(scene: Scene, live_cable, set_contact) -> tuple[LiveHarness, dict]:
     """The harness solver of ``scene`` and a LiveCable per cable (made by ``live_cable(cable
-    spec, core, positions, quaternions)`` with the user's clips' poses), not solved yet."""
+    spec, core, positions, quaternions)`` with the user's clips' poses), not solved yet;
+    with contact, ``set_contact(core, scene, cable)`` gives each cable its contact term."""
     from cablelife import _core
     from cablelife.harness import harness_cables
     from cablelife.simulate import build_cable, clip_poses
 
-    if scene.contact is not None and scene.contact.enabled:
-        raise SceneError(
-            "the workbench does not solve contact on harnesses (scenes with [[junctions]]) "
-            "yet; set contact.enabled = false here, `cablelife run` solves it (static, "
-            "quasistatic)"
-        )
     cables, specs = harness_cables(scene)
     cores = [build_cable(scene, c) for c in cables]
+    if scene.contact is not None and scene.contact.enabled:
+        for c, co in zip(cables, cores, strict=True):  # the obstacles of the bodies at rest
+            set_contact(co, scene, c)
     try:
         core = _core.Harness(cores, [c.name for c in cables], specs,
                              max_iterations=scene.simulation.max_iterations)  # fmt: skip

@@ -181,7 +181,7 @@ class Session:
         """A fresh harness solver for the whole tree, solved from the routed shapes."""
         from cablelife.workbench.harness_live import build_harness
 
-        self.harness, lives = build_harness(self.scene, self._live_cable)
+        self.harness, lives = build_harness(self.scene, self._live_cable, self._set_contact)
         self.cables.update(lives)
         self._solve_harness({})
 
@@ -211,7 +211,15 @@ class Session:
     def _contact_on(self, body) -> bool:
         """Contact is solved and ``body`` carries obstacles."""
         c = self.scene.contact
-        return c is not None and c.enabled and bool(body.geometry) and self.harness is None
+        return c is not None and c.enabled and bool(body.geometry)
+
+    def _set_contacts(self, scene: Scene) -> None:
+        """Every cable's contact term with the obstacles of ``scene`` (a harness takes its
+        cables' terms again: it keeps copies)."""
+        for cable in self.scene.cables:
+            self._set_contact(self.cables[cable.name].core, scene, cable)
+        if self.harness is not None:
+            self.harness.core.update_contact([self.cables[n].core for n in self.harness.names])
 
     @staticmethod
     def _set_contact(core, scene: Scene, cable: Cable) -> None:
@@ -398,7 +406,7 @@ class Session:
                     targets.setdefault(
                         cable.name, (live.clip_positions.copy(), live.clip_quaternions.copy(), [])
                     )
-                    self._set_contact(live.core, moved, cable)
+                self._set_contacts(moved)
             keep = {n: (c.state, c.clip_positions, c.clip_quaternions, c.message)
                     for n, c in self.cables.items()}  # fmt: skip
             keep_junctions = None
@@ -416,8 +424,7 @@ class Session:
                         keep_junctions
                     )
                 if contact:
-                    for cable in self.scene.cables:
-                        self._set_contact(self.cables[cable.name].core, self.scene, cable)
+                    self._set_contacts(self.scene)
                 return errors
             if mark:
                 self._push_undo()
@@ -781,8 +788,8 @@ class Session:
             if contact or not (np.array_equal(pos[0], live.clip_positions)
                                and np.array_equal(quat[0], live.clip_quaternions)):  # fmt: skip
                 targets[cable.name] = (pos[0], quat[0])
-                if contact:
-                    self._set_contact(live.core, scene, cable)
+        if contact:
+            self._set_contacts(scene)
         if not all(self._solve_targets(targets)):
             return False
         self.scene = scene
