@@ -231,13 +231,6 @@ def run_harness(scene: Scene, times: np.ndarray, mode: str, progress, stop):
             f"mode = {mode!r}: {mode} analysis of harnesses (scenes with [[junctions]]) is not "
             "supported yet; allowed for harnesses: 'static', 'quasistatic', 'dynamic'"
         )
-    contact = scene.contact is not None and scene.contact.enabled
-    if contact and mode == "dynamic":
-        raise SceneError(
-            "contact with the geometry is not supported yet in dynamic harness runs (scenes "
-            "with [[junctions]]); allowed with contact: mode = 'static' or 'quasistatic' "
-            "(or set contact.enabled = false: clearance is computed without it)"
-        )
     cables, specs = harness_cables(scene)
     cores = [build_cable(scene, c) for c in cables]
     for c, co in zip(cables, cores, strict=True):  # each cable's contact: a harness term

@@ -165,7 +165,7 @@ impl Record {
     }
 
     /// Room for the contact outputs of `n` saved steps.
-    fn reserve_contact(&mut self, n: usize, nodes: usize, bodies: usize) {
+    pub(crate) fn reserve_contact(&mut self, n: usize, nodes: usize, bodies: usize) {
         self.contact_normal.reserve(n * 3 * nodes);
         self.contact_friction.reserve(n * 3 * nodes);
         self.contact_state.reserve(n * nodes);

@@ -472,12 +472,6 @@ impl Harness {
         progress_every: usize,
         stop: Option<Bound<'py, StopFlag>>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        if self.solver.has_contact() {
-            return Err(PyValueError::new_err(
-                "contact with the geometry is not supported yet in dynamic harness runs; \
-                 allowed: static and quasistatic",
-            ));
-        }
         if !(newton_tolerance > 0.0 && newton_tolerance < 1.0) {
             return Err(PyValueError::new_err(format!(
                 "newton_tolerance = {newton_tolerance}: allowed is 0 < tolerance < 1"
@@ -579,6 +573,7 @@ impl Harness {
             ..Default::default()
         };
         let solver = &mut self.solver;
+        let obstacle_poses = &self.obstacle_poses;
         let every = output_every.max(1);
         let mut poller = Poller::new(stop.as_ref(), progress, progress_every, t);
         let (nj, ne) = (tree.junctions.len(), tree.ends.len());
@@ -625,11 +620,29 @@ impl Harness {
                 .map(|m| m.iter().map(|x| x.pose).collect())
                 .collect();
             st.set_clip_poses(tree, &poses);
+            for (c, contact) in solver.contact.iter_mut().enumerate() {
+                if let (Some(c), Some(p)) = (contact, obstacle_at(&obstacle_poses[c], 0)) {
+                    c.set_obstacle_poses(p);
+                }
+            }
+            for ((rec, c), rod) in out
+                .records
+                .iter_mut()
+                .zip(&solver.contact)
+                .zip(&tree.cables)
+            {
+                if let Some(c) = c {
+                    rec.reserve_contact(saved, rod.arc.len(), c.body_force.len());
+                }
+            }
             let stats = match solver.solve_static(tree, &mut st) {
                 Ok(s) => s,
                 Err(e) => return (out, Some(format!("static equilibrium at t = 0: {e}"))),
             };
             let mut hd = HarnessDynamics::new(tree, &st, &motions[0], opts);
+            for (dy, c) in hd.cables.iter_mut().zip(&solver.contact) {
+                dy.contact.clone_from(c); // each cable's contact: a term of its assembly
+            }
             for (c, (ts, tb)) in taus.iter().enumerate() {
                 hd.set_retardation_times(tree, c, *ts, *tb);
             }
@@ -645,6 +658,9 @@ impl Harness {
                         rec.push_sliding(rod, dy.sliding.as_ref());
                         rec.push_viscous(&dy.ws);
                         rec.push_energies(&dy.energies);
+                        if let Some(c) = &dy.contact {
+                            rec.push_contact(c);
+                        }
                     }
                     for (pose, v) in st.junctions.iter().zip(hd.junction_velocities()) {
                         out.jpos.extend_from_slice(pose.position.as_slice());
@@ -676,6 +692,13 @@ impl Harness {
                 };
             record(&mut out, &hd, &st, &stats);
             for k in 1..t {
+                for (c, dy) in hd.cables.iter_mut().enumerate() {
+                    if let (Some(c), Some(p)) =
+                        (&mut dy.contact, obstacle_at(&obstacle_poses[c], k))
+                    {
+                        c.set_obstacle_poses(p);
+                    }
+                }
                 match hd.advance(tree, &mut st, time_step, &motions[k - 1], &motions[k], 6) {
                     Ok(s) => {
                         if k % every == 0 {

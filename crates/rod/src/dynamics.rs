@@ -794,8 +794,20 @@ impl Dynamics {
         if alpha >= 1.0 {
             return None;
         }
-        // Δq = dq0 + k_dq v̇ → α Δq.
-        for b in seg.blocks.clone() {
+        Some(self.scale_predictor(st, h, alpha, seg.blocks.clone()))
+    }
+
+    /// The predictor's step Δq = dq0 + k_dq v̇ of `blocks` shortened to α Δq (the kinematics
+    /// updated; returns the new increment): `limit_predictor`, and the harness's with the
+    /// bound over every cable.
+    pub(crate) fn scale_predictor(
+        &mut self,
+        st: &mut State,
+        h: f64,
+        alpha: f64,
+        blocks: std::ops::Range<usize>,
+    ) -> f64 {
+        for b in blocks.clone() {
             let dq = self.dq0[b] + self.k_dq * self.vdot[b];
             let target = (alpha * dq - self.dq0[b]) / self.k_dq;
             for i in 0..6 {
@@ -804,7 +816,18 @@ impl Dynamics {
                 }
             }
         }
-        Some(self.update_kinematics(st, h, seg.blocks.clone()))
+        self.update_kinematics(st, h, blocks)
+    }
+
+    /// Whether the contact obstacles moved at the start of this step (their work is not
+    /// counted: the energy guard is off for the step).
+    pub(crate) fn obstacles_moved(&self) -> bool {
+        self.obstacles_moved
+    }
+
+    /// The node positions at the start of the step (t_n).
+    pub(crate) fn start_positions(&self) -> &[Vector3<f64>] {
+        &self.x_n
     }
 
     /// Returns to the values at the start of the last (failed) step.

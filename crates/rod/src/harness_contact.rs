@@ -153,4 +153,4 @@ impl HarnessStatics {
 
 #[cfg(test)]
 #[path = "harness_contact_tests.rs"]
-mod tests;
+pub(crate) mod tests;

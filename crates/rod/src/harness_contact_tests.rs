@@ -12,9 +12,9 @@ use crate::routing::route;
 use crate::statics::{NewtonOptions, Statics};
 use nalgebra::Vector6;
 
-const R: f64 = 0.005;
+pub(crate) const R: f64 = 0.005;
 
-fn table(rod: &Rod) -> Contact {
+pub(crate) fn table(rod: &Rod) -> Contact {
     let origin = Pose {
         position: Vector3::zeros(),
         orientation: Quat::identity(),

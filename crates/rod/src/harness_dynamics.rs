@@ -25,6 +25,9 @@ use crate::rotation::{log_vec, right_jacobian, rotate_body, rotation_matrix, ske
 use crate::statics::{NewtonOptions, SolveError};
 use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 
+#[path = "harness_dynamics_contact.rs"]
+mod contact;
+
 fn top(v: &Vector6<f64>) -> Vector3<f64> {
     v.fixed_rows::<3>(0).into()
 }
@@ -507,8 +510,8 @@ impl HarnessDynamics {
             self.cables[c].begin_step(rod, &mut st.cables[c], dt, &self.motions[c]);
         }
         // The junctions: the cables' predictor (v̇_{n+1} = v̇_n: jvdot holds it; constant
-        // velocity after a restart) and kinematics.
-        if restarted {
+        // velocity after a restart and with contact, as the cables') and kinematics.
+        if restarted || self.has_contact() {
             let c_a = ((1.0 - ga.alpha_m) * (-(0.5 - ga.beta) / ga.beta) + ga.alpha_m)
                 / (1.0 - ga.alpha_f);
             let c_v = -ga.alpha_f / (1.0 - ga.alpha_f);
@@ -535,6 +538,9 @@ impl HarnessDynamics {
             err = err.max(dy.local_error(0..rod.arc.len()));
         }
         self.sync_ends(h, st);
+        if let Some(shortened) = self.limit_predictor(h, st, dt) {
+            inc = shortened; // no cable dives through its contact barrier
+        }
         (inc, err)
     }
 
@@ -612,7 +618,15 @@ impl HarnessDynamics {
         let mut last_fresh_norm = f64::INFINITY;
         let mut last_applied = f64::INFINITY;
         let mut converged = false;
-        for it in 0..self.opts.max_iterations {
+        // With contact, the single cable's rules (`Dynamics::solve_segment`): iterations whose
+        // correction the barrier shortened do not count (up to 4× the limit), three strikes.
+        let contact = self.has_contact();
+        let mut budget = self.opts.max_iterations;
+        let mut strikes = 0;
+        let mut next = 0;
+        while next < budget {
+            let it = next;
+            next += 1;
             let refactor = !self.factor_valid || self.factor_h != dt;
             self.assemble(h, st, c_damp, c_mass, refactor)?;
             if refactor {
@@ -627,10 +641,15 @@ impl HarnessDynamics {
                 self.factor_valid = false;
                 continue;
             }
-            if !norm.is_finite() || (refactor && norm >= last_fresh_norm) {
+            if refactor && norm >= last_fresh_norm {
+                strikes += 1;
+            }
+            if !norm.is_finite() || strikes >= if contact { 3 } else { 1 } {
                 // Diverging; the iterate is kept when the correction that led to it was
                 // below `STALL_TOLERANCE` of the step's increment (as `Dynamics`).
-                if it > 0 && norm.is_finite() && last_applied < STALL_TOLERANCE * scale {
+                let touching = contact && self.contact_active();
+                if it > 0 && !touching && norm.is_finite() && last_applied < STALL_TOLERANCE * scale
+                {
                     converged = true;
                     break;
                 }
@@ -640,19 +659,43 @@ impl HarnessDynamics {
             if refactor {
                 last_fresh_norm = norm;
             }
-            let (s, error) = self.apply_correction(h, st, dt, c_mass, 1.0);
+            // Contact: no cable dives through its barrier (the correction is shortened).
+            let alpha = if contact {
+                self.contact_alpha(h, st, dt, c_mass)
+            } else {
+                1.0
+            };
+            if alpha < 1.0 {
+                last_fresh_norm = f64::INFINITY;
+                budget = (budget + 1).min(4 * self.opts.max_iterations);
+            }
+            let (s, error) = self.apply_correction(h, st, dt, c_mass, alpha);
             scale = s;
             last_applied = norm;
             stats.iterations = it + 1;
-            let tolerance = (self.opts.tolerance * error)
-                .min(STALL_TOLERANCE * scale)
-                .max(TOLERANCE_FLOOR * scale)
-                .max(self.opts.abs_tolerance);
-            if norm < tolerance {
+            let active = contact && self.contact_active();
+            let mut tolerance = if contact {
+                STALL_TOLERANCE * scale // the rule contact was verified with (`Dynamics`)
+            } else {
+                (self.opts.tolerance * error)
+                    .min(STALL_TOLERANCE * scale)
+                    .max(TOLERANCE_FLOOR * scale)
+            }
+            .max(self.opts.abs_tolerance);
+            if active {
+                let tight = self.opts.contact_tolerance * scale;
+                tolerance = tolerance.min(tight.max(self.opts.abs_tolerance));
+            }
+            if alpha == 1.0 && norm < tolerance {
                 converged = true;
                 break;
             }
-            if norm > self.opts.refactor_rate * last_norm && !refactor {
+            let rate = if active {
+                self.opts.contact_refactor_rate
+            } else {
+                self.opts.refactor_rate
+            };
+            if norm > rate * last_norm && !refactor {
                 self.factor_valid = false;
             }
             last_norm = norm;
@@ -725,7 +768,20 @@ impl HarnessDynamics {
         to: &[Vec<ClipMotion>],
         max_depth: usize,
     ) -> Result<StepStats, HarnessError> {
-        match self.step(h, st, dt, to) {
+        // With contact near: the energy guard of the single cable (harness_dynamics_contact).
+        let start = if max_depth > 0 {
+            self.energy_start(h, st, dt)?
+        } else {
+            None
+        };
+        let result = match (self.step(h, st, dt, to), start) {
+            (Ok(s), Some(e0)) if self.energy_grew(h, st, &e0)? => Err(HarnessError(format!(
+                "the step gained energy at contact ({} iterations)",
+                s.iterations
+            ))),
+            (r, _) => r,
+        };
+        match result {
             Ok(s) => self.check_sliding(h, st).map(|_| s),
             Err(e) if max_depth == 0 => Err(e),
             Err(_) => {

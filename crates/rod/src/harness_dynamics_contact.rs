@@ -1,0 +1,229 @@
+//! Contact in dynamic harness runs (docs/harness.md, "Surroundings"): each cable's `Contact`
+//! is a term of its dynamic assembly (`Dynamics::assemble`), its entries at joined end nodes
+//! reach the junction blocks (`Workspace::end_jac`); this module holds the single cable's
+//! safeguards taken over the whole tree: the predictor and every Newton correction close at
+//! most 90 % of any gap (`Contact::step_bound`) of any cable, a joined end's node moving with
+//! its junction; and the energy guard of `Dynamics::advance` on the whole harness: near the
+//! geometry a step whose energy (kinetic, elastic, loads, barrier; cables and junctions) grows
+//! by more than `energy_tolerance` of the energies at play, beyond the work of the clips, is
+//! split.
+use super::{top, HarnessDynamics};
+use crate::dynamics::Energies;
+use crate::harness::{Harness, HarnessError, HarnessState};
+use crate::model::Pose;
+use crate::rotation::log_vec;
+use nalgebra::Vector3;
+
+/// A clip's (or held junction's) reaction force and moment on the harness and its pose.
+type Reaction = (Vector3<f64>, Vector3<f64>, Pose);
+
+/// What the energy guard keeps from t_n.
+pub(crate) struct EnergyStart {
+    energies: Energies,
+    /// Per cable, its own clips (not the joined ends: internal to the harness).
+    clips: Vec<Vec<(usize, Reaction)>>,
+    /// Per junction held by a clip.
+    held: Vec<Option<Reaction>>,
+    /// Per cable: dissipated energy and power at t_n (restored when a step is refused).
+    dissipated: Vec<(f64, f64)>,
+}
+
+impl HarnessDynamics {
+    /// Whether any cable has contact.
+    pub fn has_contact(&self) -> bool {
+        self.cables.iter().any(|d| d.contact.is_some())
+    }
+
+    /// Whether samples of some cable are inside the contact barrier (at the last assembly).
+    pub(crate) fn contact_active(&self) -> bool {
+        self.cables
+            .iter()
+            .any(|d| d.contact.as_ref().is_some_and(|c| c.active > 0))
+    }
+
+    /// The largest α ≤ 1 such that the Newton correction in the tree's `delta` and `dj`,
+    /// scaled by α, dives through no cable's barrier. A node moves by h k_dq c_mass δx (v̇ +=
+    /// c_mass δx, x = x_n + h(dq0 + k_dq v̇)), a joined end's node with its junction alike.
+    pub(crate) fn contact_alpha(
+        &self,
+        h: &Harness,
+        st: &HarnessState,
+        dt: f64,
+        c_mass: f64,
+    ) -> f64 {
+        let mut alpha = 1.0f64;
+        for (c, dy) in self.cables.iter().enumerate() {
+            let Some(contact) = &dy.contact else {
+                continue;
+            };
+            let kx = dt * dy.k_dq * c_mass;
+            let (delta, dj, inertial) = (&self.tree.delta[c], &self.tree.dj, &dy.inertial);
+            let dx = |n: usize| {
+                if inertial[n][0] {
+                    return kx * top(&delta[n]);
+                }
+                for &k in &h.cable_ends[c] {
+                    let e = &h.ends[k];
+                    if e.topo.node == n && !h.held[e.junction] {
+                        return kx * top(&dj[e.junction]);
+                    }
+                }
+                Vector3::zeros()
+            };
+            let edges = 0..h.cables[c].n_edges();
+            alpha = alpha.min(contact.step_bound(&st.cables[c].x, dx, edges));
+        }
+        alpha
+    }
+
+    /// Shortens the predictor (from t_n) of every cable and junction by one factor so that no
+    /// cable dives through its barrier; returns the largest increment when it was shortened.
+    pub(crate) fn limit_predictor(
+        &mut self,
+        h: &Harness,
+        st: &mut HarnessState,
+        dt: f64,
+    ) -> Option<f64> {
+        let mut alpha = 1.0f64;
+        for (c, dy) in self.cables.iter().enumerate() {
+            let Some(contact) = &dy.contact else {
+                continue;
+            };
+            let (x, x_n) = (&st.cables[c].x, dy.start_positions());
+            let edges = 0..h.cables[c].n_edges();
+            alpha = alpha.min(contact.step_bound(x_n, |n| x[n] - x_n[n], edges));
+        }
+        if alpha >= 1.0 {
+            return None;
+        }
+        let k_dq = self.cables[0].k_dq;
+        for j in 0..self.jv.len() {
+            if h.held[j] {
+                continue;
+            }
+            let dq = self.jdq0[j] + k_dq * self.jvdot[j];
+            self.jvdot[j] = (alpha * dq - self.jdq0[j]) / k_dq;
+        }
+        let mut inc = self.junction_kinematics(st, dt, true);
+        self.impose_held(st);
+        for (c, rod) in h.cables.iter().enumerate() {
+            let blocks = 0..rod.arc.len();
+            inc = inc.max(self.cables[c].scale_predictor(&mut st.cables[c], dt, alpha, blocks));
+        }
+        self.sync_ends(h, st);
+        Some(inc)
+    }
+
+    /// The energy guard's values at t_n, when some cable is near the geometry (within d̂ plus
+    /// twice the step's travel at the harness's largest speed); None otherwise or without
+    /// contact.
+    pub(crate) fn energy_start(
+        &mut self,
+        h: &Harness,
+        st: &HarnessState,
+        dt: f64,
+    ) -> Result<Option<EnergyStart>, HarnessError> {
+        // The harness's largest speed (as the single cable's over its nodes).
+        let speed = self
+            .cables
+            .iter()
+            .flat_map(|d| d.rates.v.iter())
+            .chain(&self.jv)
+            .map(|v| top(v).norm())
+            .fold(0.0, f64::max);
+        let travel = 2.0 * dt * speed;
+        let near = self.cables.iter().enumerate().any(|(c, dy)| {
+            dy.contact
+                .as_ref()
+                .is_some_and(|k| k.near(&st.cables[c].x, travel))
+        });
+        if !near {
+            return Ok(None);
+        }
+        self.update_outputs(h, st)?;
+        Ok(Some(EnergyStart {
+            energies: self.energies,
+            clips: self.own_clip_reactions(h, st),
+            held: self.held_reactions(h, st),
+            dissipated: self
+                .cables
+                .iter()
+                .map(|d| (d.energies.dissipated, d.power_n))
+                .collect(),
+        }))
+    }
+
+    /// Whether the step just taken from `start` gained energy beyond the clips' work and the
+    /// tolerance (then the dissipated energies are put back: the step will be redone).
+    pub(crate) fn energy_grew(
+        &mut self,
+        h: &Harness,
+        st: &HarnessState,
+        start: &EnergyStart,
+    ) -> Result<bool, HarnessError> {
+        if self.cables.iter().any(|d| d.obstacles_moved()) {
+            return Ok(false); // moving geometry does work that is not counted
+        }
+        self.update_outputs(h, st)?;
+        let work_of = |r0: &Reaction, r1: &Reaction| {
+            let turn = log_vec(&(r1.2.orientation * r0.2.orientation.conjugate()));
+            0.5 * (r0.0 + r1.0).dot(&(r1.2.position - r0.2.position))
+                + 0.5 * (r0.1 + r1.1).dot(&turn)
+        };
+        let mut work = 0.0;
+        for (c0, c1) in start.clips.iter().zip(self.own_clip_reactions(h, st)) {
+            for ((_, r0), (_, r1)) in c0.iter().zip(&c1) {
+                work += work_of(r0, r1);
+            }
+        }
+        for (r0, r1) in start.held.iter().zip(self.held_reactions(h, st)) {
+            if let (Some(r0), Some(r1)) = (r0, r1) {
+                work += work_of(r0, &r1);
+            }
+        }
+        let (e0, e1) = (&start.energies, &self.energies);
+        let total = |e: &Energies| e.kinetic + e.elastic + e.load_potential + e.contact;
+        let scale = e0.kinetic + e1.kinetic + e0.elastic.abs() + e0.contact + work.abs();
+        let grew = total(e1) - total(e0) - work > self.opts.energy_tolerance * scale;
+        if grew {
+            for (dy, &(d, p)) in self.cables.iter_mut().zip(&start.dissipated) {
+                (dy.energies.dissipated, dy.power_n) = (d, p);
+            }
+        }
+        Ok(grew)
+    }
+
+    /// Every cable's own clips (not the joined ends): reaction on the cable and pose.
+    fn own_clip_reactions(&self, h: &Harness, st: &HarnessState) -> Vec<Vec<(usize, Reaction)>> {
+        h.cables
+            .iter()
+            .enumerate()
+            .map(|(c, rod)| {
+                let ends: Vec<usize> = h.cable_ends[c]
+                    .iter()
+                    .map(|&k| h.ends[k].topo.clip)
+                    .collect();
+                (0..rod.spec.clips.len())
+                    .filter(|k| !ends.contains(k))
+                    .map(|k| {
+                        let (f, m) = self.cables[c].ws.clip_reaction(rod, &st.cables[c], k);
+                        (k, (f, m, st.cables[c].clip_pose[k]))
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+
+    /// The reaction of the clip on each junction it holds, with the junction's pose.
+    fn held_reactions(&self, h: &Harness, st: &HarnessState) -> Vec<Option<Reaction>> {
+        self.junction_reactions(h, st)
+            .into_iter()
+            .enumerate()
+            .map(|(j, (f, m))| h.held[j].then_some((f, m, st.junctions[j])))
+            .collect()
+    }
+}
+
+#[cfg(test)]
+#[path = "harness_dynamics_contact_tests.rs"]
+mod tests;
