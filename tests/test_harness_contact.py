@@ -9,7 +9,7 @@ import warnings
 
 import numpy as np
 import pytest
-from cablelife.scene import SceneError, scene_from_dict
+from cablelife.scene import scene_from_dict
 from cablelife.simulate import simulate
 
 SECTION = {"shape": "circle", "radius": 0.004}
