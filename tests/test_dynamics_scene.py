@@ -212,3 +212,30 @@ def test_set_damping_ratio_holds_on_a_sagging_hose(scene_dict):
     zeta, period = free_decay(res.time, y, after=1.0)
     assert zeta == pytest.approx(0.05, rel=0.1)
     assert 2 * math.pi / info["omega1"] == pytest.approx(period, rel=0.03)
+
+
+def test_default_damping_is_held_for_a_first_mode_hardly_bending(scene_dict):
+    # A hose hanging in a U from two clips pointing down and up 0.1 m apart: its first mode is a
+    # swing that gravity stiffens (74 % of its stiffness is bending). The τ that damps it at ζ
+    # would over-damp every bending mode above it; it is held at 2ζ/(ω₁ · MIN_BENDING_SHARE),
+    # the mode gets ζ · share / MIN_BENDING_SHARE from bending, and the run says so.
+    from cablelife.hints import run_hints
+    from cablelife.modal import MIN_BENDING_SHARE, bending_damping_of_mode1
+
+    cable = scene_dict["cables"][0]
+    cable["damping"] = {"ratio": 0.2}
+    a, b = cable["clips"]
+    a.update(direction=[0.0, 0.0, -1.0], normal=[1.0, 0.0, 0.0])
+    b.update(position=[0.1, 0.0, 0.0], direction=[0.0, 0.0, 1.0], normal=[1.0, 0.0, 0.0])
+    scene = scene_from_dict(scene_dict)
+    omega1, per_tau = bending_damping_of_mode1(scene, scene.cables[0])
+    share = 2 * per_tau / omega1
+    assert 0.5 < share < MIN_BENDING_SHARE
+    _, bend, info = retardation_times(scene, scene.cables[0])
+    assert bend[0] == pytest.approx(2 * 0.2 / (omega1 * MIN_BENDING_SHARE), rel=1e-12)
+    assert bend[0] < 0.2 / per_tau  # the unheld calibration would damp more
+    assert info["bending_share"] == pytest.approx(share, rel=1e-12)
+    scene_dict["simulation"].update(mode="dynamic", duration=0.01, time_step=0.001)
+    scene = scene_from_dict(scene_dict)
+    hints = run_hints(scene, simulate(scene))
+    assert any(f"only {100 * share:.0f} % bending" in h for h in hints), hints

@@ -338,6 +338,7 @@ def run_harness(scene: Scene, times: np.ndarray, mode: str, progress, stop):
                 damping_source=info["source"],
                 damping_ratio=info.get("ratio", float("nan")),
                 omega1=info.get("omega1", float("nan")),  # the whole harness's first mode
+                bending_share=info.get("bending_share", float("nan")),
                 viscous_peak=np.asarray(o["viscous_peak"]),
             )
             energies.update(

@@ -10,16 +10,13 @@ import math
 #: flagged: the generalized-α scheme damps and detunes a mode resolved this coarsely.
 STEPS_PER_PERIOD = 20
 
-#: Share of bending in the first mode's stiffness below which the default damping is flagged:
-#: the bending retardation time that gives that mode its ratio ζ damps a pure bending mode
-#: at twice its frequency at 2ζ/share (> 8ζ).
-BENDING_SHARE = 0.25
-
 
 def run_hints(scene, result) -> list[str]:
     """Hints about ``result`` of ``scene``: a dynamic time step that does not resolve the
-    cable's first natural frequency; a default damping calibrated on a first mode that is
-    hardly bending."""
+    cable's first natural frequency; a default damping that cannot give a first mode that is
+    hardly bending its damping ratio."""
+    from cablelife.modal import MIN_BENDING_SHARE
+
     out = []
     if result.mode != "dynamic":
         return out
@@ -36,15 +33,15 @@ def run_hints(scene, result) -> list[str]:
                 f"period of its first natural mode (f₁ = {f1:.3g} Hz); the dynamics are not "
                 f"resolved: use time_step ≤ {1 / (STEPS_PER_PERIOD * f1):.2g} s"
             )
-        zeta, tau = c.solver.get("damping_ratio"), c.solver.get("tau_bend")
-        if c.solver.get("damping_source") == "ratio" and tau is not None and tau[0] > 0:
-            share = 2 * zeta / (tau[0] * w1)  # τ = ζ/ζ₁(1 s), ζ₁(1 s) = share·ω₁/2
-            if share < BENDING_SHARE:
-                out.append(
-                    f"cable '{name}': its first natural mode (f₁ = {f1:.3g} Hz) is only "
-                    f"{100 * share:.0f} % bending; the bending damping that gives it ζ = {zeta:g} "
-                    f"(τ = {tau[0]:.3g} s) damps a bending mode at {2 * f1:.3g} Hz at ζ ≈ "
-                    f"{2 * zeta / share:.2g}: set damping.bending or damping.retardation_time "
-                    f"(s) to choose otherwise (docs/dynamics.md)"
-                )
+        share, zeta = c.solver.get("bending_share"), c.solver.get("damping_ratio")
+        least = MIN_BENDING_SHARE
+        if c.solver.get("damping_source") == "ratio" and share is not None and share < least:
+            out.append(
+                f"cable '{name}': its first natural mode (f₁ = {f1:.3g} Hz) is only "
+                f"{100 * share:.0f} % bending (gravity or extension stiffen it): the default "
+                f"material damping gives it ζ ≈ {zeta * share / least:.2g} instead of "
+                f"{zeta:g} (more would over-damp every bending mode above it); set "
+                f"damping.bending or "
+                f"damping.retardation_time (s) to choose otherwise (docs/dynamics.md)"
+            )
     return out

@@ -185,6 +185,11 @@ def modes(scene: Scene, count: int = 6) -> dict[str, Modes]:
     return {c.name: cable_modes(scene, c, count) for c in scene.cables}
 
 
+#: The least share of bending in the first mode's stiffness for which the default damping
+#: gives that mode its damping ratio ζ (``retardation_times``); below, the bending retardation
+#: time is held at 2ζ/(ω₁ · this) and the mode gets ζ · share / this.
+MIN_BENDING_SHARE = 0.9
+
 #: Loss factor η = ωτ of the default damping of extension, torsion and shear on their lowest
 #: mode (ζ = η/2 = 0.05): a typical polymer's (cable insulation, hose rubber: 0.05 … 0.3).
 DEFAULT_LOSS_FACTOR = 0.1
@@ -254,13 +259,16 @@ def retardation_times(
 
     Default (``ratio`` ζ, 1 unless given): bending gets the τ that gives the first natural
     mode of the mounted cable the damping ratio ζ (ζ = 1: critical), τ = ζ / ζ₁(τ = 1 s) with
-    ζ₁ the mode's Rayleigh damping ratio φᵀC_bφ / (2ω φᵀMφ) (``mode1_bending_damping``);
-    τ = 2ζ/ω₁ only where the mode's bending stiffness is its whole stiffness: where the
-    loads' geometric stiffness lowers ω₁ (a slack, curved or compressed span) it would give
-    several times ζ. A harness's cables are calibrated on the whole tree's mode 1 (``mode1``
-    of the harness): with one ζ on every cable that mode gets ζ exactly. Extension, torsion and
-    shear get a material-like damping: the loss factor
-    η = ``DEFAULT_LOSS_FACTOR`` on their own lowest mode, τ_i = min(τ, η/ω_i)
+    ζ₁ the mode's Rayleigh damping ratio φᵀC_bφ / (2ω φᵀMφ) (``mode1_bending_damping``).
+    The beam rule 2ζ/ω₁ is right only where the mode's bending stiffness is its whole
+    stiffness: where the loads' geometric stiffness lowers ω₁ (a curved or compressed span)
+    it would give several times ζ. Where gravity or extension stiffen mode 1 (a slack span's
+    swing: ``info["bending_share"]`` below ``MIN_BENDING_SHARE``) no bending damping can give
+    it ζ without over-damping the bending modes above it: τ is held at 2ζ/(ω₁ ·
+    MIN_BENDING_SHARE) and the mode gets ζ · share / MIN_BENDING_SHARE. A harness's cables
+    are calibrated on the whole tree's mode 1 (``mode1`` of the harness): with one ζ on every
+    cable that mode gets ζ exactly. Extension, torsion and shear get a material-like damping:
+    the loss factor η = ``DEFAULT_LOSS_FACTOR`` on their own lowest mode, τ_i = min(τ, η/ω_i)
     (``lowest_frequencies``). One τ on all modes would damp extension, torsion and shear
     hundreds of times over-critically and let the viscous forces dominate the section loads
     (docs/dynamics.md). A given ``retardation_time`` applies to all modes. Per-mode values
@@ -277,11 +285,17 @@ def retardation_times(
     else:
         zeta = d.ratio if d.ratio is not None else DEFAULT_DAMPING_RATIO
         omega1, per_tau = mode1 if mode1 is not None else bending_damping_of_mode1(scene, cable)
-        if per_tau > 0:
-            tau = zeta / per_tau  # mode 1's Rayleigh damping ratio from bending is ζ exactly
-        else:  # mode 1 bends nothing (no bending stiffness in it): the beam rule
-            tau = 2 * zeta / omega1 if omega1 > 0 else 0.0
-        info.update(source="ratio", ratio=zeta, omega1=omega1)
+        beam = 2 * zeta / omega1 if omega1 > 0 else 0.0  # a pure bending mode at ω₁ gets ζ
+        # Mode 1's Rayleigh damping ratio from bending is ζ exactly — while at least
+        # MIN_BENDING_SHARE of its stiffness is bending. A mode stiffened by gravity (a slack
+        # span's swing) or by extension is only partly bending, and the τ that would damp it at
+        # ζ over-damps every bending mode above it (bench_contact's draped hose, 45 % bending:
+        # τ = 0.15 s, ζ ≈ 46 at 100 Hz, and Newton failed at 0.53 s); it then gets
+        # ζ · share / MIN_BENDING_SHARE (a run hint says so).
+        cap = beam / MIN_BENDING_SHARE
+        tau = min(zeta / per_tau, cap) if per_tau > 0 else beam
+        share = 2 * per_tau / omega1 if omega1 > 0 else float("nan")
+        info.update(source="ratio", ratio=zeta, omega1=omega1, bending_share=share)
         own = {k: min(tau, DEFAULT_LOSS_FACTOR / w) for k, w in lowest_frequencies(cable).items()}
     info["tau"] = tau
     pick = lambda v, default: default if v is None else v  # noqa: E731

@@ -349,6 +349,7 @@ def _run_cable(
                 damping_source=info["source"],
                 damping_ratio=info.get("ratio", float("nan")),
                 omega1=info.get("omega1", float("nan")),
+                bending_share=info.get("bending_share", float("nan")),
             )
         else:
             pos, quat = clip_poses(scene, cable, times)
