@@ -227,14 +227,16 @@ impl Workspace {
 
     /// Adds ∂r_n/∂x_m (3×3, node rows n, node columns m, n and m equal or adjacent) of a term
     /// acting on node positions: into the cable's matrix when both nodes are free, into
-    /// `end_jac` when one is a held end node, else nowhere (a clip prescribes it).
+    /// `end_jac` when one is a held end node, else nowhere (a clip prescribes it). Two held
+    /// nodes couple nowhere: a one-segment cable joined at both ends loses the contact
+    /// coupling of its two junctions (the residual stays exact; Newton converges linearly).
     pub fn add_node_block(&mut self, rod: &Rod, n: usize, m: usize, block: &Matrix3<f64>) {
         let free = |k: usize| rod.node_kind[k] == NodeKind::Free;
         match (free(n), free(m)) {
             (true, true) => self.jac.add3(n, 0, m, 0, block),
             (false, false) if n != m => {}
-            (held_row, _) => {
-                let end = if held_row { m } else { n };
+            (n_free, _) => {
+                let end = if n_free { m } else { n }; // the held node
                 let last = rod.n_edges();
                 let Some(j) = (end == 0).then_some(0).or((end == last).then_some(1)) else {
                     return;
