@@ -185,6 +185,9 @@ pub struct Obstacle {
     position: Vector3<f64>,
     rotation: Matrix3<f64>,
     moved: bool,
+    /// Added to every signed distance: the solid shrunk by this much (0: as given). The
+    /// push-out continuation of a start inside the geometry (`Contact::set_shrink`).
+    shrink: f64,
 }
 
 impl Obstacle {
@@ -197,6 +200,7 @@ impl Obstacle {
             position: pose.position,
             rotation: rotation_matrix(&pose.orientation),
             moved: true,
+            shrink: 0.0,
         }
     }
 
@@ -216,7 +220,7 @@ impl Obstacle {
         let local = self.rotation.transpose() * (p - self.position);
         let q = self.shape.query(&local);
         PointQuery {
-            distance: q.distance,
+            distance: q.distance + self.shrink,
             normal: self.rotation * q.normal,
             hessian: if q.hessian == Matrix3::zeros() {
                 q.hessian
@@ -231,14 +235,15 @@ impl Obstacle {
     pub fn distance(&self, p: &Vector3<f64>) -> f64 {
         self.shape
             .distance(&(self.rotation.transpose() * (p - self.position)))
+            + self.shrink
     }
 
     /// Signed distance at a global point if within `bound` of the surface, else a value ≥
     /// `bound` (broad phase; [`Shape::distance_within`]).
     #[inline]
     pub fn distance_within(&self, p: &Vector3<f64>, bound: f64) -> f64 {
-        self.shape
-            .distance_within(&(self.rotation.transpose() * (p - self.position)), bound)
+        let local = self.rotation.transpose() * (p - self.position);
+        self.shape.distance_within(&local, bound - self.shrink) + self.shrink
     }
 
     /// Closest points between the segment [a, b] and the obstacle (the distance along the
@@ -632,6 +637,18 @@ impl Contact {
 
     /// Moves the obstacles of body `b` to the body pose (their frames relative to the body are
     /// given by `local`, one per obstacle).
+    /// Shrinks every obstacle by `by` (m, ≥ 0: every signed distance grows by it; 0 restores
+    /// the geometry): the push-out continuation of a cable started inside the geometry
+    /// deeper than the barrier reaches (`Statics::solve`).
+    pub fn set_shrink(&mut self, by: f64) {
+        for o in &mut self.obstacles {
+            o.shrink = by;
+        }
+        for c in &mut self.cache_edges {
+            c.d_mid = f64::INFINITY; // the cached distances are of the former surface
+        }
+    }
+
     pub fn set_obstacle_poses(&mut self, poses: &[Pose]) {
         for (o, p) in self.obstacles.iter_mut().zip(poses) {
             o.set_pose(p);
@@ -871,6 +888,36 @@ impl Contact {
             }
         }
         worst
+    }
+
+    /// Moves every free node whose surface gap is below `margin` out along the obstacle's
+    /// normal to the gap `margin`, and turns the edge frames with their chords (the minimal
+    /// rotation): a feasible start for the barrier (the push-out continuation).
+    pub fn move_out(&self, rod: &Rod, st: &mut State, margin: f64) {
+        let before = st.x.clone();
+        for (n, x) in st.x.iter_mut().enumerate() {
+            if rod.node_kind[n] == NodeKind::Free {
+                self.move_point_out(x, margin);
+            }
+        }
+        for (e, p) in st.p.iter_mut().enumerate() {
+            let (a, b) = (before[e + 1] - before[e], st.x[e + 1] - st.x[e]);
+            if a != b && a.norm() > 0.0 && b.norm() > 0.0 {
+                *p = crate::rotation::min_rotation(&a.normalize(), &b.normalize()) * *p;
+            }
+        }
+    }
+
+    /// Moves a point of the cable's axis whose surface gap is below `margin` out along each
+    /// obstacle's normal to the gap `margin` (`move_out`; a harness junction).
+    pub fn move_point_out(&self, x: &mut Vector3<f64>, margin: f64) {
+        for o in &self.obstacles {
+            let q = o.query(x);
+            let gap = q.distance - self.opts.radius;
+            if gap < margin {
+                *x += (margin - gap) * q.normal;
+            }
+        }
     }
 
     /// Whether a free node of the state lies inside an obstacle (negative gap).

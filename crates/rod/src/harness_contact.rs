@@ -115,6 +115,71 @@ impl HarnessStatics {
         found
     }
 
+    /// The single cable's push-out continuation (`Statics::solve`) over every cable: the
+    /// geometry shrunk until every cable is clear of it, grown back in halving stages, the
+    /// free nodes it reaches moved out along its normal before each solve.
+    fn push_out(
+        &mut self,
+        h: &Harness,
+        st: &mut HarnessState,
+        solve: &mut impl FnMut(
+            &mut Self,
+            &Harness,
+            &mut HarnessState,
+        ) -> Result<SolveStats, HarnessError>,
+    ) {
+        let mut depth = 0.0f64;
+        let mut reach = 0.0f64;
+        for (c, contact) in self.contact.iter().enumerate() {
+            if let Some(k) = contact {
+                if let Some(p) = k.deepest_penetration(&st.cables[c]) {
+                    depth = depth.max(p.depth);
+                }
+                reach = reach.max(k.opts.distance);
+            }
+        }
+        if depth == 0.0 {
+            return;
+        }
+        let mut shrink = depth + 2.0 * reach;
+        let mut last = st.clone();
+        let (mut fraction, mut failures) = (0.5, 0);
+        while shrink > 0.0 && failures < 8 {
+            let next = if shrink <= 4.0 * reach {
+                0.0
+            } else {
+                fraction * shrink
+            };
+            for (c, contact) in self.contact.iter_mut().enumerate() {
+                if let Some(k) = contact {
+                    k.set_shrink(next);
+                    k.move_out(&h.cables[c], &mut st.cables[c], 0.5 * reach);
+                }
+            }
+            // A junction (not held by a clip) moves out with its ends' cables.
+            for e in &h.ends {
+                if let (false, Some(k)) = (h.held[e.junction], &self.contact[e.cable]) {
+                    k.move_point_out(&mut st.junctions[e.junction].position, 0.5 * reach);
+                }
+            }
+            st.sync_ends(h);
+            if solve(self, h, st).is_ok() {
+                (shrink, fraction) = (next, 0.5);
+                last.clone_from(st);
+            } else {
+                st.clone_from(&last);
+                fraction = 0.5 + 0.5 * fraction;
+                failures += 1;
+                if next == 0.0 {
+                    shrink = 8.0 * reach;
+                }
+            }
+        }
+        for k in self.contact.iter_mut().flatten() {
+            k.set_shrink(0.0);
+        }
+    }
+
     /// `solve_static` with contact: a start that runs through the geometry (a routed shape) is
     /// first solved without contact (as `Statics::solve`); the barrier then pushes it out. A
     /// cable left inside is an error naming it.
@@ -138,6 +203,7 @@ impl HarnessStatics {
             }
             self.contact = contact;
             self.mark_deep_edges(Some(st));
+            self.push_out(h, st, &mut solve);
         }
         let result = solve(self, h, st);
         self.mark_deep_edges(None);

@@ -165,3 +165,50 @@ fn jacobian_with_contact_at_a_joined_end_matches_finite_differences() {
         }
     }
 }
+
+/// A route through a pipe (a cylinder across the middle of the pair, axis horizontal, its top
+/// 2 cm above the straight route: the pair without contact sags 2.4 cm into it, beyond the
+/// barrier's reach): the harness static solve pushes every cable and the junction out over the
+/// pipe (the single cable's push-out continuation over the tree; it fails without), the same
+/// equilibrium as the single continuous cable's push-out (frictionless: one equilibrium).
+#[test]
+fn a_pair_routed_through_a_pipe_is_pushed_out_as_the_single_cable() {
+    use crate::contact::Cylinder;
+    let n = 20;
+    let (h, mut st, single, mut st1) = pair_and_single(0.5, n);
+    let radius = 0.05;
+    let pipe = |rod: &Rod| {
+        let pose = Pose {
+            position: Vector3::new(0.5, 0.0, 0.01 - radius),
+            orientation: crate::harness::tests::frame(&Vector3::y()),
+        };
+        let shape = Cylinder {
+            radius,
+            length: f64::INFINITY,
+        };
+        let o = Obstacle::new("pipe", 0, Box::new(shape), 0.0, &pose);
+        Contact::new(rod, vec![o], ContactOptions::for_radius(R), 1).unwrap()
+    };
+    assert!(pipe(&single).penetrates(&single, &st1));
+    let mut s1 = Statics::new(&single, NewtonOptions::default());
+    s1.contact = Some(pipe(&single));
+    s1.solve(&single, &mut st1).unwrap();
+    let mut hs = HarnessStatics::new(&h, NewtonOptions::default());
+    for (slot, rod) in hs.contact.iter_mut().zip(&h.cables) {
+        *slot = Some(pipe(rod));
+    }
+    hs.solve_static(&h, &mut st).unwrap();
+    let mut worst = 0.0f64;
+    for k in 0..=n {
+        worst = worst.max((st.cables[0].x[k] - st1.x[k]).norm());
+        worst = worst.max((st.cables[1].x[k] - st1.x[n + k]).norm());
+    }
+    assert!(worst < 1e-7, "harness vs single cable: {worst} m");
+    for (c, contact) in hs.contact.iter().enumerate() {
+        let gap = contact.as_ref().unwrap().surface_gap(&st.cables[c]).0;
+        assert!(gap > -0.01 * R, "cable {c}: gap {gap}");
+    }
+    // Over the pipe, not under it: the junction (the middle) lies on its top.
+    let zj = st.junctions[0].position.z;
+    assert!((zj - (0.01 + R)).abs() < 0.01 * R, "junction at z = {zj}");
+}

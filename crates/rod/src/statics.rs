@@ -562,6 +562,7 @@ impl Statics {
                 c.mark_deep_edges(Some(&st.x));
             }
             self.contact = contact;
+            pre.iterations += self.push_out(rod, st);
         }
         // Never a silent wrong answer: a cable left inside the geometry, or a start inside it
         // that the solver could not resolve, is an error naming where.
@@ -604,6 +605,68 @@ impl Statics {
         stats.snap = None; // leaving an unstable first solution is no jump of the cable
         self.check_sliding(rod, st)?;
         Ok(stats)
+    }
+
+    /// A cable that lies deeper inside the geometry than the barrier reaches (the equilibrium
+    /// without contact of a route through a solid): the geometry is shrunk until the cable is
+    /// clear of it (every signed distance grown by the depth) and grown back to its true
+    /// surface in halving stages; at each stage the free nodes it reaches are moved out along
+    /// its normal (their edge frames turned with their chords) and the cable is solved from
+    /// there with contact, so it ends on the side of the surface nearest to where it was.
+    /// Returns the iterations spent; a cable that cannot get out (a clip inside the solid) is
+    /// left for the caller's error.
+    fn push_out(&mut self, rod: &Rod, st: &mut State) -> usize {
+        let Some(deep) = self
+            .contact
+            .as_ref()
+            .and_then(|c| c.deepest_penetration(st))
+        else {
+            return 0;
+        };
+        let reach = self.contact.as_ref().map_or(0.0, |c| c.opts.distance);
+        let mut shrink = deep.depth + 2.0 * reach;
+        let mut iterations = 0;
+        let mut last = st.clone();
+        let mut fraction = 0.5; // of the shrink kept at the next stage
+        let mut failures = 0;
+        while shrink > 0.0 && failures < 8 {
+            let next = if shrink <= 4.0 * reach {
+                0.0
+            } else {
+                fraction * shrink
+            };
+            let c = self.contact.as_mut().expect("contact");
+            c.set_shrink(next);
+            c.move_out(rod, st, 0.5 * reach);
+            let r = self.solve_any(rod, st);
+            if std::env::var_os("ROD_DEBUG").is_some() {
+                eprintln!(
+                    "push-out: shrink {next:.3e} -> {:?}",
+                    r.as_ref().map(|s| s.iterations)
+                );
+            }
+            match r {
+                Ok(s) => {
+                    iterations += s.iterations;
+                    (shrink, fraction) = (next, 0.5);
+                    last.clone_from(st);
+                }
+                Err(_) => {
+                    // A smaller stage from the last equilibrium; the caller names a cable
+                    // that still cannot get out.
+                    st.clone_from(&last);
+                    fraction = 0.5 + 0.5 * fraction;
+                    failures += 1;
+                    if next == 0.0 {
+                        shrink = 8.0 * reach; // stages down to zero again
+                    }
+                }
+            }
+        }
+        if let Some(c) = self.contact.as_mut() {
+            c.set_shrink(0.0);
+        }
+        iterations
     }
 
     /// Fails with `RigidBody` if the clips leave a rigid-body motion of a part free.
