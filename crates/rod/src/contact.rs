@@ -892,9 +892,11 @@ impl Contact {
 
     /// Moves every free node whose surface gap is below `margin` out along the obstacle's
     /// normal to the gap `margin`, and turns the edge frames with their chords (the minimal
-    /// rotation): a feasible start for the barrier (the push-out continuation).
-    pub fn move_out(&self, rod: &Rod, st: &mut State, margin: f64) {
-        let before = st.x.clone();
+    /// rotation) from their directions at `since` (default: the positions at the call; a
+    /// harness gives the positions before its junctions moved the held ends): a feasible start
+    /// for the barrier (the push-out continuation).
+    pub fn move_out(&self, rod: &Rod, st: &mut State, margin: f64, since: Option<&[Vector3<f64>]>) {
+        let before = since.map_or_else(|| st.x.clone(), <[Vector3<f64>]>::to_vec);
         for (n, x) in st.x.iter_mut().enumerate() {
             if rod.node_kind[n] == NodeKind::Free {
                 self.move_point_out(x, margin);

@@ -150,19 +150,28 @@ impl HarnessStatics {
             } else {
                 fraction * shrink
             };
-            for (c, contact) in self.contact.iter_mut().enumerate() {
-                if let Some(k) = contact {
-                    k.set_shrink(next);
-                    k.move_out(&h.cables[c], &mut st.cables[c], 0.5 * reach);
-                }
+            let before: Vec<Vec<_>> = st.cables.iter().map(|c| c.x.clone()).collect();
+            for k in self.contact.iter_mut().flatten() {
+                k.set_shrink(next);
             }
-            // A junction (not held by a clip) moves out with its ends' cables.
+            // A junction (not held by a clip) moves out with its ends' cables, then the free
+            // nodes; the edge frames turn from their directions before either moved.
             for e in &h.ends {
                 if let (false, Some(k)) = (h.held[e.junction], &self.contact[e.cable]) {
                     k.move_point_out(&mut st.junctions[e.junction].position, 0.5 * reach);
                 }
             }
             st.sync_ends(h);
+            for (c, contact) in self.contact.iter().enumerate() {
+                if let Some(k) = contact {
+                    k.move_out(
+                        &h.cables[c],
+                        &mut st.cables[c],
+                        0.5 * reach,
+                        Some(&before[c]),
+                    );
+                }
+            }
             if solve(self, h, st).is_ok() {
                 (shrink, fraction) = (next, 0.5);
                 last.clone_from(st);

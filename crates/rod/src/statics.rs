@@ -637,7 +637,7 @@ impl Statics {
             };
             let c = self.contact.as_mut().expect("contact");
             c.set_shrink(next);
-            c.move_out(rod, st, 0.5 * reach);
+            c.move_out(rod, st, 0.5 * reach, None);
             let r = self.solve_any(rod, st);
             if std::env::var_os("ROD_DEBUG").is_some() {
                 eprintln!(
