@@ -10,8 +10,10 @@ the engine shaken by the ISO 16750-3 engine PSD (as the demo), 1 ms steps. Print
 - a dynamic run (generalized-α, default damping and Newton tolerance) of 1 s at 1 ms steps
   through the PSD motion: real-time factor (simulated time / solver wall time; target ≥ 10×)
   and of the whole simulate() call, harness and single cable alternated.
+With --contact, also the dynamic run with a tray (a plane 6 mm below the lowest clip) under
+the harness and contact on: the harness rests on it and touches it while shaken.
 One core: OpenBLAS held to one thread.
-Run: python benchmarks/bench_harness.py [--repeat K]
+Run: python benchmarks/bench_harness.py [--repeat K] [--contact]
 """
 
 from __future__ import annotations
@@ -169,6 +171,21 @@ def main() -> None:
     cpu = (1 / med(hd, 3), 1 / med(sd, 3))
     print(f"{'  × real time (simulate() CPU)':<34} {cpu[0]:>12.2f} {cpu[1]:>14.2f}")
     print(f"{'  Newton iterations per step':<34} {med(hd, 2):>12.2f} {med(sd, 2):>14.2f}")
+    if "--contact" in sys.argv:
+        tray = {"shape": "plane", "name": "tray", "point": [0, 0, -0.106], "normal": [0, 0, 1]}
+        both = []
+        for make in (scene, single):
+            d = make("dynamic", 1.0)
+            d["bodies"].append({"name": "tray", "geometry": [tray]})
+            d["contact"] = {"enabled": True}
+            both.append(scene_from_dict(d))
+        hc, sc = [], []
+        for _ in range(k):
+            hc.append(timed(both[0], 1))
+            sc.append(timed(both[1], 1))
+        print(f"{'dynamic on a tray, contact: solver':<34} {med(hc, 0):>12.3f} {med(sc, 0):>14.3f}")
+        print(f"{'  × real time (solver)':<34} {1 / med(hc, 0):>12.2f} {1 / med(sc, 0):>14.2f}")
+        print(f"{'  Newton iterations per step':<34} {med(hc, 2):>12.2f} {med(sc, 2):>14.2f}")
 
 
 if __name__ == "__main__":

@@ -331,3 +331,45 @@ def test_compressed_pair_on_a_table_escapes_to_a_stable_buckled_state():
     assert all(c.solver["unstable"][0] == -1 for c in res.cables.values())
     res = simulate(scene_from_dict(table(y_scene(mass=0.02))))
     assert all(c.solver["unstable"][0] == 0 for c in res.cables.values())
+
+
+def test_dynamic_harness_resting_on_a_tray_with_the_default_damping():
+    # The default damping is calibrated on the harness's first mode at its equilibrium, which
+    # here rests on a tray (the 5-branch harness of benchmarks/bench_harness.py, 16 segments
+    # per cable): the modal analysis takes the contact stiffness into K. Without it the part
+    # the tray carries is no equilibrium of K alone ("the equilibrium is unstable (1 negative
+    # stiffness eigenvalue)") and the run stopped before its first step.
+    def branch(name, length, *clips):
+        return cable(name, length, 16, list(clips))
+
+    d = {
+        "simulation": {"mode": "dynamic", "duration": 0.02, "time_step": 0.001},
+        "bodies": [
+            {"name": "engine", "origin": [1.0, 0.0, -0.1]},
+            {"name": "tray", "geometry": [
+                {"shape": "plane", "name": "tray", "point": [0, 0, -0.106], "normal": [0, 0, 1]}
+            ]},
+        ],
+        "cables": [
+            branch("trunk", 0.42, clamp("body-1", 0.0, [0.0, 0.0, 0.0], [1, 0, 0])),
+            branch("link", 0.32),
+            branch("a", 0.33, clamp("a-end", 0.33, [0.45, 0.3, 0.0], [0, 1, 0])),
+            branch("b", 0.33, clamp("b-end", 0.33, [0.45, -0.3, 0.0], [0, -1, 0])),
+            branch("c", 0.35, clamp("c-end", 0.35, [1.0, 0.1, -0.05], [1, 0, 0], "engine")),
+            branch("d", 0.37, clamp("d-end", 0.37, [1.0, -0.15, -0.1], [1, 0, 0], "engine")),
+        ],
+        "junctions": [
+            {"name": "j1", "ends": ["trunk:end", "link:start", "a:start", "b:start"],
+             "position": [0.4, 0.0, 0.0],
+             "directions": [[-1, 0, 0], [1, 0, 0], [0.2, 1, 0], [0.2, -1, 0]]},
+            {"name": "j2", "ends": ["link:end", "c:start", "d:start"],
+             "position": [0.7, 0.0, 0.0],
+             "directions": [[-1, 0, 0], [1, 0.3, 0], [1, -0.4, -0.3]]},
+        ],
+        "contact": {"enabled": True},
+    }  # fmt: skip
+    res = simulate(scene_from_dict(d))
+    assert res.complete
+    c = res.cables["trunk"]
+    assert c.solver["damping_source"] == "ratio" and c.solver["omega1"] > 0
+    assert any((k.contact["contact_state"][-1] > 0).any() for k in res.cables.values())

@@ -9,7 +9,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use rod::harness::{Harness as Tree, HarnessState, HarnessStatics, JunctionSpec};
 use rod::harness_dynamics::HarnessDynamics;
-use rod::harness_modal::{harness_damping_ratio, harness_lowest_modes, ModalSystem};
+use rod::harness_modal::{harness_damping_ratio, harness_lowest_modes_with_contact, ModalSystem};
 use rod::routing::route;
 use rod::{ClipMotion, DynamicOptions, NewtonOptions, Pose};
 
@@ -360,8 +360,13 @@ impl Harness {
             PyValueError::new_err("run a static solve (run_sequence) of the harness first")
         })?;
         let tree = &self.tree;
+        let solver = &mut self.solver;
         let modes = py
-            .detach(|| harness_lowest_modes(tree, st, count))
+            .detach(|| {
+                // A harness resting on the geometry: its contact stiffness is part of K.
+                let contact = solver.has_contact().then_some(&mut solver.contact);
+                harness_lowest_modes_with_contact(tree, st, count, contact)
+            })
             .map_err(|e| PyValueError::new_err(e.0))?;
         let k = modes.len();
         let nj = tree.junctions.len();

@@ -371,9 +371,25 @@ pub fn harness_lowest_modes(
     st: &HarnessState,
     count: usize,
 ) -> Result<Vec<HarnessMode>, HarnessError> {
+    harness_lowest_modes_with_contact(h, st, count, None)
+}
+
+/// `harness_lowest_modes` with each cable's contact stiffness in K (`contact`: the solver's
+/// terms, `ModalSystem::load_with_contact`): the modes of a harness resting on the geometry
+/// (without it, the part the contact carries is no equilibrium of K alone and shows as
+/// unstable).
+pub fn harness_lowest_modes_with_contact(
+    h: &Harness,
+    st: &HarnessState,
+    count: usize,
+    contact: Option<&mut Vec<Option<Contact>>>,
+) -> Result<Vec<HarnessMode>, HarnessError> {
     let describe = |e: ModalError| HarnessError(format!("modal analysis of the harness: {e}"));
     let mut sys = ModalSystem::new(h);
-    sys.load(h, st)?;
+    match contact {
+        Some(c) => sys.load_with_contact(h, st, c)?,
+        None => sys.load(h, st)?,
+    }
     let p = &sys;
     let massive =
         p.m.iter()
