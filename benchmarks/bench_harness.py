@@ -172,20 +172,17 @@ def main() -> None:
     print(f"{'  × real time (simulate() CPU)':<34} {cpu[0]:>12.2f} {cpu[1]:>14.2f}")
     print(f"{'  Newton iterations per step':<34} {med(hd, 2):>12.2f} {med(sd, 2):>14.2f}")
     if "--contact" in sys.argv:
+        # The harness only: the single cable's span sags 38 cm below the tray's height (a
+        # push-out that deep fails; docs/contact.md), it would need a tray of its own.
         tray = {"shape": "plane", "name": "tray", "point": [0, 0, -0.106], "normal": [0, 0, 1]}
-        both = []
-        for make in (scene, single):
-            d = make("dynamic", 1.0)
-            d["bodies"].append({"name": "tray", "geometry": [tray]})
-            d["contact"] = {"enabled": True}
-            both.append(scene_from_dict(d))
-        hc, sc = [], []
-        for _ in range(k):
-            hc.append(timed(both[0], 1))
-            sc.append(timed(both[1], 1))
-        print(f"{'dynamic on a tray, contact: solver':<34} {med(hc, 0):>12.3f} {med(sc, 0):>14.3f}")
-        print(f"{'  × real time (solver)':<34} {1 / med(hc, 0):>12.2f} {1 / med(sc, 0):>14.2f}")
-        print(f"{'  Newton iterations per step':<34} {med(hc, 2):>12.2f} {med(sc, 2):>14.2f}")
+        d = scene("dynamic", 1.0)
+        d["bodies"].append({"name": "tray", "geometry": [tray]})
+        d["contact"] = {"enabled": True}
+        hc = [timed(scene_from_dict(d), 1) for _ in range(k)]
+        print(f"{'dynamic on a tray, contact: solver':<34} {med(hc, 0):>12.3f} {'-':>14}")
+        print(f"{'  × real time (solver)':<34} {1 / med(hc, 0):>12.2f} {'-':>14}")
+        print(f"{'  × real time (whole simulate())':<34} {1 / med(hc, 1):>12.2f} {'-':>14}")
+        print(f"{'  Newton iterations per step':<34} {med(hc, 2):>12.2f} {'-':>14}")
 
 
 if __name__ == "__main__":
