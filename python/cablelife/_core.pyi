@@ -116,11 +116,13 @@ class Cable:
         stick_velocity=1e-3,
         max_samples=8,
         meshes=...,
+        damping=5e-4,
     ) -> Any:
         """Contact with rigid obstacles (docs/contact.md): `obstacles` as (name, body index,
         type, dimensions, friction μ); their global poses per time step of the next run,
         `positions` (T, O, 3) and `quaternions` (T, O, 4, scalar first) — T = 1: at rest.
         distance/stick_distance ≤ 0: the defaults for the radius (1 % and 0.1 % of r).
+        `damping`: the normal damping time constant τ_c of dynamic contact, s.
         Type "mesh": dimensions [k], the k-th of `meshes` (vertices (M, 3), faces (F, 3)) in
         the obstacle's frame.
         """

@@ -23,6 +23,7 @@ class ContactSettings(BaseModel):
     stiffness: Annotated[float, Field(ge=0.0)] = 0.0  # κ, N/m² (0: from the weight per length)
     stick_distance: Annotated[float, Field(ge=0.0)] = 0.0  # ε_x, m (0: 0.1 % of r)
     stick_velocity: Annotated[float, Field(gt=0.0)] = 1e-3  # ε_v, m/s
+    damping: Annotated[float, Field(ge=0.0)] = 5e-4  # τ_c, s: normal damping of dynamic contact
 
     @model_validator(mode="before")
     @classmethod
@@ -170,5 +171,6 @@ def set_contact(core, scene, cable, times: np.ndarray) -> None:
         stiffness=c.stiffness,
         stick_distance=c.stick_distance,
         stick_velocity=c.stick_velocity,
+        damping=c.damping,
         meshes=meshes,
     )

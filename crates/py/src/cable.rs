@@ -508,10 +508,12 @@ impl Cable {
     /// type, dimensions, friction μ); their global poses per time step of the next run,
     /// `positions` (T, O, 3) and `quaternions` (T, O, 4, scalar first) — T = 1: at rest.
     /// distance/stick_distance ≤ 0: the defaults for the radius (1 % and 0.1 % of r).
+    /// `damping`: the normal damping time constant τ_c of dynamic contact, s.
     /// Type "mesh": dimensions [k], the k-th of `meshes` (vertices (M, 3), faces (F, 3)) in
     /// the obstacle's frame.
     #[pyo3(signature = (obstacles, n_bodies, radius, positions, quaternions, distance=0.0,
-        stiffness=0.0, stick_distance=0.0, stick_velocity=1e-3, max_samples=8, meshes=vec![]))]
+        stiffness=0.0, stick_distance=0.0, stick_velocity=1e-3, max_samples=8, meshes=vec![],
+        damping=5e-4))]
     #[allow(clippy::too_many_arguments)]
     fn set_contact(
         &mut self,
@@ -526,6 +528,7 @@ impl Cable {
         stick_velocity: f64,
         max_samples: usize,
         meshes: Vec<(PyReadonlyArray2<'_, f64>, PyReadonlyArray2<'_, i64>)>,
+        damping: f64,
     ) -> PyResult<()> {
         let pos = positions.as_array();
         let qs = quaternions.as_array();
@@ -550,6 +553,7 @@ impl Cable {
         opts.stiffness = stiffness;
         opts.stick_velocity = stick_velocity;
         opts.max_samples = max_samples;
+        opts.damping = damping;
         let mut list = Vec::with_capacity(obstacles.len());
         for (k, (name, body, kind, dims, mu)) in obstacles.into_iter().enumerate() {
             let sh = if kind == "mesh" {

@@ -303,6 +303,11 @@ pub struct ContactOptions {
     pub stick_velocity: f64,
     /// Largest number of sample intervals per edge (on curved and sharp geometry).
     pub max_samples: usize,
+    /// Normal damping of dynamic contact, s: a Kelvin–Voigt time constant τ_c on the barrier's
+    /// stiffness (the normal force gains τ_c κ w b''(g) ġ, ġ the gap's rate relative to the
+    /// geometry over the step), so a contact oscillation of frequency f has the damping ratio
+    /// π f τ_c. 0: an elastic contact (it rings on the barrier).
+    pub damping: f64,
 }
 
 impl ContactOptions {
@@ -315,8 +320,19 @@ impl ContactOptions {
             stick_distance: 1e-3 * radius,
             stick_velocity: 1e-3,
             max_samples: 8,
+            damping: 5e-4,
         }
     }
+}
+
+/// b'''(g) of `barrier` (0 on the quadratic continuation below g_s and beyond d̂).
+#[inline]
+pub fn barrier_third(g: f64, dhat: f64) -> f64 {
+    if g >= dhat || g < 1e-3 * dhat {
+        return 0.0;
+    }
+    let d = g - dhat;
+    -6.0 / g + 6.0 * d / (g * g) - 2.0 * d * d / (g * g * g)
 }
 
 /// Barrier b(g), b'(g), b''(g) (times κ elsewhere), zero beyond d̂, C² Taylor continuation
@@ -362,12 +378,14 @@ pub struct SampleTerms {
     pub jac: Matrix3<f64>,
     /// Tangential displacement |u_T| relative to the stick width.
     pub slip_ratio: f64,
-    /// Work of friction over the step (≥ 0).
+    /// Work of friction and of the normal damping over the step (≥ 0).
     pub friction_work: f64,
 }
 
-/// The contact term at a point x with weight w (arc length, m), reference x_ref, obstacle
-/// query q: barrier and friction (μ, stick width ε).
+/// The contact term at a point x with weight w (arc length, m), reference x_ref (the point at
+/// the step's start, carried with the geometry), obstacle query q: barrier, normal damping
+/// (`damping_rate` = τ_c/h, 0 in statics; `gap_ref` the gap of x_ref) and friction (μ, stick
+/// width ε).
 #[allow(clippy::too_many_arguments)]
 #[inline]
 pub fn sample_terms(
@@ -380,6 +398,8 @@ pub fn sample_terms(
     kappa: f64,
     mu: f64,
     eps: f64,
+    damping_rate: f64,
+    gap_ref: f64,
     want_jac: bool,
 ) -> Option<SampleTerms> {
     let g = q.distance - radius;
@@ -389,12 +409,27 @@ pub fn sample_terms(
     let (b, b1, b2) = barrier(g, dhat);
     let kw = kappa * w;
     let n = q.normal;
-    let normal_grad = kw * b1 * n;
+    let mut normal_grad = kw * b1 * n;
     let mut jac = if want_jac {
         kw * (b2 * n * n.transpose() + b1 * q.hessian)
     } else {
         Matrix3::zeros()
     };
+    let mut damping_work = 0.0;
+    if damping_rate > 0.0 {
+        // Normal damping: c Δg n with c = (τ_c/h) κ w b''(g) and Δg = g − g_ref the gap's
+        // change over the step relative to the geometry (Δg/h the backward-difference gap
+        // rate; a point sliding along a curved surface keeps its gap).
+        let dg = g - gap_ref;
+        let c = damping_rate * kw * b2;
+        normal_grad += c * dg * n;
+        damping_work = c * dg * dg;
+        if want_jac {
+            // ∂c/∂x = (τ_c/h) κ w b''' n;  ∂Δg/∂x = n;  ∂n/∂x = H.
+            let c3 = damping_rate * kw * barrier_third(g, dhat);
+            jac += (c3 * dg + c) * n * n.transpose() + c * dg * q.hessian;
+        }
+    }
     let mut friction_grad = Vector3::zeros();
     let mut slip_ratio = 0.0;
     let mut friction_work = 0.0;
@@ -430,7 +465,7 @@ pub fn sample_terms(
         friction_grad,
         jac,
         slip_ratio,
-        friction_work,
+        friction_work: friction_work + damping_work,
     })
 }
 
@@ -442,8 +477,17 @@ pub struct Contact {
     pub opts: ContactOptions,
     /// κ in use, N/m².
     pub kappa: f64,
-    /// Node positions at the start of the step (friction reference).
+    /// Node positions at the start of the step (friction and damping reference).
     reference: Vec<Vector3<f64>>,
+    /// Per obstacle: its pose (position, rotation) when the reference was taken, that pose
+    /// before the current step (restored by `rollback_step`), and the rigid motion x ↦ R x + t
+    /// of the obstacle since the reference was taken (the reference is carried with it).
+    reference_pose: Vec<(Vector3<f64>, Matrix3<f64>)>,
+    reference_pose_n: Vec<(Vector3<f64>, Matrix3<f64>)>,
+    transport: Vec<(Matrix3<f64>, Vector3<f64>)>,
+    /// Per sample (as `cache_samples`): the gap of its reference point, queried once per step
+    /// when the sample first needs it (NaN: not yet).
+    reference_gap: Vec<f64>,
     /// Stick width of the current step (m) and the step duration (dynamics).
     eps: f64,
     step: Option<f64>,
@@ -549,6 +593,13 @@ impl Contact {
         if !(opts.stick_velocity.is_finite() && opts.stick_velocity > 0.0) {
             return bad("stick_velocity", opts.stick_velocity, "must be > 0 m/s");
         }
+        if !(opts.damping.is_finite() && opts.damping >= 0.0) {
+            return bad(
+                "damping",
+                opts.damping,
+                "must be ≥ 0 s (0: an elastic contact)",
+            );
+        }
         if opts.max_samples < 1 {
             return Err(ContactError("contact max_samples = 0: must be ≥ 1".into()));
         }
@@ -590,7 +641,12 @@ impl Contact {
         let n = rod.arc.len();
         let n_obstacles = obstacles.len();
         let opts_samples = opts.max_samples.max(1);
+        let poses: Vec<_> = obstacles.iter().map(|o| (o.position, o.rotation)).collect();
         Ok(Contact {
+            reference_pose_n: poses.clone(),
+            reference_pose: poses,
+            reference_gap: vec![f64::NAN; n_obstacles * n.saturating_sub(1) * (opts_samples + 1)],
+            transport: vec![(Matrix3::identity(), Vector3::zeros()); n_obstacles],
             obstacles,
             kappa,
             eps: opts.stick_distance,
@@ -619,10 +675,25 @@ impl Contact {
     pub fn begin_step(&mut self, x: &[Vector3<f64>], h: Option<f64>) {
         self.reference.copy_from_slice(x);
         self.step = h;
+        // The obstacles' motion since their poses at the reference (set before this step):
+        // friction and damping act on the motion relative to the geometry.
+        self.reference_pose_n.clone_from(&self.reference_pose);
+        self.reference_gap.fill(f64::NAN);
+        for (k, o) in self.obstacles.iter().enumerate() {
+            let (p0, r0) = self.reference_pose[k];
+            let r = o.rotation * r0.transpose();
+            self.transport[k] = (r, o.position - r * p0);
+            self.reference_pose[k] = (o.position, o.rotation);
+        }
         self.eps = match h {
             Some(h) => self.opts.stick_velocity * h,
             None => self.opts.stick_distance,
         };
+    }
+
+    /// Undoes `begin_step`'s record of the obstacle poses (a step rolled back and redone).
+    pub fn rollback_step(&mut self) {
+        self.reference_pose.clone_from(&self.reference_pose_n);
     }
 
     /// Whether an obstacle moved since the last call (and clears the flags).
@@ -990,7 +1061,12 @@ impl Contact {
         };
         let stride = self.opts.max_samples.max(1) + 1;
         let kk = self.samples[k];
-        let (ra, rb) = (self.reference[e], self.reference[e + 1]);
+        let (rot, shift) = self.transport[k];
+        let (ra, rb) = (
+            rot * self.reference[e] + shift,
+            rot * self.reference[e + 1] + shift,
+        );
+        let damping_rate = self.step.map_or(0.0, |h| self.opts.damping / h);
         for i in 0..=kk {
             let t = i as f64 / kk as f64;
             let w = if i == 0 || i == kk { 0.5 } else { 1.0 } * ds / kk as f64;
@@ -1001,6 +1077,14 @@ impl Contact {
                 self.min_gap = self.min_gap.min(q.distance - self.opts.radius);
             }
             let xr = ra + t * (rb - ra);
+            let mut gap_ref = 0.0;
+            if damping_rate > 0.0 && q.distance - self.opts.radius < self.opts.distance {
+                let cached = &mut self.reference_gap[slot * stride + i];
+                if cached.is_nan() {
+                    *cached = o.query(&xr).distance - self.opts.radius;
+                }
+                gap_ref = *cached;
+            }
             let Some(s) = sample_terms(
                 &q,
                 &x,
@@ -1011,6 +1095,8 @@ impl Contact {
                 self.kappa,
                 o.friction,
                 self.eps,
+                damping_rate,
+                gap_ref,
                 want_jac,
             ) else {
                 continue;
@@ -1248,7 +1334,7 @@ mod tests {
                 let (a0, b0) = (p - along, p + 1.1 * along);
                 for slip in [1e-4, 2e-3] {
                     let (ra, rb) = (a0 + Vector3::new(0.5, 1.0, -0.5) * slip, b0);
-                    let eval = |z: &[f64; 6], mu: f64, jac: bool| {
+                    let eval = |z: &[f64; 6], mu: f64, damping: f64, jac: bool| {
                         // Coordinates in units of 1 mm (the FD steps of check_derivatives).
                         let a = a0 + 1e-3 * Vector3::new(z[0], z[1], z[2]);
                         let b = b0 + 1e-3 * Vector3::new(z[3], z[4], z[5]);
@@ -1261,9 +1347,10 @@ mod tests {
                             let xr = ra + tt * (rb - ra);
                             let q = o.query(&x);
                             let w = 0.002;
-                            if let Some(s) =
-                                sample_terms(&q, &x, &xr, w, radius, dhat, 50.0, mu, 1e-3, jac)
-                            {
+                            let gr = o.query(&xr).distance - radius;
+                            if let Some(s) = sample_terms(
+                                &q, &x, &xr, w, radius, dhat, 50.0, mu, 1e-3, damping, gr, jac,
+                            ) {
                                 e += s.energy;
                                 let gr = s.normal_grad + s.friction_grad;
                                 let c = [1.0 - tt, tt];
@@ -1282,15 +1369,17 @@ mod tests {
                         }
                         (e, g, m)
                     };
-                    let (_, g, m) = eval(&[0.0; 6], 0.0, true);
+                    let (_, g, m) = eval(&[0.0; 6], 0.0, 0.0, true);
                     assert!(g.iter().any(|v| *v != 0.0), "{name}: no contact");
                     check_derivatives::<6>(
-                        |z| eval(z, 0.0, false).0,
+                        |z| eval(z, 0.0, 0.0, false).0,
                         |i| 1e-3 * g[i],
                         |i, j| 1e-6 * m[i][j],
                     );
-                    // Friction: the Jacobian of the force.
-                    let (_, _, m) = eval(&[0.0; 6], 0.4, true);
+                    // Friction and normal damping (τ_c/h = 5, the reference moved by `slip`
+                    // across the normal too): the Jacobian of the force.
+                    let damping = 5.0;
+                    let (_, _, m) = eval(&[0.0; 6], 0.4, damping, true);
                     let scale = m.iter().flatten().fold(0.0f64, |s, v| s.max(v.abs()));
                     let h = 1e-5; // 10 nm
                     for j in 0..6 {
@@ -1298,12 +1387,15 @@ mod tests {
                         let mut zm = [0.0; 6];
                         zp[j] = h;
                         zm[j] = -h;
-                        let (gp, gm) = (eval(&zp, 0.4, false).1, eval(&zm, 0.4, false).1);
+                        let (gp, gm) = (
+                            eval(&zp, 0.4, damping, false).1,
+                            eval(&zm, 0.4, damping, false).1,
+                        );
                         for i in 0..6 {
                             let fd = (gp[i] - gm[i]) / (2.0 * h * 1e-3);
                             assert!(
                                 (fd - m[i][j]).abs() < 1e-5 * scale,
-                                "{name} friction jac {i},{j}: fd {fd} analytic {}",
+                                "{name} friction and damping jac {i},{j}: fd {fd} analytic {}",
                                 m[i][j]
                             );
                         }

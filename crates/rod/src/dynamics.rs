@@ -842,6 +842,9 @@ impl Dynamics {
         self.invalidate_factors();
         self.outputs_current = false;
         self.restarted = true;
+        if let Some(c) = &mut self.contact {
+            c.rollback_step();
+        }
     }
 
     fn invalidate_factors(&mut self) {
