@@ -8,6 +8,7 @@ The geometry is on a fixed body (`[[bodies]] geometry`).
 Figures are medians over --repeat K runs (solver wall time: the Rust run, including the static
 equilibrium at t = 0; one core: OpenBLAS held to one thread).
 Run: python benchmarks/bench_contact.py [--quick] [--repeat K] [--only-mesh]
+     [--contact-damping TAU]  (the contact's normal damping τ_c in s; 0: elastic contact)
 """
 
 from __future__ import annotations
@@ -105,6 +106,8 @@ def scene(duration: float, contact: str | None, mode: str = "dynamic") -> dict:
     if contact:
         d["bodies"].append({"name": "surroundings", "geometry": geometry(contact)})
         d["contact"] = {"enabled": True, "friction": 0.2}
+        if "--contact-damping" in sys.argv:
+            d["contact"]["damping"] = float(sys.argv[sys.argv.index("--contact-damping") + 1])
     return d
 
 

@@ -86,6 +86,7 @@ def test_contact_outputs_are_saved_and_read_back(scene_dict, tmp_path):
     [
         ({"enabled": True, "friction": -0.2}, "friction"),
         ({"enabled": True, "distance": float("nan")}, "distance"),
+        ({"enabled": True, "damping": -1e-3}, "damping"),
         (
             {"enabled": True, "geometry": [{"type": "plane"}]},
             r"contact.geometry is no longer read.*\[\[bodies\]\] geometry",

@@ -174,10 +174,12 @@ def test_dynamic_joined_pair_bouncing_on_a_table_equals_the_continuous_cable():
     # The kicked pair bounces on the table with its junction: the harness integrator takes the
     # single cable's contact rules over the tree (step bounds, tolerances, the energy guard and
     # its step splitting), so the same discrete model follows the same path — to round-off
-    # until the guard decides a split differently at a step where its test is borderline
-    # (measured: 1.4e-11 m over the first 222 steps; saved step 223 split differently), and
-    # within the guard's energy tolerance after that (3e-5 m of 5.2 mm: 0.6 %; 1e-3 of the
-    # energies at play per step, bouncing motion is chaotic).
+    # until the two decide a step differently where the test is borderline: the guard's split
+    # or the rest detection (with the contact's normal damping, session 8: 8.6e-14 m over the
+    # first 90 steps, which include the first impact (split at step 85); at step 90 the pair
+    # rests and the single cable takes one more step), and within the guard's energy tolerance
+    # after that (measured 1.8e-5 m of 5.2 mm: 0.35 %; bouncing motion is chaotic). Before the
+    # damping: 1.4e-11 m over the first 222 steps, 3e-5 m after.
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # the kick starts abruptly (a start-up warning)
         pr = simulate(scene_from_dict(shaken(table(pair(16)), 0.005, 0.3)))
@@ -189,7 +191,7 @@ def test_dynamic_joined_pair_bouncing_on_a_table_equals_the_continuous_cable():
     assert one.solver["substeps"].sum() > 0  # the guard split steps
     differ = np.flatnonzero(a.solver["substeps"] != one.solver["substeps"])
     same = differ[0] if differ.size else len(x)
-    assert same > 100  # the first bounces
+    assert same > np.flatnonzero(one.solver["substeps"] > 1)[0]  # the first impact's split
     assert np.abs(x[:same] - one.positions[:same]).max() < 1e-8 * moved
     gap = np.minimum(a.contact["contact_gap"], b.contact["contact_gap"])  # smallest per step
     np.testing.assert_allclose(gap[:same], one.contact["contact_gap"][:same], rtol=0,

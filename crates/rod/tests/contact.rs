@@ -978,6 +978,20 @@ fn a_route_through_a_table_is_pushed_out_onto_it() {
     assert!(worst < 1e-6, "push-out vs rising table: {worst} m");
 }
 
+/// A free cable (no clips) of `n` segments, gravity down (the incline's section).
+fn free_cable(length: f64, n: usize) -> Rod {
+    Rod::new(CableSpec {
+        length,
+        segments: n,
+        section: section(1e4, 1e-3, 0.1),
+        natural_curvature: Vector3::zeros(),
+        clips: vec![],
+        loads: vec![],
+        gravity: Vector3::new(0.0, 0.0, -9.81),
+    })
+    .unwrap()
+}
+
 /// A free straight cable lying on a plane, released a little above its resting gap: it rocks
 /// rigidly on the barrier (every sample alike) with ω² = κ b''(g₀)/(ρA), and the contact's
 /// normal damping (a time constant τ_c on the barrier's stiffness) gives the oscillation the
@@ -987,18 +1001,9 @@ fn a_route_through_a_table_is_pushed_out_onto_it() {
 fn contact_oscillation_has_the_damping_ratio_of_its_time_constant() {
     let r = 0.005;
     let zeta_of = |steps_per_period: f64| -> (f64, f64) {
-        let (l, n) = (0.2, 10);
-        let sec = section(1e4, 1e-3, 0.1);
-        let rod = Rod::new(CableSpec {
-            length: l,
-            segments: n,
-            section: sec.clone(),
-            natural_curvature: Vector3::zeros(),
-            clips: vec![],
-            loads: vec![],
-            gravity: Vector3::new(0.0, 0.0, -9.81),
-        })
-        .unwrap();
+        let n = 10;
+        let rod = free_cable(0.2, n);
+        let sec = rod.spec.section.clone();
         // The resting gap: κ (−b') = ρA g with the automatic κ = ρA g/d̂, i.e. −b'(g₀) = d̂.
         let dhat = ContactOptions::for_radius(r).distance;
         let (mut lo, mut hi) = (1e-6 * dhat, dhat);
@@ -1065,17 +1070,8 @@ fn contact_oscillation_has_the_damping_ratio_of_its_time_constant() {
 #[test]
 fn friction_carries_a_cable_on_a_moving_table() {
     let r = 0.003;
-    let (l, n) = (0.3, 30);
-    let rod = Rod::new(CableSpec {
-        length: l,
-        segments: n,
-        section: section(1e4, 1e-3, 0.1),
-        natural_curvature: Vector3::zeros(),
-        clips: vec![],
-        loads: vec![],
-        gravity: Vector3::new(0.0, 0.0, -9.81),
-    })
-    .unwrap();
+    let n = 30;
+    let rod = free_cable(0.3, n);
     let dhat = ContactOptions::for_radius(r).distance;
     let x = rod
         .arc
