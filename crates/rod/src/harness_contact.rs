@@ -212,7 +212,15 @@ impl HarnessStatics {
             }
             self.contact = contact;
             self.mark_deep_edges(Some(st));
-            self.push_out(h, st, &mut solve);
+            // A shallow start first through the barrier's continuation (as `Statics::solve`);
+            // the push-out when that fails or leaves a cable inside.
+            let shallow = st.clone();
+            let clear = solve(self, h, st).is_ok() && self.penetration_error(h, st).is_none();
+            if !clear {
+                st.clone_from(&shallow);
+                self.mark_deep_edges(Some(st));
+                self.push_out(h, st, &mut solve);
+            }
         }
         let result = solve(self, h, st);
         self.mark_deep_edges(None);
