@@ -173,13 +173,15 @@ def shaken(d: dict, amplitude: float, duration: float) -> dict:
 def test_dynamic_joined_pair_bouncing_on_a_table_equals_the_continuous_cable():
     # The kicked pair bounces on the table with its junction: the harness integrator takes the
     # single cable's contact rules over the tree (step bounds, tolerances, the energy guard and
-    # its step splitting), so the same discrete model follows the same path — to round-off
-    # until the two decide a step differently where the test is borderline: the guard's split
-    # or the rest detection (with the contact's normal damping, session 8: 8.6e-14 m over the
-    # first 90 steps, which include the first impact (split at step 85); at step 90 the pair
-    # rests and the single cable takes one more step), and within the guard's energy tolerance
-    # after that (measured 1.8e-5 m of 5.2 mm: 0.35 %; bouncing motion is chaotic). Before the
-    # damping: 1.4e-11 m over the first 222 steps, 3e-5 m after.
+    # its step splitting), so the same discrete model follows the same path — within the Newton
+    # tolerance with contact (1e-4 of each step's increment: at most that fraction of the
+    # distance travelled) until the two decide a step differently where the test is
+    # borderline: the guard's split or the rest detection (session 8: 5.2e-8 m over the first 90
+    # steps, bound 1.0e-6 m; they include the first impact, split at step 85; at step 90 the
+    # pair rests and the single cable takes one more step), and within the guard's energy
+    # tolerance after that (measured 1.8e-5 m of 5.2 mm: 0.35 %; bouncing motion is chaotic).
+    # With the former contact tolerance 1e-5 and no contact damping the paths agreed to
+    # 1.4e-11 m over the first 222 steps.
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # the kick starts abruptly (a start-up warning)
         pr = simulate(scene_from_dict(shaken(table(pair(16)), 0.005, 0.3)))
@@ -192,10 +194,11 @@ def test_dynamic_joined_pair_bouncing_on_a_table_equals_the_continuous_cable():
     differ = np.flatnonzero(a.solver["substeps"] != one.solver["substeps"])
     same = differ[0] if differ.size else len(x)
     assert same > np.flatnonzero(one.solver["substeps"] > 1)[0]  # the first impact's split
-    assert np.abs(x[:same] - one.positions[:same]).max() < 1e-8 * moved
+    travel = np.abs(np.diff(one.positions[:same], axis=0)).sum(axis=0).max()
+    assert np.abs(x[:same] - one.positions[:same]).max() < 1e-4 * travel
     gap = np.minimum(a.contact["contact_gap"], b.contact["contact_gap"])  # smallest per step
     np.testing.assert_allclose(gap[:same], one.contact["contact_gap"][:same], rtol=0,
-                               atol=1e-9 * moved)  # fmt: skip
+                               atol=1e-4 * travel)  # fmt: skip
     assert np.abs(x - one.positions).max() < 0.02 * moved
 
 

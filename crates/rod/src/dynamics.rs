@@ -135,7 +135,7 @@ impl Default for DynamicOptions {
             refactor_rate: 0.5,
             outputs_every_step: true,
             energy_tolerance: 1e-3,
-            contact_tolerance: 1e-5,
+            contact_tolerance: 1e-4,
             contact_refactor_rate: 0.2,
             contact_line_search: false,
         }
