@@ -497,12 +497,11 @@ fn drop_with(r: f64, mu: f64, line_search: bool, tilt: f64) -> Result<(), (usize
             e <= e0 + 1e-6 * drop_energy,
             "r = {r}, μ = {mu}: step {k}: {e} > {e0}"
         );
-        // With friction the per-step bound does not hold (open, docs/contact.md: measured
-        // 0.67 % of the energy in motion at step 248, the first beyond 2e-3, at μ = 0.3); never
-        // above the start does.
+        // With friction too (before the contact's normal damping, session 8, the μ = 0.3 drop
+        // gained 0.67 % of the energy in motion at step 248 and was exempt).
         let scale = last_kinetic + en.kinetic + last_elastic.abs() + last_contact;
         assert!(
-            mu > 0.0 || e <= last + 2e-3 * scale,
+            e <= last + 2e-3 * scale,
             "r = {r}, μ = {mu}: energy grew at step {k}: {last} → {e} (scale {scale}, {en:?})"
         );
         (last, last_kinetic, last_elastic, last_contact) = (e, en.kinetic, en.elastic, en.contact);
