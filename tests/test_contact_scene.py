@@ -249,3 +249,27 @@ def test_a_cable_held_inside_the_geometry_is_a_clear_error(scene_dict):
     message = str(err.value)
     assert "inside the geometry" in message and "block" in message, message
     assert "node" in message and "mm deep" in message, message
+
+
+def test_modes_and_damping_calibration_rest_on_the_table(scene_dict):
+    """The modal analysis of a cable with contact (and the default damping's calibration of a
+    dynamic run, which uses it) is about the run's own equilibrium resting on the table, with
+    the contact's stiffness in K; before, the equilibrium without contact hung through the
+    table and mode 1 was the span's swing through it."""
+    from cablelife.modal import bending_damping_of_mode1, cable_modes
+
+    scene = scene_from_dict(with_table(scene_dict))
+    cable = scene.cables[0]
+    run = simulate(scene).cable
+    m = cable_modes(scene, cable, 3)
+    np.testing.assert_allclose(m.equilibrium, run.positions[0], atol=1e-9)
+    r = 0.005
+    assert m.equilibrium[:, 2].min() - r - TABLE_Z > -0.01 * r
+    # Without contact: hanging through the table, another mode 1.
+    free = scene_from_dict({**with_table(copy.deepcopy(scene_dict)), "contact": {}})
+    m0 = cable_modes(free, free.cables[0], 3)
+    assert m0.equilibrium[:, 2].min() - r - TABLE_Z < -0.01
+    assert abs(m.omega[0] - m0.omega[0]) > 0.05 * m0.omega[0]
+    # The damping calibration takes mode 1 of the cable on the table.
+    omega1, _ = bending_damping_of_mode1(scene, cable)
+    assert omega1 == pytest.approx(m.omega[0], rel=1e-9)  # 1 mode vs 3: the eigensolver

@@ -45,10 +45,15 @@ class Modes:
 
 
 def _equilibrium(scene: Scene, cable: Cable):
-    """The solver object at the static equilibrium with the clip poses of t = 0."""
+    """The solver object at the static equilibrium with the clip poses of t = 0, with the
+    contact term when ``[contact]`` is enabled (the run's own start: a cable resting on a
+    surface is resting there for its modes and its damping calibration too)."""
+    from cablelife.contact_settings import set_contact
+
     core = build_cable(scene, cable)
     pos, quat = clip_poses(scene, cable, np.array([0.0]), with_motion=True)
     try:
+        set_contact(core, scene, cable, np.array([0.0]))
         out = core.run_sequence(pos, quat)
     except ValueError as err:
         raise SceneError(f"cable '{cable.name}': {err}") from None

@@ -940,8 +940,10 @@ impl Cable {
             .as_ref()
             .ok_or_else(|| PyValueError::new_err("run a static solve (run_sequence) first"))?;
         let rod = &self.rod;
+        // About an equilibrium with contact: the contact stiffness in K.
+        let contact = self.solver.contact.as_mut();
         let modes = py
-            .detach(|| rod::modal::lowest_modes(rod, st, count))
+            .detach(|| rod::modal::lowest_modes_with_contact(rod, st, count, contact))
             .map_err(|e| PyValueError::new_err(e.to_string()))?;
         let k = modes.len();
         let (nodes, edges) = (rod.arc.len(), rod.n_edges());

@@ -23,6 +23,7 @@
 //! eigenvalue is round-off of a zero mode (a free rigid motion), not an instability.
 use crate::assembly::Workspace;
 use crate::block_tridiag::{Block, BlockTridiag};
+use crate::contact::Contact;
 use crate::model::{EdgeKind, NodeKind, Rod};
 use crate::rotation::rotation_matrix;
 use crate::sliding::SlidingClips;
@@ -164,9 +165,23 @@ pub fn lumped_mass(rod: &Rod) -> Vec<Vector6<f64>> {
 
 /// The symmetric tangent stiffness at `st` (inactive slots: identity rows and columns).
 pub fn tangent_stiffness(rod: &Rod, st: &State) -> Result<BlockTridiag, ModalError> {
+    tangent_stiffness_with_contact(rod, st, None)
+}
+
+/// `tangent_stiffness` with the contact term's stiffness (the barrier, and a sticking
+/// friction's tangential spring, symmetrised) when the cable touches its surroundings.
+pub fn tangent_stiffness_with_contact(
+    rod: &Rod,
+    st: &State,
+    contact: Option<&mut Contact>,
+) -> Result<BlockTridiag, ModalError> {
     let mut ws = Workspace::new(rod);
-    ws.assemble_terms(rod, st, 1.0, true, &mut [&mut SlidingClips::of(rod)])
-        .map_err(|k| ModalError::Kink { node: k.node })?;
+    let mut sliding = SlidingClips::of(rod);
+    let assembled = match contact {
+        Some(c) => ws.assemble_terms(rod, st, 1.0, true, &mut [&mut sliding, c]),
+        None => ws.assemble_terms(rod, st, 1.0, true, &mut [&mut sliding]),
+    };
+    assembled.map_err(|k| ModalError::Kink { node: k.node })?;
     let mut k = ws.jac;
     let n = k.n_blocks();
     for b in 0..n {
@@ -371,6 +386,18 @@ fn subspace_iteration<P: ShiftInvert>(
 
 /// The `count` lowest modes of the cable at the equilibrium `st`.
 pub fn lowest_modes(rod: &Rod, st: &State, count: usize) -> Result<Vec<Mode>, ModalError> {
+    lowest_modes_with_contact(rod, st, count, None)
+}
+
+/// `lowest_modes` about an equilibrium in contact with the surroundings: K takes the contact
+/// term's stiffness (`tangent_stiffness_with_contact`), so a cable resting on a surface is an
+/// equilibrium of K (without it the carried part is unsupported).
+pub fn lowest_modes_with_contact(
+    rod: &Rod,
+    st: &State,
+    count: usize,
+    contact: Option<&mut Contact>,
+) -> Result<Vec<Mode>, ModalError> {
     let mass = lumped_mass(rod);
     let m = mass.clone();
     let massive = m
@@ -382,7 +409,7 @@ pub fn lowest_modes(rod: &Rod, st: &State, count: usize) -> Result<Vec<Mode>, Mo
         return Err(ModalError::NoUnknowns);
     }
     let count = count.clamp(1, massive);
-    let k = tangent_stiffness(rod, st)?;
+    let k = tangent_stiffness_with_contact(rod, st, contact)?;
     let n = m.len();
     // Eigenvalue scale for shifts off a singular point: the largest translational K_ii/M_ii.
     let mut scale = 0.0f64;
