@@ -325,6 +325,27 @@ impl ContactOptions {
     }
 }
 
+/// Below this fraction of d̂ the contact's normal damping coefficient stops growing (it is
+/// κ w b''(g) φ(g) τ_c/h above).
+pub const DAMPING_SATURATION: f64 = 1e-2;
+
+/// The fade φ(g) of the contact's normal damping and φ'(g): 1 up to 3/4 of d̂, then
+/// 1 − ((g − ¾d̂)/(¼d̂))² down to 0 at d̂ (C¹ at both ends, so the damping coefficient
+/// κ w b''(g) φ(g) has a continuous slope where samples enter the barrier).
+#[inline]
+pub fn damping_fade(g: f64, dhat: f64) -> (f64, f64) {
+    let g1 = 0.75 * dhat;
+    if g <= g1 {
+        (1.0, 0.0)
+    } else if g >= dhat {
+        (0.0, 0.0)
+    } else {
+        let w = dhat - g1;
+        let u = (g - g1) / w;
+        (1.0 - u * u, -2.0 * u / w)
+    }
+}
+
 /// b'''(g) of `barrier` (0 on the quadratic continuation below g_s and beyond d̂).
 #[inline]
 pub fn barrier_third(g: f64, dhat: f64) -> f64 {
@@ -421,12 +442,25 @@ pub fn sample_terms(
         // change over the step relative to the geometry (Δg/h the backward-difference gap
         // rate; a point sliding along a curved surface keeps its gap).
         let dg = g - gap_ref;
-        let c = damping_rate * kw * b2;
+        // Faded out towards d̂ (C¹ there: b'' alone would switch its slope b''' on at d̂,
+        // and Newton stalls on samples that enter and leave).
+        let (phi, dphi) = damping_fade(g, dhat);
+        // Saturated below d̂/100: b'' grows as 1/g², and a sample a clip drives into the
+        // geometry (its node prescribed) would meet a damping force without bound that no
+        // free node can balance (bench_harness --contact: Newton stalled at 100 N).
+        let (gc, capped) = if g < DAMPING_SATURATION * dhat {
+            (DAMPING_SATURATION * dhat, true)
+        } else {
+            (g, false)
+        };
+        let b2c = barrier(gc, dhat).2;
+        let c = damping_rate * kw * b2c * phi;
         normal_grad += c * dg * n;
         damping_work = c * dg * dg;
         if want_jac {
-            // ∂c/∂x = (τ_c/h) κ w b''' n;  ∂Δg/∂x = n;  ∂n/∂x = H.
-            let c3 = damping_rate * kw * barrier_third(g, dhat);
+            // ∂c/∂x = (τ_c/h) κ w (b''' φ + b'' φ') n;  ∂Δg/∂x = n;  ∂n/∂x = H.
+            let b3c = if capped { 0.0 } else { barrier_third(g, dhat) };
+            let c3 = damping_rate * kw * (b3c * phi + b2c * dphi);
             jac += (c3 * dg + c) * n * n.transpose() + c * dg * q.hessian;
         }
     }
@@ -1327,7 +1361,9 @@ mod tests {
         let dhat = 0.01;
         for (name, shape) in shapes() {
             let o = Obstacle::new(name, 0, shape, 0.4, &tilted());
-            for p in probes(&o, radius + 0.3 * dhat) {
+            // Gaps in the barrier, in the damping's fade (> ¾ d̂) and below its saturation.
+            let gaps = [0.3, 0.85, 0.5 * DAMPING_SATURATION];
+            for p in gaps.iter().flat_map(|f| probes(&o, radius + f * dhat)) {
                 let q0 = o.query(&p);
                 let t = Matrix3::identity() - q0.normal * q0.normal.transpose();
                 let along = (t * Vector3::new(0.3, -0.5, 0.8)).normalize() * 0.004;
