@@ -97,10 +97,6 @@ def _unique_rows(rows: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 def primitive_mesh(part, size: float, near=None) -> tuple[np.ndarray, np.ndarray]:
     """A triangle mesh of an analytic part (in its own coordinates); a plane becomes a square
     of side ``size`` around the projection of ``near`` (default: its point)."""
-    import trimesh
-
-    from cablelife.simulate import euler_matrix
-
     if part.shape == "plane":
         n = np.asarray(part.normal, float)
         n /= np.linalg.norm(n)
@@ -113,6 +109,10 @@ def primitive_mesh(part, size: float, near=None) -> tuple[np.ndarray, np.ndarray
         h = size / 2
         v = np.array([p + h * (a * u + b * w) for a, b in ((-1, -1), (1, -1), (1, 1), (-1, 1))])
         return v, np.array([[0, 1, 2], [0, 2, 3]])
+    import trimesh  # 0.5 s to import: only for the solids (a plane needs none)
+
+    from cablelife.simulate import euler_matrix
+
     t = np.eye(4)
     t[:3, 3] = part.center
     if part.shape == "box":
