@@ -306,14 +306,9 @@ fn pulled_ratio(mu: f64, mut c: Capstan, mut s: Statics) -> f64 {
     ratio
 }
 
-/// A cantilever along x clamped at height z₀ over a table, gravity down: the contact forces
-/// and the clip reaction carry the weight, and the cable lies on the table.
-#[test]
-fn cable_on_a_table_carries_its_weight_in_contact() {
-    let r = 0.005;
-    let l = 1.0;
-    let z0 = r + 0.005 * r;
-    let mut spec = cantilever(l, 100, section(1e5, 2e-3, 0.2));
+/// The static equilibrium of `spec` (clamped along x, its first clip moved to height z₀,
+/// gravity down) started straight at z₀ over a frictionless table z = 0 of a cable of radius r.
+fn solved_on_a_table(mut spec: CableSpec, r: f64, z0: f64) -> (Rod, State, Statics) {
     spec.clips[0].pose.position = Vector3::new(0.0, 0.0, z0);
     spec.gravity = Vector3::new(0.0, 0.0, -9.81);
     let rod = Rod::new(spec).unwrap();
@@ -323,6 +318,18 @@ fn cable_on_a_table_carries_its_weight_in_contact() {
     let table = Obstacle::new("table", 0, Box::new(Plane), 0.0, &origin());
     s.contact = Some(contact(&rod, vec![table], r));
     s.solve(&rod, &mut st).unwrap();
+    (rod, st, s)
+}
+
+/// A cantilever along x clamped at height z₀ over a table, gravity down: the contact forces
+/// and the clip reaction carry the weight, and the cable lies on the table.
+#[test]
+fn cable_on_a_table_carries_its_weight_in_contact() {
+    let r = 0.005;
+    let l = 1.0;
+    let z0 = r + 0.005 * r;
+    let spec = cantilever(l, 100, section(1e5, 2e-3, 0.2));
+    let (rod, st, mut s) = solved_on_a_table(spec, r, z0);
     s.assemble(&rod, &st, 1.0, false).unwrap();
     let weight = 0.2 * l * 9.81;
     let ct = s.contact.as_ref().unwrap();
@@ -356,18 +363,8 @@ fn cable_on_a_table_carries_its_weight_in_contact() {
 /// A free cable lying down the slope of an incline (angle α) at rest, gravity down: dynamics.
 /// Returns the distance slid down the slope after `t` seconds.
 fn incline(alpha: f64, mu: f64, t: f64, r: f64) -> f64 {
-    let l = 0.3;
     let n = 30;
-    let spec = CableSpec {
-        length: l,
-        segments: n,
-        section: section(1e4, 1e-3, 0.1),
-        natural_curvature: Vector3::zeros(),
-        clips: vec![],
-        loads: vec![],
-        gravity: Vector3::new(0.0, 0.0, -9.81),
-    };
-    let rod = Rod::new(spec).unwrap();
+    let rod = free_cable(0.3, n);
     let normal = Vector3::new(-alpha.sin(), 0.0, alpha.cos());
     let down = Vector3::new(-alpha.cos(), 0.0, -alpha.sin());
     // At the gap where the barrier carries the weight's normal part (κ = ρA g/d̂, automatic).
@@ -1129,17 +1126,9 @@ fn modes_on_a_table_are_the_horizontal_beam_modes() {
         let dhat = ContactOptions::for_radius(r).distance;
         let z0 = r + 0.5 * dhat;
         let mut spec = cantilever(l, n, section(1e5, ei, mass));
-        spec.clips[0].pose.position = Vector3::new(0.0, 0.0, z0);
         let tip = pose([l, 0.0, z0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]);
         spec.clips.push(clip("tip", l, 0.0, ClipKind::Fixed, tip));
-        spec.gravity = Vector3::new(0.0, 0.0, -9.81);
-        let rod = Rod::new(spec).unwrap();
-        let x = rod.arc.iter().map(|&s| Vector3::new(s, 0.0, z0)).collect();
-        let mut st = state_through(&rod, x, Vector3::z());
-        let mut s = Statics::new(&rod, NewtonOptions::default());
-        let table = Obstacle::new("table", 0, Box::new(Plane), 0.0, &origin());
-        s.contact = Some(contact(&rod, vec![table], r));
-        s.solve(&rod, &mut st).unwrap();
+        let (rod, st, mut s) = solved_on_a_table(spec, r, z0);
         let with = rod::modal::lowest_modes_with_contact(&rod, &st, 2, s.contact.as_mut()).unwrap();
         let without = rod::modal::lowest_modes(&rod, &st, 2).unwrap();
         let horizontal = |m: &rod::modal::Mode| {
@@ -1179,16 +1168,8 @@ fn a_clip_driven_into_the_geometry_keeps_newton_converging() {
     let r = 0.005;
     let (l, n) = (0.3, 30);
     let z0 = r + 0.2 * ContactOptions::for_radius(r).distance;
-    let mut spec = cantilever(l, n, section(1e4, 1e-3, 0.1));
-    spec.clips[0].pose.position = Vector3::new(0.0, 0.0, z0);
-    spec.gravity = Vector3::new(0.0, 0.0, -9.81);
-    let rod = Rod::new(spec).unwrap();
-    let x = rod.arc.iter().map(|&s| Vector3::new(s, 0.0, z0)).collect();
-    let mut st = state_through(&rod, x, Vector3::z());
-    let table = Obstacle::new("table", 0, Box::new(Plane), 0.0, &origin());
-    let mut s = Statics::new(&rod, NewtonOptions::default());
-    s.contact = Some(contact(&rod, vec![table], r));
-    s.solve(&rod, &mut st).unwrap();
+    let spec = cantilever(l, n, section(1e4, 1e-3, 0.1));
+    let (rod, mut st, s) = solved_on_a_table(spec, r, z0);
     let (w, depth) = (2.0 * PI * 50.0, 0.3 * r);
     let motion = |t: f64| {
         let mut pose = rod.spec.clips[0].pose;
