@@ -346,10 +346,16 @@ pub fn damping_fade(g: f64, dhat: f64) -> (f64, f64) {
     }
 }
 
+/// g_s: below it the barrier is its C² Taylor polynomial from there.
+#[inline]
+fn continuation_gap(dhat: f64) -> f64 {
+    1e-3 * dhat
+}
+
 /// b'''(g) of `barrier` (0 on the quadratic continuation below g_s and beyond d̂).
 #[inline]
 pub fn barrier_third(g: f64, dhat: f64) -> f64 {
-    if g >= dhat || g < 1e-3 * dhat {
+    if g >= dhat || g < continuation_gap(dhat) {
         return 0.0;
     }
     let d = g - dhat;
@@ -363,7 +369,7 @@ pub fn barrier(g: f64, dhat: f64) -> (f64, f64, f64) {
     if g >= dhat {
         return (0.0, 0.0, 0.0);
     }
-    let gs = 1e-3 * dhat;
+    let gs = continuation_gap(dhat);
     let exact = |g: f64| {
         let d = g - dhat;
         let l = (g / dhat).ln();
@@ -448,12 +454,9 @@ pub fn sample_terms(
         // Saturated below d̂/100: b'' grows as 1/g², and a sample a clip drives into the
         // geometry (its node prescribed) would meet a damping force without bound that no
         // free node can balance (bench_harness --contact: Newton stalled at 100 N).
-        let (gc, capped) = if g < DAMPING_SATURATION * dhat {
-            (DAMPING_SATURATION * dhat, true)
-        } else {
-            (g, false)
-        };
-        let b2c = barrier(gc, dhat).2;
+        let floor = DAMPING_SATURATION * dhat;
+        let capped = g < floor;
+        let b2c = if capped { barrier(floor, dhat).2 } else { b2 };
         let c = damping_rate * kw * b2c * phi;
         normal_grad += c * dg * n;
         damping_work = c * dg * dg;
@@ -676,10 +679,11 @@ impl Contact {
         let n_obstacles = obstacles.len();
         let opts_samples = opts.max_samples.max(1);
         let poses: Vec<_> = obstacles.iter().map(|o| (o.position, o.rotation)).collect();
+        let sample_slots = n_obstacles * n.saturating_sub(1) * (opts_samples + 1);
         Ok(Contact {
             reference_pose_n: poses.clone(),
             reference_pose: poses,
-            reference_gap: vec![f64::NAN; n_obstacles * n.saturating_sub(1) * (opts_samples + 1)],
+            reference_gap: vec![f64::NAN; sample_slots],
             transport: vec![(Matrix3::identity(), Vector3::zeros()); n_obstacles],
             obstacles,
             kappa,
@@ -697,10 +701,7 @@ impl Contact {
             deep: vec![false; n_obstacles * n.saturating_sub(1)],
             line: Vec::new(),
             cache_edges: vec![CachedEdge::default(); n_obstacles * n.saturating_sub(1)],
-            cache_samples: vec![
-                (0.0, Vector3::zeros());
-                n_obstacles * n.saturating_sub(1) * (opts_samples + 1)
-            ],
+            cache_samples: vec![(0.0, Vector3::zeros()); sample_slots],
         })
     }
 

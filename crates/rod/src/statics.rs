@@ -568,22 +568,17 @@ impl Statics {
             // inside: then the push-out from the equilibrium without contact.
             let shallow = st.clone();
             let direct = self.solve_any(rod, st);
+            if let Ok(s) = &direct {
+                pre.iterations += s.iterations;
+            }
             let clear = direct.is_ok() && {
                 let c = self.contact.as_mut().expect("contact");
                 c.mark_deep_edges(Some(&st.x));
                 c.deepest_penetration(st).is_none()
             };
-            match direct {
-                Ok(s) if clear => pre.iterations += s.iterations,
-                Ok(s) => {
-                    pre.iterations += s.iterations;
-                    st.clone_from(&shallow);
-                    pre.iterations += self.push_out(rod, st);
-                }
-                Err(_) => {
-                    st.clone_from(&shallow);
-                    pre.iterations += self.push_out(rod, st);
-                }
+            if !clear {
+                st.clone_from(&shallow);
+                pre.iterations += self.push_out(rod, st);
             }
         }
         // Never a silent wrong answer: a cable left inside the geometry, or a start inside it
