@@ -50,7 +50,8 @@ def load_times(page: Path, repeat: int) -> None:
         f"{med(loads):.2f} s (min {min(loads):.2f}, max {max(loads):.2f}, n = {repeat}"
         + (", older page: time to its check − 1.5 s" if old else "")
         + f"); figures rendered {last.rendered}/{last.expected}, script errors "
-        f"{len(last.errors)}, overlapping text boxes {len(last.overlaps)}"
+        f"{len(last.errors)}, overlapping text boxes {len(last.overlaps)}, text cut off at a "
+        f"figure's edge {len(last.clipped)}"
     )
     print(
         f"chromium CPU time, navigation to every figure drawn: median {med(cpus):.2f} s "

@@ -206,7 +206,8 @@ PAGE_FACTS = {
 
 
 def test_report_as_a_person_sees_it_in_headless_chromium(mixed_report):
-    """Every figure renders without script errors, no two text boxes overlap, each ranking
+    """Every figure renders without script errors, no two text boxes overlap, no text is cut
+    off at a figure's edge (the animated views' slider labels were), each ranking
     table ranks runs of one mode, the damage colours span the moving cable; screenshots of
     the whole page are kept as test artifacts (look at them)."""
     from cablelife.report.browser import check_page, find_browser
@@ -220,6 +221,7 @@ def test_report_as_a_person_sees_it_in_headless_chromium(mixed_report):
     assert seen.errors == []
     assert seen.rendered == seen.expected > 0
     assert seen.overlaps == [], seen.overlaps
+    assert seen.clipped == [], seen.clipped  # no label cut off at a figure's edge
     rankings = json.loads(seen.values["rankings"])
     assert [r["caption"].split(" runs:")[0] for r in rankings] == ["dynamic", "quasistatic"]
     assert rankings[0]["runs"] == ["short-dynamic"]

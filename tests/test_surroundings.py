@@ -640,6 +640,7 @@ def test_report_has_the_clearance_section(scene_dict, tmp_path):
     seen = check_page(tmp_path / "r.html")
     assert seen.errors == [] and seen.rendered == seen.expected == len(figs)
     assert seen.overlaps == [], seen.overlaps
+    assert seen.clipped == [], seen.clipped
 
 
 def test_report_arrays_of_text_go_as_lists():

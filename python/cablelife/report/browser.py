@@ -63,6 +63,28 @@ OVERLAP_JS = r"""
 """
 
 
+# Text of a figure drawn (partly) outside the figure's own box: cut off where the figure's
+# margins are too small for its tick labels, titles or slider (a legend too long for the
+# figure scrolls: not counted).
+CLIPPED_JS = r"""
+(function(){
+ var out=[];
+ document.querySelectorAll('.js-plotly-plot').forEach(function(fig){
+  var box=fig.getBoundingClientRect();
+  fig.querySelectorAll('svg.main-svg text').forEach(function(t){
+   if(!t.textContent.trim()||t.closest('g.legend'))return;  // a long legend scrolls
+   var s=getComputedStyle(t);
+   if(s.display==='none'||s.visibility==='hidden'||+s.opacity===0||+s.fillOpacity===0)return;
+   var r=t.getBoundingClientRect();
+   if(r.width<1||r.height<1)return;
+   if(r.left<box.left-1||r.right>box.right+1||r.top<box.top-1||r.bottom>box.bottom+1)
+    out.push({figure:fig.id,text:t.textContent.trim()});});
+ });
+ return JSON.stringify(out);
+})()
+"""
+
+
 def find_browser() -> str | None:
     return next((b for b in map(shutil.which, BROWSERS) if b), None)
 
@@ -77,6 +99,7 @@ class PageCheck:
     rendered: int
     errors: list[str]
     overlaps: list[dict] = field(default_factory=list)
+    clipped: list[dict] = field(default_factory=list)  # text outside its figure's box
     screenshots: list[Path] = field(default_factory=list)
     values: dict = field(default_factory=dict)
     first_screen_s: float = -1.0  # navigation start → the figures on the first screen drawn
@@ -200,6 +223,7 @@ async def _check(
     data = await cdp.evaluate("JSON.stringify(document.body.dataset)")
     d = json.loads(data)
     overlaps = json.loads(await cdp.evaluate(OVERLAP_JS))
+    clipped = json.loads(await cdp.evaluate(CLIPPED_JS))
     values = {k: await cdp.evaluate(js) for k, js in (evaluate or {}).items()}
     files = []
     if shots is not None:
@@ -224,6 +248,7 @@ async def _check(
         rendered=int(d.get("renderedFigures", 0)),
         errors=json.loads(d.get("errors", "[]")),
         overlaps=overlaps,
+        clipped=clipped,
         screenshots=files,
         values=values,
         cpu_s=cpu,

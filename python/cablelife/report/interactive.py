@@ -7,6 +7,7 @@ import numpy as np
 from cablelife.plots.loads import ORDER, magnitude_label, span_maxima
 from cablelife.plots.runs import QUANTITIES, as_runs, variant_colours
 from cablelife.report.decimate import minmax, nice_range
+from cablelife.report.margins import BOTTOM, EXTRA_HEIGHT, LEFT, TOP, legend_room
 
 _DASH = {"--": "dash", "-": "solid", ":": "dot"}
 #: Points of a span's line (shown on demand; the maxima over the moving spans get MAX_POINTS).
@@ -77,9 +78,14 @@ def maxima_over_time_figure(runs, quantities=ORDER, per_span: bool = True):
         )
     fig.update_xaxes(title_text="time [s]", ticklabelstandoff=5, row=len(quantities), col=1)
     fig.update_layout(
-        height=200 * len(quantities) + 80,
+        height=200 * len(quantities) + 80 + EXTRA_HEIGHT,
         title="largest magnitude over the spans that move, over time",
-        margin={"l": 60, "r": 10, "t": 50, "b": 40},
+        margin={
+            "l": LEFT,
+            "r": legend_room(t.name for t in fig.data if t.showlegend),
+            "t": TOP,
+            "b": BOTTOM,
+        },
         legend={"font": {"size": 10}},
     )
     return fig

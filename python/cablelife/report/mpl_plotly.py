@@ -16,6 +16,8 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Polygon, Rectangle
 from matplotlib.text import Annotation
 
+from cablelife.report.margins import BOTTOM, EXTRA_HEIGHT, LEFT, TOP, legend_room
+
 _DASH = {"-": "solid", "--": "dash", ":": "dot", "-.": "dashdot"}
 _XANCHOR = {"left": "left", "center": "center", "right": "right"}
 _YANCHOR = {"top": "top", "center": "middle", "bottom": "bottom", "baseline": "bottom"}
@@ -87,8 +89,9 @@ def to_plotly(fig: Figure):
     title = fig._suptitle.get_text() if fig._suptitle is not None else ""
     out.update_layout(
         title=title or None,
-        height=int(max(320, 95 * height)),
-        margin={"l": 70, "r": 20, "t": 70 if title else 50, "b": 50},
+        height=int(max(320, 95 * height)) + EXTRA_HEIGHT,
+        # wide enough for labels and legend (cablelife.report.margins)
+        margin={"l": LEFT, "r": legend_room(legend), "t": 70 if title else TOP, "b": BOTTOM},
         legend={"font": {"size": 10}},
         hovermode="closest",
     )

@@ -311,7 +311,7 @@ def cable_figure(
                     "x": 0.16,
                     "len": 0.84,
                     "y": 0.0,
-                    "pad": {"t": 10, "b": 0},
+                    "pad": {"t": 10, "b": 20},  # room below its time labels (else cut off)
                     "currentvalue": {"prefix": "t = ", "suffix": " s", "xanchor": "right"},
                     "steps": [
                         {

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from cablelife.report.margins import BOTTOM, EXTRA_HEIGHT, LEFT, TOP, legend_room
 from cablelife.report.scene3d import mesh_trace
 from cablelife.results import CableResult, Result
 from cablelife.surroundings.summary import clearance_summary
@@ -57,8 +58,8 @@ def clearance_envelope_figure(cable: CableResult):
         title=f"clearance of {cable.name} along the cable",
         xaxis_title="arc length s [m]",
         yaxis_title="clearance [mm]",
-        height=380,
-        margin={"l": 60, "r": 20, "t": 50, "b": 50},
+        height=380 + EXTRA_HEIGHT,
+        margin={"l": LEFT, "r": legend_room(t.name for t in fig.data), "t": TOP, "b": BOTTOM},
     )
     return fig
 
