@@ -544,6 +544,88 @@ def test_display_geometry_follows_the_bodies_and_goes_to_paraview(scene_dict, tm
     assert "clearance" in names and "clearance_body" in names
 
 
+def _signed_volume(v, f):
+    a, b, c = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
+    return float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6)
+
+
+def test_primitive_display_meshes_are_closed_outward_and_on_the_surface():
+    """The solids' display meshes (numpy, without importing trimesh): watertight with
+    consistent winding, normals outward (positive signed volume: exact for the box and the
+    48-sided prism, the inscribed polyhedron's for the sphere), vertices on the surface, and
+    the extents of trimesh.creation's meshes of the same parts."""
+    from cablelife.rotations import euler_matrix
+    from cablelife.surroundings.display import box_mesh, cylinder_mesh, sphere_mesh
+
+    c = np.array([0.4, -0.2, 0.1])
+    rot = euler_matrix([0.3, -0.2, 0.5])
+    size = np.array([0.1, 0.2, 0.3])
+    v, f = box_mesh(c, rot, size)
+    assert _signed_volume(v, f) == pytest.approx(np.prod(size), rel=1e-12)
+    local = (v - c) @ rot
+    np.testing.assert_allclose(np.abs(local), np.broadcast_to(size / 2, v.shape), rtol=1e-12)
+    t = np.eye(4)
+    t[:3, :3], t[:3, 3] = rot, c
+    ref = trimesh.creation.box(extents=size, transform=t)
+    np.testing.assert_allclose(np.sort(v, axis=0), np.sort(ref.vertices, axis=0), atol=1e-15)
+    meshes = [(v, f)]
+
+    axis, r, length = np.array([0.2, 1.0, 0.3]), 0.02, 0.3
+    v, f = cylinder_mesh(c, axis, r, length)
+    n = 48
+    assert _signed_volume(v, f) == pytest.approx(n / 2 * np.sin(2 * np.pi / n) * r * r * length)
+    a = axis / np.linalg.norm(axis)
+    along = (v - c) @ a
+    radial = np.linalg.norm((v - c) - along[:, None] * a, axis=1)
+    assert np.allclose(np.abs(along), length / 2)
+    assert np.allclose(radial[:-2], r) and np.allclose(radial[-2:], 0.0, atol=1e-15)
+    t = np.eye(4)
+    t[:3, :3] = trimesh.geometry.align_vectors([0, 0, 1], a)[:3, :3]
+    t[:3, 3] = c
+    ref = trimesh.creation.cylinder(radius=r, height=length, sections=n, transform=t)
+    assert ref.volume == pytest.approx(_signed_volume(v, f), rel=1e-12)
+    meshes.append((v, f))
+
+    v, f = sphere_mesh(c, 0.03)
+    assert np.allclose(np.linalg.norm(v - c, axis=1), 0.03)
+    exact = 4 / 3 * np.pi * 0.03**3
+    assert 0.97 * exact < _signed_volume(v, f) < exact  # inscribed: a little less
+    np.testing.assert_allclose(v.min(axis=0), c - 0.03, atol=1e-4)  # poles on z; ≤ 1 − cos(π/32)
+    np.testing.assert_allclose(v.max(axis=0), c + 0.03, atol=1e-4)
+    meshes.append((v, f))
+    for v, f in meshes:
+        m = trimesh.Trimesh(v, f, process=False)
+        assert m.is_watertight and m.is_winding_consistent and m.volume > 0
+
+
+def test_primitives_need_no_trimesh(scene_dict):
+    """Loading surroundings of analytic parts only (and their display meshes) does not import
+    trimesh (0.3–0.5 s with scipy.spatial; a quarter of a small run)."""
+    import json
+    import subprocess
+    import sys
+
+    parts = [
+        {"shape": "box", "center": [0.3, 0, -0.1], "size": [0.1, 0.1, 0.1]},
+        {"shape": "cylinder", "center": [0.3, 0, -0.3], "axis": [0, 1, 0], "radius": 0.02,
+         "length": 0.2},
+        {"shape": "sphere", "center": [0.5, 0, -0.2], "radius": 0.03},
+        {"shape": "plane", "point": [0, 0, -0.6], "normal": [0, 0, 1]},
+    ]  # fmt: skip
+    scene = copy.deepcopy(scene_dict)
+    scene["bodies"] = [{"name": "frame", "geometry": parts}]
+    code = (
+        "import json, sys\nfrom cablelife.scene import scene_from_dict\n"
+        "from cablelife.surroundings.build import load_surroundings\n"
+        f"env = load_surroundings(scene_from_dict(json.loads({json.dumps(json.dumps(scene))})))\n"
+        "assert len(env.display_meshes()) == 1 and len(env.meshes) == 4\n"
+        "print(json.dumps(sorted(sys.modules)))"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    loaded = json.loads(out.stdout.strip().splitlines()[-1])
+    assert "trimesh" not in loaded and "scipy.spatial" not in loaded
+
+
 def test_decimation_for_display():
     from cablelife.surroundings.display import decimate
 

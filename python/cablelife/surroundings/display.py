@@ -109,25 +109,83 @@ def primitive_mesh(part, size: float, near=None) -> tuple[np.ndarray, np.ndarray
         h = size / 2
         v = np.array([p + h * (a * u + b * w) for a, b in ((-1, -1), (1, -1), (1, 1), (-1, 1))])
         return v, np.array([[0, 1, 2], [0, 2, 3]])
-    import trimesh  # 0.5 s to import: only for the solids (a plane needs none)
+    # The solids are tessellated here rather than by trimesh.creation: importing trimesh takes
+    # 0.3–0.5 s (scipy.spatial with it), a quarter of a small `cablelife run` whose scene has
+    # only primitives (tests compare these meshes with trimesh's).
+    from cablelife.rotations import euler_matrix
 
-    from cablelife.simulate import euler_matrix
-
-    t = np.eye(4)
-    t[:3, 3] = part.center
+    c = np.asarray(part.center, float)
     if part.shape == "box":
-        t[:3, :3] = euler_matrix(part.orientation)
-        m = trimesh.creation.box(extents=part.size, transform=t)
-    elif part.shape == "cylinder":
-        a = np.asarray(part.axis, float)
-        t[:3, :3] = trimesh.geometry.align_vectors([0, 0, 1], a / np.linalg.norm(a))[:3, :3]
-        m = trimesh.creation.cylinder(
-            radius=part.radius, height=part.length, sections=48, transform=t
-        )
-    else:
-        m = trimesh.creation.icosphere(subdivisions=3, radius=part.radius)
-        m.apply_translation(part.center)
-    return np.asarray(m.vertices, float), np.asarray(m.faces, np.int64)
+        return box_mesh(c, euler_matrix(part.orientation), part.size)
+    if part.shape == "cylinder":
+        return cylinder_mesh(c, part.axis, part.radius, part.length)
+    return sphere_mesh(c, part.radius)
+
+
+# The cube [−½, ½]³: corners by bits (x, y, z), two outward triangles per face.
+_CUBE = np.array([[(i >> 0) & 1, (i >> 1) & 1, (i >> 2) & 1] for i in range(8)], float) - 0.5
+_CUBE_FACES = np.array(
+    [[0, 2, 1], [1, 2, 3], [4, 5, 6], [5, 7, 6], [0, 1, 4], [1, 5, 4],
+     [2, 6, 3], [3, 6, 7], [0, 4, 2], [2, 4, 6], [1, 3, 5], [3, 7, 5]],
+    np.int64,
+)  # fmt: skip
+
+
+def box_mesh(center, rotation, size) -> tuple[np.ndarray, np.ndarray]:
+    """The box of edge lengths ``size`` (its axes the columns of ``rotation``) around
+    ``center``: 8 vertices, 12 triangles, normals outward."""
+    v = (_CUBE * np.asarray(size, float)) @ np.asarray(rotation, float).T + center
+    return v, _CUBE_FACES.copy()
+
+
+def _basis(axis) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Unit vectors u, w, a with a along ``axis`` and (u, w, a) right-handed."""
+    a = np.asarray(axis, float)
+    a = a / np.linalg.norm(a)
+    u = np.cross(a, np.eye(3)[int(np.argmin(np.abs(a)))])
+    u /= np.linalg.norm(u)
+    return u, np.cross(a, u), a
+
+
+def cylinder_mesh(center, axis, radius, length, sections: int = 48):
+    """The closed cylinder (a prism of ``sections`` sides, corners on the circle): two rings
+    and a centre on each end cap; normals outward."""
+    u, w, a = _basis(axis)
+    phi = 2 * np.pi * np.arange(sections) / sections
+    ring = radius * (np.cos(phi)[:, None] * u + np.sin(phi)[:, None] * w)
+    half = 0.5 * length * a
+    v = np.concatenate([ring - half, ring + half, [-half, half]]) + center
+    k = np.arange(sections)
+    k1 = (k + 1) % sections
+    n = sections
+    faces = np.concatenate(
+        [
+            np.stack([k, k1, n + k], 1),  # side
+            np.stack([k1, n + k1, n + k], 1),
+            np.stack([np.full(n, 2 * n), k1, k], 1),  # bottom cap (normal −a)
+            np.stack([np.full(n, 2 * n + 1), n + k, n + k1], 1),  # top cap (normal +a)
+        ]
+    )
+    return v, faces.astype(np.int64)
+
+
+def sphere_mesh(center, radius, rings: int = 16, sectors: int = 32):
+    """The sphere as a latitude–longitude mesh with its poles: ``rings`` bands of ``sectors``
+    quads (triangle fans at the poles); vertices on the sphere, normals outward."""
+    theta = np.pi * np.arange(1, rings) / rings  # polar angles of the inner rings
+    phi = 2 * np.pi * np.arange(sectors) / sectors
+    st, ct = np.sin(theta)[:, None], np.cos(theta)[:, None]
+    ring = np.stack([st * np.cos(phi), st * np.sin(phi), ct * np.ones_like(phi)], -1)
+    v = np.concatenate([[[0.0, 0.0, 1.0]], ring.reshape(-1, 3), [[0.0, 0.0, -1.0]]])
+    idx = 1 + np.arange((rings - 1) * sectors).reshape(rings - 1, sectors)
+    nxt = np.roll(idx, -1, axis=1)
+    south = len(v) - 1
+    faces = [np.stack([np.zeros(sectors, np.int64), idx[0], nxt[0]], 1)]
+    for r in range(rings - 2):
+        a, b, c, d = idx[r], nxt[r], idx[r + 1], nxt[r + 1]
+        faces += [np.stack([a, c, b], 1), np.stack([b, c, d], 1)]
+    faces.append(np.stack([np.full(sectors, south), nxt[-1], idx[-1]], 1))
+    return radius * v + np.asarray(center, float), np.concatenate(faces).astype(np.int64)
 
 
 def merge(meshes: list[tuple[np.ndarray, np.ndarray]]) -> tuple[np.ndarray, np.ndarray]:
