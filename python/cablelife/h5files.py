@@ -61,3 +61,62 @@ def plain(value):
     if isinstance(value, bytes):
         return value.decode()
     return value
+
+
+# Datasets of at least this many bytes are compressed chunk by chunk in parallel threads.
+PARALLEL_BYTES = 1 << 18
+
+
+def put_deflated(group: h5py.Group, name: str, data: np.ndarray, chunk_steps: int, level: int):
+    """A dataset chunked along its first axis (``chunk_steps`` rows per chunk) with HDF5's
+    shuffle and deflate filters, as ``create_dataset(..., compression="gzip", shuffle=True)``
+    writes it, but with the chunks shuffled and deflated in parallel threads (zlib releases
+    the GIL) and written with ``write_direct_chunk``: any HDF5 reader decodes it with the
+    standard filters. Compression is most of the time of writing a result (gzip level 1:
+    0.30 s of a 5 s, 100-segment run on one thread)."""
+    import zlib
+
+    a = np.ascontiguousarray(data)
+    if a.dtype.byteorder == ">":
+        a = a.astype(a.dtype.newbyteorder("<"))
+    n = min(chunk_steps, a.shape[0])
+    ds = group.create_dataset(
+        name,
+        shape=a.shape,
+        dtype=a.dtype,
+        chunks=(n, *a.shape[1:]),
+        compression="gzip",
+        compression_opts=level,
+        shuffle=True,
+    )
+    size = a.dtype.itemsize
+
+    def deflate(start: int) -> bytes:
+        block = a[start : start + n]
+        if block.shape[0] < n:  # the last chunk is stored whole: pad it
+            block = np.concatenate([block, np.zeros((n - block.shape[0], *a.shape[1:]), a.dtype)])
+        shuffled = block.view(np.uint8).reshape(-1, size).T.tobytes()  # HDF5's shuffle filter
+        return zlib.compress(shuffled, level)
+
+    starts = range(0, a.shape[0], n)
+    if a.nbytes >= PARALLEL_BYTES and len(starts) > 1:
+        blobs = _pool().map(deflate, starts)
+    else:
+        blobs = map(deflate, starts)
+    zeros = (0,) * (a.ndim - 1)
+    for start, blob in zip(starts, blobs, strict=True):
+        ds.id.write_direct_chunk((start, *zeros), blob)
+    return ds
+
+
+_POOL = None
+
+
+def _pool():
+    """Threads for compression, one per core (started once)."""
+    global _POOL
+    if _POOL is None:
+        from concurrent.futures import ThreadPoolExecutor
+
+        _POOL = ThreadPoolExecutor(max(1, min(8, os.cpu_count() or 1)), "deflate")
+    return _POOL

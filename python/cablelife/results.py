@@ -42,7 +42,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from cablelife.h5files import atomic_h5, open_h5, plain
+from cablelife.h5files import atomic_h5, open_h5, plain, put_deflated
 from cablelife.surroundings.data import CableClearance
 from cablelife.surroundings.display import SurroundingsGeometry
 
@@ -297,8 +297,7 @@ def _put(
     if a.ndim == 0 or a.size < 64:
         ds = group.create_dataset(name, data=a)
     else:
-        chunks = (min(CHUNK_STEPS, a.shape[0]), *a.shape[1:]) if a.shape[0] else None
-        ds = group.create_dataset(name, data=a, chunks=chunks, **COMPRESSION)
+        ds = put_deflated(group, name, a, CHUNK_STEPS, COMPRESSION["compression_opts"])
     ds.attrs["unit"] = unit if unit is not None else _UNITS.get(name, "1")
 
 
