@@ -736,7 +736,7 @@ def test_report_arrays_of_text_go_as_lists():
     assert d["x"]["dtype"] == "f4"
 
 
-def test_motion_volume_against_the_bodies(scene_dict):
+def test_motion_volume_against_the_bodies(scene_dict, monkeypatch):
     """A straight cable through a 0.1 m thick box: the volume inside is the tube's
     π r² · 0.1 m (to the voxel resolution), the least distance the node depth."""
     from cablelife.simulate import simulate
@@ -758,6 +758,16 @@ def test_motion_volume_against_the_bodies(scene_dict):
     exact = math.pi * RADIUS**2 * 0.1
     assert wall.intersection == pytest.approx(exact, rel=0.03)
     assert far.intersection == 0.0 and far.min_distance == pytest.approx(0.2 - RADIUS, abs=2e-4)
+    # Both bodies are at rest: given the motion volume (same voxel, all cables and steps) the
+    # check uses its field and finds exactly the same.
+    import cablelife.volume.field as field
+    from cablelife.volume.motion import motion_volume
+
+    mv = motion_volume(res, 0.0005)
+    calls = []
+    plain = field.signed_distance
+    monkeypatch.setattr(field, "signed_distance", lambda *a, **k: calls.append(1) or plain(*a, **k))
+    assert volume_vs_surroundings(res, 0.0005, motion=mv) == [wall, far] and not calls
 
 
 def test_dynamic_run_uses_the_saved_steps(scene_dict):

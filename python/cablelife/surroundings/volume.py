@@ -34,11 +34,14 @@ def _body_core(vertices, faces):
     return core
 
 
-def volume_vs_surroundings(result, voxel: float = 0.002, steps=None) -> list[BodyVolumeCheck]:
+def volume_vs_surroundings(
+    result, voxel: float = 0.002, steps=None, motion=None
+) -> list[BodyVolumeCheck]:
     """Per body of ``result.surroundings``: the relative motion volume of all cables against
-    the body (see the module docstring)."""
-    from cablelife.volume.field import Capsules
-    from cablelife.volume.motion import volume_of_capsules
+    the body (see the module docstring). ``motion``: the motion volume of all of ``result``'s
+    cables over the same steps at the same voxel, if already computed: a body that does not
+    move sees exactly that volume, whose distance field is then used as it is."""
+    from cablelife.volume.field import Capsules, grid_for, signed_distance
     from cablelife.volume.sweep import select_steps
 
     geom = result.surroundings
@@ -61,11 +64,19 @@ def volume_vs_surroundings(result, voxel: float = 0.002, steps=None) -> list[Bod
             value, _ = core.clearance(np.ascontiguousarray(local), radius, ident)
             least = min(least, float(value.min()))
             caps.append(Capsules(local[:, :-1].reshape(-1, 3), local[:, 1:].reshape(-1, 3), radius))
-        allcaps = caps[0]
-        for more in caps[1:]:
-            allcaps = allcaps.concat(more)
-        vol = volume_of_capsules(allcaps, voxel)
-        f = vol.field
+        rest = geom.poses[b, ..., :3] == np.eye(3)
+        if (
+            motion is not None
+            and motion.field.spacing == voxel
+            and rest.all()
+            and not np.any(geom.poses[b, ..., 3])
+        ):
+            f = motion.field  # at rest at every step: the motion volume itself
+        else:
+            allcaps = caps[0]
+            for more in caps[1:]:
+                allcaps = allcaps.concat(more)
+            f = signed_distance(allcaps, *grid_for(allcaps.bounding_box, voxel), voxel)
         inside = np.argwhere(f.values <= 0)
         sd = core.project_points(0, f.points(inside))["distance"] if len(inside) else np.array([])
         out.append(BodyVolumeCheck(name, least, float((sd < 0).sum()) * voxel**3, voxel))

@@ -124,7 +124,8 @@ def volume_command(
         st.add_column("body")
         st.add_column(escape("least distance [mm]"), justify="right")
         st.add_column(escape("volume inside the body [l]"), justify="right")
-        for chk in volume_vs_surroundings(res, h):
+        # the motion volume just computed is that of every cable over every step (no --cable)
+        for chk in volume_vs_surroundings(res, h, motion=a if cable is None else None):
             st.add_row(
                 escape(chk.body), f"{chk.min_distance * 1e3:.2f}", f"{chk.intersection * 1e3:.4g}"
             )
