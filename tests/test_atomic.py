@@ -81,6 +81,33 @@ def test_stale_temporaries_of_dead_processes_are_removed_at_the_next_write(tmp_p
     assert temp_files(tmp_path) == sorted([live.name, other.name])
 
 
+def test_a_folder_of_files_is_cleaned_once_and_each_file_is_atomic(tmp_path):
+    """`atomic_folder` (a time series of many files): the stale temporaries of the names it
+    writes are removed, a live writer's and those of names it does not write are kept; an
+    exception half-way leaves the files written so far whole, no temporary, and the rest
+    unwritten."""
+    from cablelife.atomic import atomic_folder
+
+    dead = tmp_path / f".s_00001.vtp.{_dead_pid()}-0123abcd.tmp"
+    legacy = tmp_path / ".s_00002.vtp.k2j_9xq0.tmp"
+    live = tmp_path / f".s_00001.vtp.{os.getppid()}-89abcdef.tmp"
+    other = tmp_path / f".other.vtp.{_dead_pid()}-0123abcd.tmp"
+    for p in (dead, legacy, live, other):
+        p.write_bytes(b"x")
+    with atomic_folder(tmp_path) as write:
+        for k in range(1, 4):
+            write(f"s_{k:05d}.vtp", f"<step {k}/>")
+    assert [(tmp_path / f"s_{k:05d}.vtp").read_text() for k in (1, 2, 3)] == [
+        f"<step {k}/>" for k in (1, 2, 3)
+    ]
+    assert temp_files(tmp_path) == sorted([live.name, other.name])
+    with pytest.raises(KeyboardInterrupt), atomic_folder(tmp_path / "b") as write:
+        write("a.vtp", "A")
+        write("b.vtp", "B")
+        raise KeyboardInterrupt
+    assert sorted(p.name for p in (tmp_path / "b").iterdir()) == ["a.vtp", "b.vtp"]
+
+
 def test_temporary_names_follow_the_pattern_the_cleaning_knows(tmp_path):
     target = tmp_path / "a b.h5"
     name = temp_name(target)

@@ -14,7 +14,7 @@ from cablelife.surroundings.display import SurroundingsGeometry
 
 def write_bodies(geom: SurroundingsGeometry, output: str | os.PathLike, steps=None) -> Path:
     """Writes ``<output stem>_bodies.pvd`` and its files into ``<output stem>/``."""
-    from cablelife.atomic import write_text_atomic
+    from cablelife.atomic import atomic_folder, write_text_atomic
     from cablelife.export.paraview import pvd_xml, surface_xml
     from cablelife.volume.sweep import select_steps
 
@@ -22,15 +22,15 @@ def write_bodies(geom: SurroundingsGeometry, output: str | os.PathLike, steps=No
     folder = output.parent / output.stem
     idx = select_steps(geom.time.size, steps)
     entries = []
-    for b, name in enumerate(geom.bodies):
-        _, faces = geom.meshes[b]
-        safe = "".join(ch if ch.isalnum() or ch in "-_" else "_" for ch in name)
-        for k in idx:
-            file = f"{output.stem}_body_{safe}_{int(k):05d}.vtp"
-            fields = {"time": float(geom.time[k])}
-            xml = surface_xml(geom.at(b, int(k)), faces, {}, {}, fields)
-            write_text_atomic(folder / file, xml)
-            entries.append((float(geom.time[k]), f"{folder.name}/{file}", b))
+    with atomic_folder(folder) as write:
+        for b, name in enumerate(geom.bodies):
+            _, faces = geom.meshes[b]
+            safe = "".join(ch if ch.isalnum() or ch in "-_" else "_" for ch in name)
+            for k in idx:
+                file = f"{output.stem}_body_{safe}_{int(k):05d}.vtp"
+                fields = {"time": float(geom.time[k])}
+                write(file, surface_xml(geom.at(b, int(k)), faces, {}, {}, fields))
+                entries.append((float(geom.time[k]), f"{folder.name}/{file}", b))
     return write_text_atomic(output.with_name(f"{output.stem}_bodies.pvd"), pvd_xml(entries))
 
 
