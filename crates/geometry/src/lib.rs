@@ -111,3 +111,15 @@ impl Surface for Shape {
         self.surface().closest_to_segment(a, b, max_distance, hint)
     }
 }
+
+/// Uniform numbers in [0, 1) from a 64-bit linear congruential generator (Knuth's MMIX
+/// constants): the tests' reproducible random points and segments.
+#[cfg(test)]
+pub(crate) fn test_random(mut seed: u64) -> impl FnMut() -> f64 {
+    move || {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    }
+}

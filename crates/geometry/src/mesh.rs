@@ -1154,13 +1154,7 @@ mod tests {
     #[test]
     fn cube_signed_distance_is_exact() {
         let m = cube();
-        let mut seed = 12345u64;
-        let mut rnd = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rnd = crate::test_random(12345);
         for _ in 0..2000 {
             let p = V3::new(rnd() * 3.0 - 1.0, rnd() * 3.0 - 1.0, rnd() * 3.0 - 1.0);
             let r = m.project_point(&p, f64::INFINITY, usize::MAX).unwrap();

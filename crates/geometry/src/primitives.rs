@@ -467,13 +467,7 @@ mod tests {
             0.02,
             0.06,
         );
-        let mut seed = 12345u64;
-        let mut rnd = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rnd = crate::test_random(12345);
         let (mut inside, mut interior) = (0, 0);
         for k in 0..1500 {
             let a = V3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5) * 0.3;

@@ -352,13 +352,7 @@ mod tests {
         // boxes and points chosen so that float32 rounding to nearest would overestimate the
         // gap (the box's face and the point a fraction of a float32 step apart): the bound
         // must stay at or below the exact float64 distance, times F32_SAFE
-        let mut seed = 7u64;
-        let mut rnd = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rnd = crate::test_random(7);
         for _ in 0..20000 {
             let scale = [1e-3, 1.0, 1e3][(rnd() * 3.0) as usize % 3];
             let lo = V3::new(rnd(), rnd(), rnd()) * scale;
@@ -401,13 +395,7 @@ mod tests {
     #[test]
     fn float32_disk_bounds_are_lower_bounds() {
         use crate::closest::{point_triangle, segment_triangle};
-        let mut seed = 99u64;
-        let mut rnd = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rnd = crate::test_random(99);
         let mut over_without_pad = 0;
         for case in 0..20000 {
             let size = [1e-3, 1.0, 1e3][case % 3];
