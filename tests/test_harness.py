@@ -3,6 +3,7 @@ the Python workflow, junction equilibrium and symmetry, results round trip."""
 
 from __future__ import annotations
 
+import copy
 import math
 
 import numpy as np
@@ -171,6 +172,31 @@ def test_dynamic_y_stays_symmetric_and_saves_its_junction(tmp_path):
     # (ζ = 1 from bending, tests/test_harness_damping.py), the same τ on every branch.
     taus = {cable.solver["tau_bend"][0] for cable in result.cables.values()}
     assert len(taus) == 1 and taus.pop() > 0
+
+
+def test_dynamic_start_reuses_the_calibration_equilibrium():
+    """The default damping's calibration solves the harness's static equilibrium at t = 0; the
+    dynamic run then starts from it (one Newton iteration) instead of solving it again from
+    the routed shape, and runs as with the same damping given explicitly (no calibration: the
+    equilibrium solved from the route), to the static tolerance."""
+    sc = y_scene(mode="dynamic", duration=0.02, time_step=1e-3)
+    sine = {"type": "sine", "amplitude": 0.003, "frequency": 20.0}
+    sc["bodies"][0]["motion"] = [{"channel": "z", "signal": sine}]
+    calibrated = simulate(scene_from_dict(sc))
+    given = copy.deepcopy(sc)
+    for c in given["cables"]:
+        taus = calibrated.cables[c["name"]].solver
+        c["damping"] = {
+            "shear": float(taus["tau_shear"][0]),
+            "extension": float(taus["tau_shear"][2]),
+            "bending": float(taus["tau_bend"][0]),
+            "torsion": float(taus["tau_bend"][2]),
+        }
+    explicit = simulate(scene_from_dict(given))
+    assert calibrated.cables["trunk"].solver["iterations"][0] <= 1  # converged at the start
+    assert explicit.cables["trunk"].solver["iterations"][0] > 1
+    for name, c in calibrated.cables.items():
+        np.testing.assert_allclose(c.positions, explicit.cables[name].positions, atol=1e-12)
 
 
 def pair_scene(joined: bool) -> dict:
