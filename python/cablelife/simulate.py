@@ -508,12 +508,17 @@ def simulate(scene: Scene, mode: str | None = None, progress: Progress | None = 
     if scene.junctions:
         return _simulate_harness(scene, mode, times, env, progress)
     workers = max(1, min(len(scene.cables), os.cpu_count() or 1))
-    with interrupt.stop_flag() as stop, ThreadPoolExecutor(max_workers=workers) as pool:
-        futures = [
-            pool.submit(_run_cable, scene, c, times, mode, progress, stop) for c in scene.cables
-        ]
-        interrupt.wait_stopping(futures, stop.set)  # Ctrl-C: the runs end after their step
-        outcomes = [f.result() for f in futures]
+    # The cables run in threads: their warnings are collected and given again from here, so
+    # that they point at the caller of simulate(), not at the thread pool's internals.
+    with warnings.catch_warnings(record=True) as caught:
+        with interrupt.stop_flag() as stop, ThreadPoolExecutor(max_workers=workers) as pool:
+            futures = [
+                pool.submit(_run_cable, scene, c, times, mode, progress, stop) for c in scene.cables
+            ]
+            interrupt.wait_stopping(futures, stop.set)  # Ctrl-C: the runs end after their step
+            outcomes = [f.result() for f in futures]
+    for w in caught:
+        warnings.warn(w.message, w.category, stacklevel=2)
     cables = {res.name: res for res, _ in outcomes}
     errors = [f"cable '{res.name}': {err}" for res, err in outcomes if err]
     stopped = any(err == interrupt.INTERRUPTED for _, err in outcomes) and all(
