@@ -228,6 +228,23 @@ def test_local_cluster_study_writes_the_summary_table_and_reruns_nothing(tmp_pat
     assert rerun.computed == [] and sorted(rerun.skipped) == sorted(table["variant"])
     assert stamps == {n: (out / "variants" / n / "result.h5").stat().st_mtime_ns for n in stamps}
     pd.testing.assert_frame_equal(pd.read_csv(rerun.csv), table)
+    # The table as the CLI prints it at 80 columns (nothing to compute: all finished): one line
+    # per variant with its parameters and figures, nothing cut or folded into a column of
+    # single characters (the long variant names did that; the parameters name the variant).
+    env = {**os.environ, "COLUMNS": "80"}
+    printed = subprocess.run(
+        [sys.executable, "-m", "cablelife", "study", str(write_study(tmp_path)), "-o", str(out)],
+        capture_output=True, text=True, env=env, check=True,
+    ).stdout  # fmt: skip
+    lines = printed.splitlines()
+    table = lines[: next(i for i, line in enumerate(lines) if "already finished" in line)]
+    assert max(map(len, table)) <= 80, printed
+    assert f"summary: {outcome.csv}, {outcome.parquet}" in lines  # paths whole, not folded
+    header = next(line for line in lines if "max D" in line)
+    assert all(h in header for h in ("#", "shift", "length", "ratio", "spot (m)", "vol (l)"))
+    rows = [r for r in map(str.split, lines) if len(r) >= 6 and r[0].isdigit() and "," not in r[1]]
+    assert [int(r[0]) for r in rows] == [1, 2, 3, 4], printed
+    assert float(rows[0][4]) == pytest.approx(1.0)  # the ratio of the best, whole
 
 
 def test_a_failing_variant_is_reported_and_the_others_finish(tmp_path):

@@ -47,9 +47,9 @@ HEADERS = {
     "rank": "#",
     "max_damage": "max D",
     "ratio_to_best": "ratio",
-    "hot_spot_s_m": "spot s (m)",
-    "hot_spot_clip": "near clip",
-    "motion_volume_l": "vol. (l)",
+    "hot_spot_s_m": "spot (m)",
+    "hot_spot_clip": "near",
+    "motion_volume_l": "vol (l)",
 }
 
 
@@ -139,19 +139,30 @@ def study_command(
         print_error(err, e)
         raise typer.Exit(2) from None
     frame = outcome.table
-    t = Table(title=escape(f"study {outcome.out_dir}"), title_justify="left", box=box.SIMPLE_HEAD)
+    t = Table(
+        title=escape(f"study {outcome.out_dir}"),
+        title_justify="left",
+        box=box.SIMPLE_HEAD,
+        pad_edge=False,  # 80 columns
+    )
     shown = ["rank", "variant", *outcome.parameters, "max_damage", "ratio_to_best"]
     shown += ["hot_spot_s_m", "hot_spot_clip", "motion_volume_l", "status"]
     shown = [c for c in shown if c in frame]
     if "status" in shown and frame["status"].eq("ok").all():
         shown.remove("status")  # fits 80 columns; the failures are listed below
+    if outcome.parameters and "variant" in shown:
+        # the parameter columns name the variant (its folder name is "p1=v1_p2=v2", in the
+        # CSV): at 80 columns that name squeezed into one character per line
+        shown.remove("variant")
     for c in shown:  # short headers; text cells wrap instead of turning into "body…"
         text = c in ("variant", "hot_spot_clip", "status")
+        longest = max((len(str(v)) for v in frame[c]), default=1) if text else 1
         t.add_column(
             escape(HEADERS.get(c, c)),
             justify="left" if text else "right",
             overflow="fold" if text else "ellipsis",
             no_wrap=not text,
+            min_width=min(longest, 16) if text else None,
         )
     for _, r in frame.head(20).iterrows():
         t.add_row(
@@ -169,8 +180,9 @@ def study_command(
     )
     for name, e in outcome.failed.items():
         console.print(f"[red]failed[/] {escape(f'{name}: {e}')}", highlight=False)
-    console.print(escape(f"summary: {outcome.csv}, {outcome.parquet}"))
+    # paths whole on one line (the terminal wraps them; folded, they cannot be copied)
+    console.print(escape(f"summary: {outcome.csv}, {outcome.parquet}"), soft_wrap=True)
     if outcome.plot is not None:
-        console.print(escape(f"plot: {outcome.plot}"))
+        console.print(escape(f"plot: {outcome.plot}"), soft_wrap=True)
     if outcome.failed:
         raise typer.Exit(1)
