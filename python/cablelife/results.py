@@ -297,7 +297,10 @@ def _put(
     if a.ndim == 0 or a.size < 64:
         ds = group.create_dataset(name, data=a)
     else:
-        ds = put_deflated(group, name, a, CHUNK_STEPS, COMPRESSION["compression_opts"])
+        if COMPRESSION:
+            ds = put_deflated(group, name, a, CHUNK_STEPS, COMPRESSION["compression_opts"])
+        else:  # uncompressed (benchmarks/bench_results.py's reference)
+            ds = group.create_dataset(name, data=a, chunks=(min(CHUNK_STEPS, len(a)), *a.shape[1:]))
     ds.attrs["unit"] = unit if unit is not None else _UNITS.get(name, "1")
 
 
