@@ -32,6 +32,24 @@ pub struct Harness {
     obstacle_poses: Vec<Vec<Vec<Pose>>>,
 }
 
+impl Harness {
+    /// Every cable routed through its clip poses `first(c)` (None: its reference route), the
+    /// junctions at their reference poses: the start of a solve without a previous state.
+    fn routed(&self, first: impl Fn(usize) -> Option<Vec<Pose>>) -> PyResult<HarnessState> {
+        let tree = &self.tree;
+        let mut st = HarnessState {
+            cables: Vec::with_capacity(tree.cables.len()),
+            junctions: tree.reference.clone(),
+        };
+        for (c, rod) in tree.cables.iter().enumerate() {
+            st.cables.push(route(rod, first(c).as_deref()).map_err(|e| {
+                PyValueError::new_err(format!("cable '{}': {}", tree.names[c], e.0))
+            })?);
+        }
+        Ok(st)
+    }
+}
+
 #[pymethods]
 impl Harness {
     #[new]
@@ -181,21 +199,7 @@ impl Harness {
         let from_previous = previous.is_some();
         let initial = match previous {
             Some(p) => p,
-            None => {
-                let mut initial = HarnessState {
-                    cables: Vec::with_capacity(nc),
-                    junctions: tree.reference.clone(),
-                };
-                for (c, rod) in tree.cables.iter().enumerate() {
-                    let first: Option<Vec<Pose>> = (t > 0).then(|| poses[c][0].clone());
-                    initial
-                        .cables
-                        .push(route(rod, first.as_deref()).map_err(|e| {
-                            PyValueError::new_err(format!("cable '{}': {}", tree.names[c], e.0))
-                        })?);
-                }
-                initial
-            }
+            None => self.routed(|c| (t > 0).then(|| poses[c][0].clone()))?,
         };
         let solver = &mut self.solver;
         let stability = &mut self.stability;
@@ -576,20 +580,7 @@ impl Harness {
         let initial = match self.state.as_ref().filter(|s| same_start(s)) {
             Some(s) => s.clone(),
             None => {
-                let mut routed = HarnessState {
-                    cables: Vec::with_capacity(nc),
-                    junctions: tree.reference.clone(),
-                };
-                for (c, rod) in tree.cables.iter().enumerate() {
-                    let first: Option<Vec<Pose>> =
-                        (t > 0).then(|| motions[0][c].iter().map(|m| m.pose).collect());
-                    routed
-                        .cables
-                        .push(route(rod, first.as_deref()).map_err(|e| {
-                            PyValueError::new_err(format!("cable '{}': {}", tree.names[c], e.0))
-                        })?);
-                }
-                routed
+                self.routed(|c| (t > 0).then(|| motions[0][c].iter().map(|m| m.pose).collect()))?
             }
         };
         let opts = DynamicOptions {
