@@ -296,31 +296,40 @@ fn segment_result<S: Convex>(
 }
 
 /// Minimiser over [0, 1] of the convex function t ↦ max(sd(a + t (b − a)), 0), sd the signed
-/// distance to a convex solid. sd is convex along the segment and, outside the solid, C¹ with
-/// derivative n·(b − a) (n the outward normal at the closest point); so the minimum lies at an
-/// end when the slope there points away (one or two projections: most half-edges of a cable),
-/// else at the root of the non-decreasing slope, bracketed and found by regula falsi
-/// (Illinois) to 1e-10 m along the segment (as the golden-section search it replaces, which
-/// took ~40 projections for every segment); a point inside the solid ends the search (0).
+/// distance to a convex solid ([`minimise_along_segment`] with the stop inside the solid).
 fn convex_segment_minimiser<S: Convex>(s: &S, a: &V3, b: &V3) -> f64 {
     let d = b - a;
     let slope = |t: f64| {
         let (sd, _, n) = s.project(&(a + d * t));
         (sd, n.dot(&d))
     };
-    let (sd0, g0) = slope(0.0);
-    if sd0 <= 0.0 || g0 >= 0.0 {
+    minimise_along_segment(slope, d.norm(), a.norm(), true)
+}
+
+/// Minimiser over [0, 1] of a convex distance f(t) along a segment of length `len` (a the
+/// start's distance from the origin, for the round-off floor), given `slope(t)` = (f(t),
+/// f′(t)); the distance to a convex solid is convex and, outside it, C¹ with f′ = n·(b − a)
+/// (n the outward normal at the closest point). The minimum lies at an end when the slope
+/// there points away (one or two evaluations: most segments), else at the root of the
+/// non-decreasing slope, bracketed and found by regula falsi (Illinois) to 1e-10 m along the
+/// segment (as the golden-section search it replaces, which took ~40 evaluations for every
+/// segment). `stop_inside`: f ≤ 0 ends the search (a distance clamped at 0: any point inside
+/// will do); else the signed minimum (the deepest point) is sought.
+pub fn minimise_along_segment(
+    slope: impl Fn(f64) -> (f64, f64),
+    len: f64,
+    a: f64,
+    stop_inside: bool,
+) -> f64 {
+    let (f0, g0) = slope(0.0);
+    if (stop_inside && f0 <= 0.0) || g0 >= 0.0 {
         return 0.0;
     }
-    let (sd1, g1) = slope(1.0);
-    if sd1 <= 0.0 {
+    let (f1, g1) = slope(1.0);
+    if (stop_inside && f1 <= 0.0) || g1 <= 0.0 {
         return 1.0;
     }
-    if g1 <= 0.0 {
-        return 1.0;
-    }
-    let len = d.norm();
-    let tol = 1e-10_f64.max(1e-15 * (1.0 + a.norm())) / len;
+    let tol = 1e-10_f64.max(1e-15 * (1.0 + a)) / len;
     let (mut lo, mut hi, mut glo, mut ghi) = (0.0, 1.0, g0, g1);
     let mut side = 0i8; // which end stayed last time (Illinois: halve its slope)
     for _ in 0..100 {
@@ -331,8 +340,8 @@ fn convex_segment_minimiser<S: Convex>(s: &S, a: &V3, b: &V3) -> f64 {
         if !(t > lo && t < hi) {
             t = 0.5 * (lo + hi);
         }
-        let (sd, g) = slope(t);
-        if sd <= 0.0 || g == 0.0 {
+        let (f, g) = slope(t);
+        if (stop_inside && f <= 0.0) || g == 0.0 {
             return t;
         }
         if g < 0.0 {

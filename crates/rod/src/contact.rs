@@ -246,36 +246,16 @@ impl Obstacle {
         self.shape.distance_within(&local, bound - self.shrink) + self.shrink
     }
 
-    /// Closest points between the segment [a, b] and the obstacle (the distance along the
-    /// segment is convex for convex shapes: golden-section search to 1e-12 of the length).
+    /// Closest points between the segment [a, b] and the obstacle: the least signed distance
+    /// along the segment (convex for convex shapes; `primitives::minimise_along_segment`, which
+    /// for a mesh finds a local minimum).
     pub fn segment_query(&self, a: &Vector3<f64>, b: &Vector3<f64>) -> SegmentQuery {
-        let at = |t: f64| self.query(&(a + t * (b - a))).distance;
-        let golden = 0.5 * (5f64.sqrt() - 1.0);
-        let (mut lo, mut hi) = (0.0f64, 1.0f64);
-        let mut x1 = hi - golden * (hi - lo);
-        let mut x2 = lo + golden * (hi - lo);
-        let (mut f1, mut f2) = (at(x1), at(x2));
-        while hi - lo > 1e-12 {
-            if f1 <= f2 {
-                hi = x2;
-                x2 = x1;
-                f2 = f1;
-                x1 = hi - golden * (hi - lo);
-                f1 = at(x1);
-            } else {
-                lo = x1;
-                x1 = x2;
-                f1 = f2;
-                x2 = lo + golden * (hi - lo);
-                f2 = at(x2);
-            }
-        }
-        let mut t = 0.5 * (lo + hi);
-        for end in [0.0, 1.0] {
-            if at(end) <= at(t) {
-                t = end;
-            }
-        }
+        let d = b - a;
+        let slope = |t: f64| {
+            let q = self.query(&(a + t * d));
+            (q.distance, q.normal.dot(&d))
+        };
+        let t = primitives::minimise_along_segment(slope, d.norm(), a.norm(), false);
         let point = a + t * (b - a);
         let q = self.query(&point);
         SegmentQuery {
