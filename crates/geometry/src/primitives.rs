@@ -438,7 +438,11 @@ mod tests {
     /// Reference: the least of max(sd, 0) over 4001 samples of the segment, refined by a
     /// ternary search between the best sample's neighbours (sd is convex along the segment).
     fn brute_force<S: Convex>(s: &S, a: &V3, b: &V3) -> f64 {
-        let f = |t: f64| s.project(&(a + (b - a) * t)).0.max(0.0);
+        brute_force_of(|t| s.project(&(a + (b - a) * t)).0.max(0.0))
+    }
+
+    /// The same search for any function of t ∈ [0, 1].
+    fn brute_force_of(f: impl Fn(f64) -> f64) -> f64 {
         let n = 4000;
         let k = (0..=n)
             .min_by(|&i, &j| f(i as f64 / n as f64).total_cmp(&f(j as f64 / n as f64)))
@@ -503,6 +507,28 @@ mod tests {
                 );
                 inside += (want == 0.0) as usize;
                 interior += (got.t > 0.0 && got.t < 1.0) as usize;
+            }
+            // The signed minimum (the deepest point of a segment through the solid), as the
+            // contact's segment query asks for it. Inside, the signed distance has kinks (where
+            // the nearest face changes) and the minimum sits on one: the slope changes sign
+            // there without a root, and the search's 1e-10 m bracket bounds the error by
+            // 1e-10 m (|slope| ≤ 1).
+            for (name, s) in [
+                ("box", &bx as &dyn Convex),
+                ("cylinder", &cy as &dyn Convex),
+            ] {
+                let d = b - a;
+                let slope = |t: f64| {
+                    let (sd, _, n) = s.project(&(a + d * t));
+                    (sd, n.dot(&d))
+                };
+                let t = minimise_along_segment(slope, d.norm(), a.norm(), false);
+                let got = s.project(&(a + d * t)).0;
+                let want = brute_force_of(|t| s.project(&(a + d * t)).0);
+                assert!(
+                    (got - want).abs() < 1e-10,
+                    "{name} signed {k}: {got} vs {want}"
+                );
             }
         }
         assert!(
