@@ -1,6 +1,8 @@
 """Result files: compressed and chunked (lossless by default), float32 histories on request,
 readable with plain h5py, and read lazily (a command reads only the datasets it uses)."""
 
+import os
+
 import cablelife
 import h5py
 import numpy as np
@@ -153,3 +155,32 @@ def test_parallel_deflate_writes_the_chunks_hdf5_would_write(tmp_path, dtype):
     with h5py.File(tmp_path / "ours.h5") as f:
         back = f["x"][()]
     assert back.dtype == a.dtype.newbyteorder("<") and np.array_equal(back, a)
+
+
+def _write_deflated(path, a):
+    from cablelife.h5files import put_deflated
+
+    with h5py.File(path, "w") as f:
+        put_deflated(f, "x", a, 256, 1)
+
+
+@pytest.mark.skipif(not hasattr(os, "fork"), reason="needs fork")
+def test_a_forked_child_writes_with_its_own_compression_threads(tmp_path):
+    """A process forked after the parent compressed in threads (a study worker, a user's
+    multiprocessing) has a copy of the pool without its threads: without its own pool it hung
+    forever at its first save. The join's bound is a hang detector, not a speed test."""
+    import multiprocessing
+
+    a = np.random.default_rng(0).random((2000, 101, 3))
+    _write_deflated(tmp_path / "parent.h5", a)  # the parent's pool is running
+    child = multiprocessing.get_context("fork").Process(
+        target=_write_deflated, args=(tmp_path / "child.h5", a)
+    )
+    child.start()
+    child.join(120)
+    hung = child.is_alive()
+    if hung:
+        child.kill()
+    assert not hung and child.exitcode == 0
+    with h5py.File(tmp_path / "child.h5") as f:
+        assert np.array_equal(f["x"][()], a)

@@ -109,14 +109,15 @@ def put_deflated(group: h5py.Group, name: str, data: np.ndarray, chunk_steps: in
     return ds
 
 
-_POOL = None
+_POOL: tuple[int, object] | None = None
 
 
 def _pool():
-    """Threads for compression, one per core (started once)."""
+    """Threads for compression, one per core, started once per process (a forked child gets a
+    copy of the parent's pool without its threads: it starts its own)."""
     global _POOL
-    if _POOL is None:
+    if _POOL is None or _POOL[0] != os.getpid():
         from concurrent.futures import ThreadPoolExecutor
 
-        _POOL = ThreadPoolExecutor(max(1, min(8, os.cpu_count() or 1)), "deflate")
-    return _POOL
+        _POOL = (os.getpid(), ThreadPoolExecutor(max(1, min(8, os.cpu_count() or 1)), "deflate"))
+    return _POOL[1]
