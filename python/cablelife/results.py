@@ -296,11 +296,12 @@ def _put(
         a = a.astype(dtype)
     if a.ndim == 0 or a.size < 64:
         ds = group.create_dataset(name, data=a)
+    elif COMPRESSION.get("compression") == "gzip" and COMPRESSION.get("shuffle"):
+        # the default filters, the chunks deflated in threads (the same bytes)
+        ds = put_deflated(group, name, a, CHUNK_STEPS, COMPRESSION.get("compression_opts", 4))
     else:
-        if COMPRESSION:
-            ds = put_deflated(group, name, a, CHUNK_STEPS, COMPRESSION["compression_opts"])
-        else:  # uncompressed (benchmarks/bench_results.py's reference)
-            ds = group.create_dataset(name, data=a, chunks=(min(CHUNK_STEPS, len(a)), *a.shape[1:]))
+        chunks = (min(CHUNK_STEPS, a.shape[0]), *a.shape[1:])
+        ds = group.create_dataset(name, data=a, chunks=chunks, **COMPRESSION)
     ds.attrs["unit"] = unit if unit is not None else _UNITS.get(name, "1")
 
 

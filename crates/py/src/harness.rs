@@ -566,8 +566,11 @@ impl Harness {
         // was at the same clip poses (the default damping's calibration has just solved it:
         // the solve then converges at once), else from the routed shape.
         // (the clips of the joined ends follow their junctions: not compared)
-        let joined =
-            |c: usize, k: usize| tree.ends.iter().any(|e| e.cable == c && e.topo.clip == k);
+        let joined = |c: usize, k: usize| {
+            tree.cable_ends[c]
+                .iter()
+                .any(|&e| tree.ends[e].topo.clip == k)
+        };
         let same_start = |st: &HarnessState| {
             t > 0
                 && st.cables.iter().enumerate().all(|(c, s)| {

@@ -34,13 +34,16 @@ FLAGS = [
     "--disable-gpu-sandbox",
 ]
 
-# Text boxes (SVG text of every plotly figure, and the HTML text) whose rectangles overlap by
-# more than 1 px in both directions; the rendered figures' texts only when visible.
-OVERLAP_JS = r"""
+# The visible text boxes of every rendered plotly figure (SVG text), checked two ways:
+# ``overlaps``, pairs whose rectangles overlap by more than 1 px in both directions; ``clipped``,
+# text drawn (partly) outside its figure's box — cut off where the figure's margins are too
+# small for its tick labels, titles or slider (a legend too long for the figure scrolls: not
+# counted).
+TEXT_JS = r"""
 (function(){
- var out=[];
- document.querySelectorAll('.js-plotly-plot').forEach(function(fig,n){
-  var boxes=[];
+ var overlaps=[],clipped=[];
+ document.querySelectorAll('.js-plotly-plot').forEach(function(fig){
+  var boxes=[],box=fig.getBoundingClientRect();
   fig.querySelectorAll('svg text').forEach(function(t){
    if(!t.textContent.trim())return;
    var s=getComputedStyle(t);
@@ -51,36 +54,18 @@ OVERLAP_JS = r"""
    if(hidden)return;
    var r=t.getBoundingClientRect();
    if(r.width<1||r.height<1)return;
-   boxes.push({t:t.textContent.trim(),r:r});});
-  for(var i=0;i<boxes.length;i++)for(var j=i+1;j<boxes.length;j++){
-   var a=boxes[i].r,b=boxes[j].r;
-   var w=Math.min(a.right,b.right)-Math.max(a.left,b.left);
-   var h=Math.min(a.bottom,b.bottom)-Math.max(a.top,b.top);
-   if(w>1&&h>1)out.push({figure:fig.id,a:boxes[i].t,b:boxes[j].t});}
+   boxes.push({t:t.textContent.trim(),r:r,legend:!!t.closest('g.legend')});});
+  for(var i=0;i<boxes.length;i++){
+   var a=boxes[i].r;
+   if(!boxes[i].legend&&(a.left<box.left-1||a.right>box.right+1||a.top<box.top-1||
+      a.bottom>box.bottom+1))clipped.push({figure:fig.id,text:boxes[i].t});
+   for(var j=i+1;j<boxes.length;j++){
+    var b=boxes[j].r;
+    var w=Math.min(a.right,b.right)-Math.max(a.left,b.left);
+    var h=Math.min(a.bottom,b.bottom)-Math.max(a.top,b.top);
+    if(w>1&&h>1)overlaps.push({figure:fig.id,a:boxes[i].t,b:boxes[j].t});}}
  });
- return JSON.stringify(out);
-})()
-"""
-
-
-# Text of a figure drawn (partly) outside the figure's own box: cut off where the figure's
-# margins are too small for its tick labels, titles or slider (a legend too long for the
-# figure scrolls: not counted).
-CLIPPED_JS = r"""
-(function(){
- var out=[];
- document.querySelectorAll('.js-plotly-plot').forEach(function(fig){
-  var box=fig.getBoundingClientRect();
-  fig.querySelectorAll('svg.main-svg text').forEach(function(t){
-   if(!t.textContent.trim()||t.closest('g.legend'))return;  // a long legend scrolls
-   var s=getComputedStyle(t);
-   if(s.display==='none'||s.visibility==='hidden'||+s.opacity===0||+s.fillOpacity===0)return;
-   var r=t.getBoundingClientRect();
-   if(r.width<1||r.height<1)return;
-   if(r.left<box.left-1||r.right>box.right+1||r.top<box.top-1||r.bottom>box.bottom+1)
-    out.push({figure:fig.id,text:t.textContent.trim()});});
- });
- return JSON.stringify(out);
+ return JSON.stringify({overlaps:overlaps,clipped:clipped});
 })()
 """
 
@@ -222,8 +207,8 @@ async def _check(
     cpu = tree_cpu(pid) - cpu0 if cpu0 >= 0 else -1.0
     data = await cdp.evaluate("JSON.stringify(document.body.dataset)")
     d = json.loads(data)
-    overlaps = json.loads(await cdp.evaluate(OVERLAP_JS))
-    clipped = json.loads(await cdp.evaluate(CLIPPED_JS))
+    texts = json.loads(await cdp.evaluate(TEXT_JS))
+    overlaps, clipped = texts["overlaps"], texts["clipped"]
     values = {k: await cdp.evaluate(js) for k, js in (evaluate or {}).items()}
     files = []
     if shots is not None:

@@ -98,11 +98,7 @@ def primitive_mesh(part, size: float, near=None) -> tuple[np.ndarray, np.ndarray
     """A triangle mesh of an analytic part (in its own coordinates); a plane becomes a square
     of side ``size`` around the projection of ``near`` (default: its point)."""
     if part.shape == "plane":
-        n = np.asarray(part.normal, float)
-        n /= np.linalg.norm(n)
-        u = np.cross(n, np.eye(3)[int(np.argmin(np.abs(n)))])
-        u /= np.linalg.norm(u)
-        w = np.cross(n, u)
+        u, w, n = _basis(part.normal)
         p = np.asarray(part.point, float)
         if near is not None:
             p = near - n * (np.asarray(near, float) - p).dot(n)

@@ -41,16 +41,21 @@ def volume_vs_surroundings(
     the body (see the module docstring). ``motion``: the motion volume of all of ``result``'s
     cables over the same steps at the same voxel, if already computed: a body that does not
     move sees exactly that volume, whose distance field is then used as it is."""
-    from cablelife.volume.field import Capsules, grid_for, signed_distance
+    from cablelife.volume.field import Capsules, union_field
     from cablelife.volume.sweep import select_steps
 
     geom = result.surroundings
     if geom is None:
         raise ValueError("the result has no surroundings (no geometry on its bodies)")
+    at_rest = np.zeros((3, 4))
+    at_rest[:, :3] = np.eye(3)
     out = []
     for b, name in enumerate(geom.bodies):
         vertices, faces = geom.meshes[b]
         core = _body_core(vertices, faces)
+        # at rest at every step: the cables sweep the motion volume itself relative to it
+        still = motion is not None and motion.field.spacing == voxel
+        still = still and bool(np.all(geom.poses[b] == at_rest))
         caps, least = [], np.inf
         for c in result.cables.values():
             idx = select_steps(c.n_steps, steps)
@@ -63,20 +68,17 @@ def volume_vs_surroundings(
             ident[0, :, :, :3] = np.eye(3)
             value, _ = core.clearance(np.ascontiguousarray(local), radius, ident)
             least = min(least, float(value.min()))
-            caps.append(Capsules(local[:, :-1].reshape(-1, 3), local[:, 1:].reshape(-1, 3), radius))
-        rest = geom.poses[b, ..., :3] == np.eye(3)
-        if (
-            motion is not None
-            and motion.field.spacing == voxel
-            and rest.all()
-            and not np.any(geom.poses[b, ..., 3])
-        ):
-            f = motion.field  # at rest at every step: the motion volume itself
+            if not still:
+                caps.append(
+                    Capsules(local[:, :-1].reshape(-1, 3), local[:, 1:].reshape(-1, 3), radius)
+                )
+        if still:
+            f = motion.field
         else:
             allcaps = caps[0]
             for more in caps[1:]:
                 allcaps = allcaps.concat(more)
-            f = signed_distance(allcaps, *grid_for(allcaps.bounding_box, voxel), voxel)
+            f = union_field(allcaps, voxel)
         inside = np.argwhere(f.values <= 0)
         sd = core.project_points(0, f.points(inside))["distance"] if len(inside) else np.array([])
         out.append(BodyVolumeCheck(name, least, float((sd < 0).sum()) * voxel**3, voxel))

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from cablelife.volume.field import VoxelField, grid_for, signed_distance
+from cablelife.volume.field import VoxelField, union_field
 from cablelife.volume.mesh import TriangleMesh, level_set_mesh
 from cablelife.volume.motion import MotionVolume
 
@@ -66,9 +66,8 @@ def compare_volumes(
     voxel = min(a.voxel, b.voxel) if voxel is None else float(voxel)
     ba, bb = a.capsules.bounding_box, b.capsules.bounding_box
     box = np.stack([np.minimum(ba[0], bb[0]), np.maximum(ba[1], bb[1])])
-    origin, shape = grid_for(box, voxel)
-    fa = signed_distance(a.capsules, origin, shape, voxel)
-    fb = signed_distance(b.capsules, origin, shape, voxel)
+    fa = union_field(a.capsules, voxel, box)  # both on the grid of the common box
+    fb = union_field(b.capsules, voxel, box)
     va, vb = fa.values, fb.values
     combos = {
         "a": va,

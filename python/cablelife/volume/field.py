@@ -137,3 +137,15 @@ def signed_distance(
         if progress is not None:
             progress(i0 + n, nx)
     return VoxelField(values=values, origin=origin, spacing=voxel, band=band)
+
+
+def union_field(
+    capsules: Capsules,
+    voxel: float,
+    bounds: np.ndarray | None = None,
+    progress: Callable[[int, int], None] | None = None,
+) -> VoxelField:
+    """The union's signed distance on the grid that covers ``bounds`` (default: the capsules'
+    own bounding box) at ``voxel``: ``grid_for`` and ``signed_distance`` together."""
+    box = capsules.bounding_box if bounds is None else np.asarray(bounds, dtype=np.float64)
+    return signed_distance(capsules, *grid_for(box, voxel), voxel, progress=progress)

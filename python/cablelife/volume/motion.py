@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from cablelife.volume.field import Capsules, VoxelField, grid_for, signed_distance
+from cablelife.volume.field import Capsules, VoxelField, union_field
 from cablelife.volume.mesh import TriangleMesh, level_set_mesh
 from cablelife.volume.sweep import result_capsules
 
@@ -67,9 +67,7 @@ def volume_of_capsules(
     """The union of ``capsules`` meshed at ``voxel`` (m) on a grid covering ``bounds``
     (default: the capsules' own bounds); ``progress(done, total)``: rows of the grid."""
     t0 = time.perf_counter()
-    box = capsules.bounding_box if bounds is None else np.asarray(bounds, dtype=np.float64)
-    origin, shape = grid_for(box, voxel)
-    f = signed_distance(capsules, origin, shape, voxel, progress=progress)
+    f = union_field(capsules, voxel, bounds, progress)
     t1 = time.perf_counter()
     mesh = level_set_mesh(f)
     t2 = time.perf_counter()
