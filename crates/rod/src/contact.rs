@@ -492,8 +492,16 @@ pub fn sample_terms(
 pub struct Contact {
     pub obstacles: Vec<Obstacle>,
     pub opts: ContactOptions,
-    /// κ in use, N/m².
+    /// κ given (`ContactOptions::stiffness`) or automatic (the weight per length at about
+    /// d̂/2), N/m²: the start of every obstacle's stiffness.
     pub kappa: f64,
+    /// κ in use per obstacle, N/m²: `kappa`, raised where the contact load far exceeds the
+    /// weight the automatic stiffness is set for (`adapt_stiffness`).
+    pub obstacle_kappa: Vec<f64>,
+    /// Per obstacle: the smallest sample gap of the last full assembly, and the smallest of
+    /// the full assemblies since `begin_solve` (∞: no sample within reach).
+    obstacle_gap: Vec<f64>,
+    lowest_gap: Vec<f64>,
     /// Node positions at the start of the step (friction and damping reference).
     reference: Vec<Vector3<f64>>,
     /// Per obstacle: its pose (position, rotation) when the reference was taken, that pose
@@ -667,6 +675,9 @@ impl Contact {
             transport: vec![(Matrix3::identity(), Vector3::zeros()); n_obstacles],
             obstacles,
             kappa,
+            obstacle_kappa: vec![kappa; n_obstacles],
+            obstacle_gap: vec![f64::INFINITY; n_obstacles],
+            lowest_gap: vec![f64::INFINITY; n_obstacles],
             eps: opts.stick_distance,
             opts,
             reference: vec![Vector3::zeros(); n],
@@ -704,6 +715,61 @@ impl Contact {
             Some(h) => self.opts.stick_velocity * h,
             None => self.opts.stick_distance,
         };
+    }
+
+    /// Starts the record of the smallest gaps of a static solve (`stiffen_after_failure`).
+    pub fn begin_solve(&mut self) {
+        self.lowest_gap.fill(f64::INFINITY);
+    }
+
+    /// Whether the stiffness is automatic (`ContactOptions::stiffness` = 0) and so adapts to
+    /// the contact load.
+    pub fn adapts(&self) -> bool {
+        self.opts.stiffness == 0.0
+    }
+
+    /// Load-scaled barrier (automatic stiffness only). The automatic κ carries the cable's
+    /// weight at about d̂/2; a load far above it (a wrap under tension, a clip pressing the
+    /// cable onto a part, a chord's point contact on a convex part) presses the gap to
+    /// nanometres, where the barrier is stiff and its Taylor continuation below d̂/1000 caps the
+    /// force a sample can give. After a converged static solve, every obstacle whose most
+    /// loaded sample (the smallest gap of the last full assembly) lies below d̂/10 gets the κ
+    /// that carries that sample's line load κ|b'(g)| at d̂/2: κ ← κ b'(g_min)/b'(d̂/2). The
+    /// contact forces of an equilibrium do not depend on κ (only its gaps do), so the solve
+    /// is repeated from there. Returns whether any stiffness changed.
+    pub fn adapt_stiffness(&mut self) -> bool {
+        if !self.adapts() {
+            return false;
+        }
+        let dhat = self.opts.distance;
+        let target = barrier(0.5 * dhat, dhat).1;
+        let mut changed = false;
+        for (kappa, &g) in self.obstacle_kappa.iter_mut().zip(&self.obstacle_gap) {
+            if g < 0.1 * dhat {
+                *kappa *= barrier(g, dhat).1 / target;
+                changed = true;
+            }
+        }
+        changed
+    }
+
+    /// After a failed static solve (automatic stiffness only): ×30 the stiffness of every
+    /// obstacle that a sample came closer to than the barrier's continuation gap d̂/1000
+    /// since `begin_solve` — a load beyond what that sample's barrier can give (the Newton
+    /// iteration creeps towards zero gap under the 90 % rule). Returns whether any changed.
+    pub fn stiffen_after_failure(&mut self) -> bool {
+        if !self.adapts() {
+            return false;
+        }
+        let gs = continuation_gap(self.opts.distance);
+        let mut changed = false;
+        for (kappa, &g) in self.obstacle_kappa.iter_mut().zip(&self.lowest_gap) {
+            if g < gs {
+                *kappa *= 30.0;
+                changed = true;
+            }
+        }
+        changed
     }
 
     /// Undoes `begin_step`'s record of the obstacle poses (a step rolled back and redone).
@@ -854,7 +920,7 @@ impl Contact {
                         } else {
                             2.0 * w_end
                         };
-                        line.push((self.kappa * w, g, approach));
+                        line.push((self.obstacle_kappa[k] * w, g, approach));
                     }
                 });
             }
@@ -1089,7 +1155,10 @@ impl Contact {
             let q = o.query(&x);
             self.cache_samples[slot * stride + i] = (q.distance, q.normal);
             if outputs {
-                self.min_gap = self.min_gap.min(q.distance - self.opts.radius);
+                let g = q.distance - self.opts.radius;
+                self.min_gap = self.min_gap.min(g);
+                self.obstacle_gap[k] = self.obstacle_gap[k].min(g);
+                self.lowest_gap[k] = self.lowest_gap[k].min(g);
             }
             let xr = ra + t * (rb - ra);
             let mut gap_ref = 0.0;
@@ -1107,7 +1176,7 @@ impl Contact {
                 w,
                 self.opts.radius,
                 self.opts.distance,
-                self.kappa,
+                self.obstacle_kappa[k],
                 o.friction,
                 self.eps,
                 damping_rate,
@@ -1147,9 +1216,10 @@ impl Contact {
                     self.normal_force[n] -= c * s.normal_grad;
                     self.friction_force[n] -= c * s.friction_grad;
                 }
-                // Node states from the samples at the nodes.
-                for (n, at_node) in [(e, i == 0), (e + 1, i == kk)] {
-                    if at_node && s.normal_grad != Vector3::zeros() {
+                // Node states from the samples nearer to each node (a chord over a convex part
+                // touches between its nodes).
+                for (n, near) in [(e, 2 * i <= kk), (e + 1, 2 * i >= kk)] {
+                    if near && s.normal_grad != Vector3::zeros() {
                         let state = if o.friction > 0.0 && s.slip_ratio >= 1.0 {
                             SLIP
                         } else {
@@ -1179,6 +1249,7 @@ impl Term for Contact {
             self.body_force.iter_mut().for_each(|v| v.fill(0.0));
             self.node_state.fill(NO_CONTACT);
             self.min_gap = f64::INFINITY;
+            self.obstacle_gap.fill(f64::INFINITY);
         }
         for k in 0..self.obstacles.len() {
             match ev.part {

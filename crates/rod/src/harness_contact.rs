@@ -73,6 +73,31 @@ impl HarnessStatics {
         }
     }
 
+    /// Starts every cable contact's record of its smallest gaps (`Contact::begin_solve`).
+    pub(crate) fn begin_contact_solve(&mut self) {
+        for c in self.contact.iter_mut().flatten() {
+            c.begin_solve();
+        }
+    }
+
+    /// `Contact::adapt_stiffness` on every cable's contact: whether any stiffness changed.
+    pub(crate) fn adapt_contact_stiffness(&mut self) -> bool {
+        let mut any = false;
+        for c in self.contact.iter_mut().flatten() {
+            any |= c.adapt_stiffness();
+        }
+        any
+    }
+
+    /// `Contact::stiffen_after_failure` on every cable's contact: whether any changed.
+    pub(crate) fn stiffen_contact_after_failure(&mut self) -> bool {
+        let mut any = false;
+        for c in self.contact.iter_mut().flatten() {
+            any |= c.stiffen_after_failure();
+        }
+        any
+    }
+
     /// Whether a free node of some cable lies inside an obstacle at `st`.
     pub(crate) fn contact_penetrates(&self, h: &Harness, st: &HarnessState) -> bool {
         self.contact.iter().enumerate().any(|(c, contact)| {

@@ -712,7 +712,42 @@ impl HarnessStatics {
     /// Static equilibrium: plain Newton; then pseudo-transient continuation; then damped
     /// Newton; then load continuation from the unloaded start (gravity and loads ramped) with
     /// damped steps.
+    ///
+    /// With contact of automatic stiffness the barrier is scaled to the load as in
+    /// `Statics::solve` (`Contact::adapt_stiffness`, `Contact::stiffen_after_failure`).
     pub fn solve_static(
+        &mut self,
+        h: &Harness,
+        st: &mut HarnessState,
+    ) -> Result<SolveStats, HarnessError> {
+        let start = st.clone();
+        let mut iterations = 0;
+        let (mut adapted, mut stiffened) = (0, 0);
+        loop {
+            self.begin_contact_solve();
+            match self.solve_static_once(h, st) {
+                Ok(mut s) => {
+                    iterations += s.iterations;
+                    if adapted < 4 && self.adapt_contact_stiffness() {
+                        adapted += 1;
+                        continue;
+                    }
+                    s.iterations = iterations;
+                    return Ok(s);
+                }
+                Err(e) => {
+                    if stiffened < 3 && self.stiffen_contact_after_failure() {
+                        stiffened += 1;
+                        st.clone_from(&start);
+                        continue;
+                    }
+                    return Err(e);
+                }
+            }
+        }
+    }
+
+    fn solve_static_once(
         &mut self,
         h: &Harness,
         st: &mut HarnessState,
@@ -912,13 +947,23 @@ impl HarnessStatics {
             }
             st.sync_ends(h);
         }
-        let result = match self.step_from_reference(h, st, target) {
+        let mut result = match self.step_from_reference(h, st, target) {
             Ok(s) => Ok(s),
             Err(_) => {
                 st.clone_from(&self.last);
                 self.step_from_reference(h, st, target)
             }
         };
+        // The barrier scaled to the load (as `solve_static`): once more from the equilibrium.
+        if let Ok(s) = &result {
+            if self.adapt_contact_stiffness() {
+                let first = s.iterations;
+                result = self.step_from_reference(h, st, target).map(|mut s| {
+                    s.iterations += first;
+                    s
+                });
+            }
+        }
         let result = result.and_then(|mut s| {
             self.ensure_stable(h, st, &mut s)?; // an unstable equilibrium is left (harness_escape)
             Ok(s)

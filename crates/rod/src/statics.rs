@@ -544,7 +544,51 @@ impl Statics {
     /// free, or a zero stiffness).
     /// With contact, a start that runs through the geometry (a routed shape) is first solved
     /// without contact; the barrier's penalty continuation then pushes the cable out.
+    ///
+    /// With contact of automatic stiffness, the barrier is scaled to the load
+    /// (`Contact::adapt_stiffness`): an equilibrium whose contact presses a sample below d̂/10
+    /// is solved again from there with the stiffness that carries it at about d̂/2, and a solve
+    /// that fails with a sample pressed below the barrier's continuation gap is retried from
+    /// the start with the stiffness ×30 (`Contact::stiffen_after_failure`, at most 3 times).
     pub fn solve(&mut self, rod: &Rod, st: &mut State) -> Result<SolveStats, SolveError> {
+        let start = st.clone();
+        let mut total = SolveStats::default();
+        let (mut adapted, mut stiffened) = (0, 0);
+        loop {
+            if let Some(c) = &mut self.contact {
+                c.begin_solve();
+            }
+            match self.solve_once(rod, st) {
+                Ok(s) => {
+                    total.iterations += s.iterations;
+                    let again =
+                        adapted < 4 && self.contact.as_mut().is_some_and(|c| c.adapt_stiffness());
+                    if !again {
+                        return Ok(SolveStats {
+                            iterations: total.iterations,
+                            ..s
+                        });
+                    }
+                    adapted += 1;
+                }
+                Err(e) => {
+                    let again = matches!(e, SolveError::NotConverged { .. })
+                        && stiffened < 3
+                        && self
+                            .contact
+                            .as_mut()
+                            .is_some_and(|c| c.stiffen_after_failure());
+                    if !again {
+                        return Err(e);
+                    }
+                    stiffened += 1;
+                    st.clone_from(&start);
+                }
+            }
+        }
+    }
+
+    fn solve_once(&mut self, rod: &Rod, st: &mut State) -> Result<SolveStats, SolveError> {
         self.has_prev = false; // a new sequence starts here
         self.check_held(rod, st)?;
         let mut pre = SolveStats::default();
@@ -1621,13 +1665,23 @@ impl Statics {
         if self.has_prev {
             st.extrapolate_free(rod, &self.prev, &self.last);
         }
-        let result = match self.step_to(rod, st, target) {
+        let mut result = match self.step_to(rod, st, target) {
             Ok(s) => Ok(s),
             Err(_) => {
                 st.clone_from(&self.last);
                 self.step_to(rod, st, target)
             }
         };
+        // The barrier scaled to the load (as `solve`): once more from the equilibrium.
+        if let Ok(s) = &result {
+            if self.contact.as_mut().is_some_and(|c| c.adapt_stiffness()) {
+                let first = s.iterations;
+                result = self.step_to(rod, st, target).map(|mut s| {
+                    s.iterations += first;
+                    s
+                });
+            }
+        }
         std::mem::swap(&mut self.prev, &mut self.last);
         self.has_prev = true;
         let stats = result?;

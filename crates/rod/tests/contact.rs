@@ -80,12 +80,16 @@ struct Capstan {
     load: f64,
 }
 
-fn capstan(mu: f64) -> (Capstan, Statics) {
+/// The capstan over a cylinder primitive of the given length (finite: flat caps with sharp
+/// rims, so every edge is sampled `max_samples` = 8 times, the wrap over the smooth mantle
+/// too: the chord of an edge touches the drum near its middle sample, whose trapezoid weight
+/// ds/8 then carries the edge's whole load).
+fn capstan_over(mu: f64, length: f64) -> (Capstan, Statics) {
     capstan_on(
         mu,
         Box::new(Cylinder {
             radius: 0.05,
-            length: f64::INFINITY,
+            length,
         }),
         0.0,
     )
@@ -181,13 +185,9 @@ fn capstan_on(mu: f64, drum: Box<dyn Shape>, corner: f64) -> (Capstan, Statics) 
         .collect();
     let st = state_through(&rod, x, Vector3::new(0.0, 1.0, 0.0));
     let mut statics = Statics::new(&rod, NewtonOptions::default());
-    // At most 2 samples per edge: with the default 8 on the sharp corners of a mesh the static
-    // solve of the wrap does not converge (docs/contact.md: the deepest sample of a chord then
-    // carries a quarter of the load, needs more than the barrier's Taylor continuation below
-    // d̂/1000 can give at zero gap, and the 90 % gap bound stalls Newton short of it).
-    let mut opts = ContactOptions::for_radius(r);
-    opts.max_samples = 2;
-    statics.contact = Some(Contact::new(&rod, vec![o], opts, 1).unwrap());
+    // The default contact settings (the automatic stiffness, scaled to the load by the static
+    // solve: `Contact::adapt_stiffness`).
+    statics.contact = Some(Contact::new(&rod, vec![o], ContactOptions::for_radius(r), 1).unwrap());
     (
         Capstan {
             rod,
@@ -207,7 +207,13 @@ fn clip_tension(s: &Statics, c: &Capstan) -> f64 {
 
 #[test]
 fn frictionless_wrap_keeps_the_tension() {
-    let (mut c, mut s) = capstan(0.0);
+    for length in [f64::INFINITY, 1.0] {
+        frictionless_wrap_over(length);
+    }
+}
+
+fn frictionless_wrap_over(length: f64) {
+    let (mut c, mut s) = capstan_over(0.0, length);
     s.solve(&c.rod, &mut c.st).unwrap();
     let n = c.rod.n_edges();
     let (t1, t2) = (s.ws.edge_force[n / 8].z, s.ws.edge_force[n - n / 8].z);
@@ -228,6 +234,20 @@ fn frictionless_wrap_keeps_the_tension() {
     // No penetration of the capsules beyond 1 % of r; in contact within d̂ of the surface.
     let (gap, _, _) = ct.surface_gap(&c.st);
     assert!(gap > -0.01 * c.r && gap < 0.01 * c.r, "gap {gap}");
+    // The barrier scaled to the load: the tension presses the drum at T/R = 200 N/m, 400 times
+    // the weight the automatic stiffness is set for; the most loaded sample then sits at about
+    // d̂/2 (at least d̂/10), not at nanometres.
+    let dhat = ct.opts.distance;
+    assert!(
+        ct.obstacle_kappa[0] > 100.0 * ct.kappa,
+        "κ {:?}",
+        ct.obstacle_kappa
+    );
+    assert!(
+        ct.min_gap > 0.1 * dhat && ct.min_gap < dhat,
+        "gap {}",
+        ct.min_gap
+    );
 }
 
 /// The drum holds the cable while the clip end is pulled slowly (dynamics, 5 cm/s: inertia
@@ -235,13 +255,15 @@ fn frictionless_wrap_keeps_the_tension() {
 #[test]
 fn capstan_ratio_at_slip_is_exp_mu_theta() {
     let mu = 0.3;
-    let (c, s) = capstan(mu);
-    let ratio = pulled_ratio(mu, c, s);
     let exact = (mu * PI).exp();
-    assert!(
-        (ratio - exact).abs() < 0.02 * exact,
-        "ratio {ratio} vs e^(μπ) = {exact}"
-    );
+    for length in [f64::INFINITY, 1.0] {
+        let (c, s) = capstan_over(mu, length);
+        let ratio = pulled_ratio(mu, c, s);
+        assert!(
+            (ratio - exact).abs() < 0.02 * exact,
+            "drum length {length}: ratio {ratio} vs e^(μπ) = {exact}"
+        );
+    }
 }
 
 /// The same capstan over a tessellated drum: a prism mesh of 512 sides with its corners on the
@@ -956,6 +978,13 @@ fn a_route_through_a_table_is_pushed_out_onto_it() {
         q.contact.as_mut().unwrap().set_obstacle_poses(&[pose]);
         q.sequence_step(&rod, &mut reference, &targets).unwrap();
     }
+    // The barrier scales to the contact load (`Contact::adapt_stiffness`), and the table
+    // pressing up on its way raised the reference's stiffness further: the push-out's
+    // equilibrium solved again at that stiffness is the same state.
+    let kappa = q.contact.as_ref().unwrap().obstacle_kappa.clone();
+    assert!(kappa[0] > s.contact.as_ref().unwrap().obstacle_kappa[0]);
+    s.contact.as_mut().unwrap().obstacle_kappa = kappa;
+    s.solve(&rod, &mut st).unwrap();
     let worst =
         st.x.iter()
             .zip(&reference.x)
