@@ -185,15 +185,17 @@ impl Record {
         self.contact_gap.push(c.min_gap);
     }
 
-    /// Updates the peaks of the viscous section loads (dynamic runs).
+    /// Updates the peaks of the viscous section loads (dynamic runs). The shear force and
+    /// bending moment magnitudes as √(x² + y²): section loads are far from overflow, and
+    /// `f64::hypot` was 1.6 % of a harness run saving every step.
     pub(crate) fn push_viscous(&mut self, ws: &Workspace) {
         let p = &mut self.viscous_peak;
         for f in &ws.edge_force_viscous {
             p[0] = p[0].max(f.z.abs());
-            p[1] = p[1].max(f.x.hypot(f.y));
+            p[1] = p[1].max((f.x * f.x + f.y * f.y).sqrt());
         }
         for m in &ws.node_moment_viscous {
-            p[2] = p[2].max(m.x.hypot(m.y));
+            p[2] = p[2].max((m.x * m.x + m.y * m.y).sqrt());
             p[3] = p[3].max(m.z.abs());
         }
     }
