@@ -101,6 +101,8 @@ pub struct HarnessStatics {
     /// Length scales: the shortest cable (steps) and the finest mean segment (moments).
     length: f64,
     h: f64,
+    /// A push-out stage solve (`harness_contact`): fallbacks cut short, no load continuation.
+    pub(crate) stage: bool,
 }
 
 impl HarnessStatics {
@@ -168,6 +170,7 @@ impl HarnessStatics {
             escape_modal: None,
             length,
             h: hmin,
+            stage: false,
         }
     }
 
@@ -804,7 +807,11 @@ impl HarnessStatics {
             Err(_) => {}
         }
         st.clone_from(&start);
-        match self.pseudo_transient(h, st, 1.0, 20 * self.opts.max_iterations) {
+        // A push-out stage that does not converge is cheap to replace by a smaller one: its
+        // pseudo-transient fallback gets 6× the iterations instead of 20×, and no load
+        // continuation (that starts from the unloaded shape, not from the stage's neighbour).
+        let factor = if self.stage { 6 } else { 20 };
+        match self.pseudo_transient(h, st, 1.0, factor * self.opts.max_iterations) {
             Ok(mut s) => {
                 s.substeps = 1;
                 return Ok(s);
@@ -813,6 +820,11 @@ impl HarnessStatics {
             Err(_) => {}
         }
         st.clone_from(&start);
+        if self.stage {
+            return Err(HarnessError(
+                "a push-out stage did not converge (the next stage is smaller)".into(),
+            ));
+        }
         let last = match self.newton(h, st, 1.0, true) {
             Ok(mut s) => {
                 s.substeps = 1;
