@@ -20,7 +20,9 @@ class ContactSettings(BaseModel):
     enabled: bool = False
     friction: Annotated[float, Field(ge=0.0)] = 0.0
     distance: Annotated[float, Field(ge=0.0)] = 0.0  # d̂, m (0: 1 % of the cable radius)
-    stiffness: Annotated[float, Field(ge=0.0)] = 0.0  # κ, N/m² (0: from the weight per length)
+    # κ, N/m² (0: automatic — from the weight per length, raised per part by the static solve
+    # to the contact load it carries; docs/contact.md "The barrier scaled to the load")
+    stiffness: Annotated[float, Field(ge=0.0)] = 0.0
     stick_distance: Annotated[float, Field(ge=0.0)] = 0.0  # ε_x, m (0: 0.1 % of r)
     stick_velocity: Annotated[float, Field(gt=0.0)] = 1e-3  # ε_v, m/s
     damping: Annotated[float, Field(ge=0.0)] = 5e-4  # τ_c, s: normal damping of dynamic contact
