@@ -273,3 +273,86 @@ def test_modes_and_damping_calibration_rest_on_the_table(scene_dict):
     # The damping calibration takes mode 1 of the cable on the table.
     omega1, _ = bending_damping_of_mode1(scene, cable)
     assert omega1 == pytest.approx(m.omega[0], rel=1e-9)  # 1 mode vs 3: the eigensolver
+
+
+def slapped_wire(amplitude: float) -> dict:
+    """A thin wire (r = 1 mm) clamped at one end to an arm shaken vertically at 20 Hz, 6 cm
+    above a floor: with 5 cm amplitude (80 g) it slaps the floor."""
+    return {
+        "simulation": {"mode": "dynamic", "duration": 0.3, "time_step": 1e-3},
+        "bodies": [
+            {
+                "name": "floor",
+                "geometry": [
+                    {"shape": "plane", "name": "floor", "point": [0, 0, 0], "normal": [0, 0, 1]}
+                ],
+            },
+            {
+                "name": "arm",
+                "motion": [
+                    {
+                        "channel": "z",
+                        "signal": {
+                            "type": "sine",
+                            "amplitude": amplitude,
+                            "frequency": 20.0,
+                            "fade_in": 0.05,
+                        },
+                    }
+                ],
+            },
+        ],
+        "contact": {"enabled": True},
+        "cables": [
+            {
+                "name": "wire",
+                "length": 0.4,
+                "segments": 40,
+                "section": {"shape": "circle", "radius": 0.001},
+                "material": {"youngs_modulus": 5e7, "poisson_ratio": 0.45, "density": 1500.0},
+                "clips": [
+                    {
+                        "name": "a",
+                        "s": 0.0,
+                        "body": "arm",
+                        "position": [0, 0, 0.06],
+                        "direction": [1, 0, 0],
+                        "normal": [0, 0, 1],
+                    }
+                ],
+            }
+        ],
+    }
+
+
+def test_an_unresolved_impact_is_a_warning_and_is_saved(tmp_path):
+    """The step guard's report of impacts it had to accept unresolved (its exactness against
+    the step's energy balance: crates/rod/tests/contact.rs) reaches the user as an
+    ImpactWarning naming the cable, the largest gain and when, and is kept in the result file;
+    a gentler shake of the same wire reports nothing."""
+    from cablelife.validity import ImpactWarning
+
+    with pytest.warns(ImpactWarning, match=r"cable 'wire': an impact .* gained up to") as rec:
+        result = simulate(scene_from_dict(slapped_wire(0.05)))
+    gains = result.cable.solver["unresolved_gain"]
+    assert gains.shape == (result.cable.n_steps,)
+    assert gains.max() > 1e-3  # the guard's tolerance: only gains above it are reported
+    (message,) = [str(w.message) for w in rec if w.category is ImpactWarning]
+    assert f"{100 * gains.max():.3g} %" in message
+    back = load_result(result.save(tmp_path / "r.h5")).cable
+    np.testing.assert_array_equal(back.solver["unresolved_gain"], gains)
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ImpactWarning)
+        calm = simulate(scene_from_dict(slapped_wire(0.005))).cable
+    assert np.all(calm.solver["unresolved_gain"] == 0.0)
+
+
+def test_impact_message_names_the_worst_step():
+    from cablelife.validity import impact_messages
+
+    times = np.array([0.0, 0.1, 0.2, 0.3])
+    assert impact_messages("cable 'x'", np.zeros(4), times) == []
+    (m,) = impact_messages("cable 'x'", np.array([0.0, 2e-3, 0.0, 5e-2]), times)
+    assert "in 2 saved step(s)" in m and "5 %" in m and "t = 0.3 s" in m

@@ -80,8 +80,10 @@ class Cable:
         of `time_step` through the clip kinematics (T, C, ·): positions, quaternions, velocities,
         angular velocities, accelerations, angular accelerations (global). Every
         `output_every`-th step is recorded (and step 0). τ: retardation times (GA₁, GA₂, EA),
-        (EI₁, EI₂, GJ). Returns the recorded arrays, energies and `error` as `run_sequence`;
-        `stop` as there.
+        (EI₁, EI₂, GJ). Returns the recorded arrays, energies and `error` as `run_sequence`,
+        and `unresolved_gain` (T,): the largest energy gain, relative to the energies at play,
+        of an impact sub-step the step guard accepted at its deepest split since the last
+        recorded step (0: none); `stop` as there.
         """
         ...
     def run_sequence(
@@ -199,8 +201,9 @@ class Harness:
         `tau_bend[c]` (3 each). Returns what `run_sequence` returns, the cables' dicts with the
         energies of `Cable.run_dynamic`, and `junction_velocities` (T, J, 6: ẋ global, ω body),
         `kinetic_energy`, `elastic_energy`, `load_potential`, `dissipated_energy` (T,) of the
-        whole harness (junctions included). Junctions held by a clip follow its motion (given
-        for their first end); sliding clips slide (a cable running out of one stops the run).
+        whole harness (junctions included), `unresolved_gain` (T,) as `Cable.run_dynamic`.
+        Junctions held by a clip follow its motion (given for their first end); sliding clips
+        slide (a cable running out of one stops the run).
         """
         ...
 

@@ -361,6 +361,13 @@ def run_harness(scene: Scene, times: np.ndarray, mode: str, progress, stop):
             energies=energies,
             contact={k: o[k] for k in CONTACT_KEYS if k in o},
         )
+    if mode == "dynamic":
+        from cablelife import validity
+
+        gains = np.asarray(out["unresolved_gain"])
+        for res in results.values():
+            res.solver["unresolved_gain"] = gains
+        validity.report(validity.impact_messages("harness", gains, saved), validity.ImpactWarning)
     junctions: dict[str, JunctionResult] = {}
     ends = core.ends
     for jj, j in enumerate(scene.junctions):

@@ -385,7 +385,14 @@ def _run_cable(
     solver.update(_stability_info(out, saved[:n], core.arc_length, cable.name))
     energies = {"elastic_energy": out["elastic_energy"]}
     if mode == "dynamic":
+        from cablelife import validity
+
         solver["viscous_peak"] = np.asarray(out["viscous_peak"])
+        solver["unresolved_gain"] = np.asarray(out["unresolved_gain"])
+        validity.report(
+            validity.impact_messages(f"cable '{cable.name}'", solver["unresolved_gain"], saved[:n]),
+            validity.ImpactWarning,
+        )
         energies.update(
             kinetic_energy=out["kinetic_energy"],
             dissipated_energy=out["dissipated_energy"],

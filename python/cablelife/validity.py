@@ -54,6 +54,10 @@ class StabilityWarning(UserWarning):
     """A static state is unstable, or the cable snapped through."""
 
 
+class ImpactWarning(UserWarning):
+    """An impact on the geometry that the time step does not resolve."""
+
+
 def strains(c: CableResult, steps: slice = slice(None)) -> tuple[np.ndarray, np.ndarray]:
     """Axial strain Γ₃ and shear strain |(Γ₁, Γ₂)| per step and edge (T, N) from the saved
     configuration, Γ = Rᵀ (x_{n+1} − x_n)/Δs − e₃ (the model's strain; unlike F/EA it holds no
@@ -159,6 +163,25 @@ def snap_events(
         "snap_s": arc[node[k]].astype(float),
         "snap_jump": jump[k].astype(float),
     }
+
+
+def impact_messages(name: str, gains: np.ndarray, times: np.ndarray) -> list[str]:
+    """The warning for impacts the dynamic step guard accepted unresolved: ``gains`` (T,) per
+    saved step, the largest energy gain of a sub-step split down to the deepest level (1/64
+    of the time step) since the saved step before, relative to the energies at play; 0 where
+    none gained more than the guard's tolerance (docs/contact.md)."""
+    gains = np.asarray(gains, dtype=float)
+    bad = np.flatnonzero(gains > 0.0)
+    if bad.size == 0:
+        return []
+    k = int(bad[np.argmax(gains[bad])])
+    return [
+        f"{name}: an impact on the geometry is not resolved by the time step in {bad.size} "
+        f"saved step(s): split down to 1/64 of the step, a sub-step still gained up to "
+        f"{100 * gains[k]:.3g} % of the energies at play (by t = {times[k]:.4g} s) and was "
+        "accepted; the contact forces and the motion right after these impacts are not "
+        "reliable (compare a run with another time_step or contact damping; docs/contact.md)"
+    ]
 
 
 def report(messages: list[str], category: type[Warning]) -> None:

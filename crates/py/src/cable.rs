@@ -56,6 +56,9 @@ pub(crate) struct Record {
     iterations: Vec<i64>,
     substeps: Vec<i64>,
     residual: Vec<f64>,
+    /// Dynamic runs: per saved step, the largest energy gain of an impact sub-step the step
+    /// guard accepted at its deepest split since the last saved step (`StepStats::unresolved_gain`).
+    unresolved_gain: Vec<f64>,
     /// Negative eigenvalues of the tangent stiffness (−1: not checked: dynamic steps, dead
     /// moments).
     unstable: Vec<i64>,
@@ -98,6 +101,7 @@ impl Record {
             iterations: Vec::with_capacity(n),
             substeps: Vec::with_capacity(n),
             residual: Vec::with_capacity(n),
+            unresolved_gain: Vec::new(),
             unstable: Vec::with_capacity(n),
             snap_fraction: Vec::with_capacity(n),
             snap_jump: Vec::with_capacity(n),
@@ -150,6 +154,11 @@ impl Record {
         self.elastic_energy.push(ws.elastic_energy);
         self.load_potential.push(ws.load_potential);
         self.contact_energy.push(ws.contact_energy);
+    }
+
+    /// The unresolved impact gain of the saved step just pushed (dynamic runs).
+    pub(crate) fn push_unresolved(&mut self, gain: f64) {
+        self.unresolved_gain.push(gain);
     }
 
     /// The slid length of every clip at the step just pushed.
@@ -234,6 +243,12 @@ impl Record {
         d.set_item("iterations", PyArray1::from_vec(py, self.iterations))?;
         d.set_item("substeps", PyArray1::from_vec(py, self.substeps))?;
         d.set_item("residual", PyArray1::from_vec(py, self.residual))?;
+        if !self.unresolved_gain.is_empty() {
+            d.set_item(
+                "unresolved_gain",
+                PyArray1::from_vec(py, self.unresolved_gain),
+            )?;
+        }
         d.set_item("unstable", PyArray1::from_vec(py, self.unstable))?;
         d.set_item("snap_fraction", PyArray1::from_vec(py, self.snap_fraction))?;
         d.set_item("snap_jump", PyArray1::from_vec(py, self.snap_jump))?;
@@ -754,8 +769,10 @@ impl Cable {
     /// of `time_step` through the clip kinematics (T, C, ·): positions, quaternions, velocities,
     /// angular velocities, accelerations, angular accelerations (global). Every
     /// `output_every`-th step is recorded (and step 0). τ: retardation times (GA₁, GA₂, EA),
-    /// (EI₁, EI₂, GJ). Returns the recorded arrays, energies and `error` as `run_sequence`;
-    /// `stop` as there.
+    /// (EI₁, EI₂, GJ). Returns the recorded arrays, energies and `error` as `run_sequence`,
+    /// and `unresolved_gain` (T,): the largest energy gain, relative to the energies at play,
+    /// of an impact sub-step the step guard accepted at its deepest split since the last
+    /// recorded step (0: none); `stop` as there.
     #[pyo3(signature = (time_step, positions, quaternions, velocities, angular_velocities,
         accelerations, angular_accelerations, output_every, tau_shear, tau_bend,
         spectral_radius=0.9, newton_tolerance=DynamicOptions::default().tolerance, progress=None,
@@ -870,15 +887,18 @@ impl Cable {
             rec.push(rod, &st, &dy.ws, &stats);
             rec.push_sliding(rod, dy.sliding.as_ref());
             rec.push_energies(&dy.energies);
+            rec.push_unresolved(0.0);
             if let Some(c) = &dy.contact {
                 rec.push_contact(c);
             }
+            let mut gain = 0.0f64; // the largest unresolved impact gain since the last saved step
             for k in 1..t {
                 if let (Some(c), Some(p)) = (&mut dy.contact, obstacle_at(obstacle_poses, k)) {
                     c.set_obstacle_poses(p);
                 }
                 match dy.advance(rod, &mut st, time_step, &motions[k - 1], &motions[k], 6) {
                     Ok(s) => {
+                        gain = gain.max(s.unresolved_gain);
                         if k % every == 0 {
                             if let Err(e) = dy.update_outputs(rod, &st) {
                                 *state_slot = Some(st);
@@ -894,6 +914,7 @@ impl Cable {
                             rec.push_sliding(rod, dy.sliding.as_ref());
                             rec.push_viscous(&dy.ws);
                             rec.push_energies(&dy.energies);
+                            rec.push_unresolved(std::mem::take(&mut gain));
                             if let Some(c) = &dy.contact {
                                 rec.push_contact(c);
                             }

@@ -454,8 +454,9 @@ impl Harness {
     /// `tau_bend[c]` (3 each). Returns what `run_sequence` returns, the cables' dicts with the
     /// energies of `Cable.run_dynamic`, and `junction_velocities` (T, J, 6: ẋ global, ω body),
     /// `kinetic_energy`, `elastic_energy`, `load_potential`, `dissipated_energy` (T,) of the
-    /// whole harness (junctions included). Junctions held by a clip follow its motion (given
-    /// for their first end); sliding clips slide (a cable running out of one stops the run).
+    /// whole harness (junctions included), `unresolved_gain` (T,) as `Cable.run_dynamic`.
+    /// Junctions held by a clip follow its motion (given for their first end); sliding clips
+    /// slide (a cable running out of one stops the run).
     #[pyo3(signature = (time_step, kinematics, output_every, tau_shear, tau_bend,
         spectral_radius=0.9, newton_tolerance=DynamicOptions::default().tolerance, progress=None,
         progress_every=100, stop=None))]
@@ -609,6 +610,7 @@ impl Harness {
             iterations: Vec<i64>,
             substeps: Vec<i64>,
             residual: Vec<f64>,
+            unresolved_gain: Vec<f64>,
             steps: usize,
         }
         let (out, error) = py.detach(move || {
@@ -629,6 +631,7 @@ impl Harness {
                 iterations: Vec::with_capacity(saved),
                 substeps: Vec::with_capacity(saved),
                 residual: Vec::with_capacity(saved),
+                unresolved_gain: Vec::with_capacity(saved),
                 steps: 0,
             };
             if t == 0 {
@@ -669,48 +672,53 @@ impl Harness {
             if let Err(e) = hd.start(tree, &mut st) {
                 return (out, Some(format!("start: {e}")));
             }
-            let record =
-                |out: &mut Out, hd: &HarnessDynamics, st: &HarnessState, s: &rod::SolveStats| {
-                    for (c, rod) in tree.cables.iter().enumerate() {
-                        let dy = &hd.cables[c];
-                        let rec = &mut out.records[c];
-                        rec.push(rod, &st.cables[c], &dy.ws, s);
-                        rec.push_sliding(rod, dy.sliding.as_ref());
-                        rec.push_viscous(&dy.ws);
-                        rec.push_energies(&dy.energies);
-                        if let Some(c) = &dy.contact {
-                            rec.push_contact(c);
-                        }
+            let record = |out: &mut Out,
+                          hd: &HarnessDynamics,
+                          st: &HarnessState,
+                          s: &rod::SolveStats,
+                          gain: f64| {
+                for (c, rod) in tree.cables.iter().enumerate() {
+                    let dy = &hd.cables[c];
+                    let rec = &mut out.records[c];
+                    rec.push(rod, &st.cables[c], &dy.ws, s);
+                    rec.push_sliding(rod, dy.sliding.as_ref());
+                    rec.push_viscous(&dy.ws);
+                    rec.push_energies(&dy.energies);
+                    if let Some(c) = &dy.contact {
+                        rec.push_contact(c);
                     }
-                    for (pose, v) in st.junctions.iter().zip(hd.junction_velocities()) {
-                        out.jpos.extend_from_slice(pose.position.as_slice());
-                        let q = pose.orientation;
-                        out.jquat.extend_from_slice(&[q.w, q.i, q.j, q.k]);
-                        out.jvel.extend_from_slice(v.as_slice());
-                    }
-                    for (f, m) in hd.branch_loads(tree, st) {
-                        out.force.extend_from_slice(f.as_slice());
-                        out.moment.extend_from_slice(m.as_slice());
-                    }
-                    for (f, m) in hd.junction_reactions(tree, st) {
-                        out.react[0].extend_from_slice(f.as_slice());
-                        out.react[1].extend_from_slice(m.as_slice());
-                    }
-                    let e = &hd.energies;
-                    for (v, x) in out.energies.iter_mut().zip([
-                        e.kinetic,
-                        e.elastic,
-                        e.load_potential,
-                        e.dissipated,
-                    ]) {
-                        v.push(x);
-                    }
-                    out.iterations.push(s.iterations as i64);
-                    out.substeps.push(s.substeps as i64);
-                    out.residual.push(s.residual);
-                    out.steps += 1;
-                };
-            record(&mut out, &hd, &st, &stats);
+                }
+                for (pose, v) in st.junctions.iter().zip(hd.junction_velocities()) {
+                    out.jpos.extend_from_slice(pose.position.as_slice());
+                    let q = pose.orientation;
+                    out.jquat.extend_from_slice(&[q.w, q.i, q.j, q.k]);
+                    out.jvel.extend_from_slice(v.as_slice());
+                }
+                for (f, m) in hd.branch_loads(tree, st) {
+                    out.force.extend_from_slice(f.as_slice());
+                    out.moment.extend_from_slice(m.as_slice());
+                }
+                for (f, m) in hd.junction_reactions(tree, st) {
+                    out.react[0].extend_from_slice(f.as_slice());
+                    out.react[1].extend_from_slice(m.as_slice());
+                }
+                let e = &hd.energies;
+                for (v, x) in out.energies.iter_mut().zip([
+                    e.kinetic,
+                    e.elastic,
+                    e.load_potential,
+                    e.dissipated,
+                ]) {
+                    v.push(x);
+                }
+                out.iterations.push(s.iterations as i64);
+                out.substeps.push(s.substeps as i64);
+                out.residual.push(s.residual);
+                out.unresolved_gain.push(gain);
+                out.steps += 1;
+            };
+            record(&mut out, &hd, &st, &stats, 0.0);
+            let mut gain = 0.0f64; // the largest unresolved impact gain since the last saved step
             for k in 1..t {
                 for (c, dy) in hd.cables.iter_mut().enumerate() {
                     if let (Some(c), Some(p)) =
@@ -721,6 +729,7 @@ impl Harness {
                 }
                 match hd.advance(tree, &mut st, time_step, &motions[k - 1], &motions[k], 6) {
                     Ok(s) => {
+                        gain = gain.max(s.unresolved_gain);
                         if k % every == 0 {
                             if let Err(e) = hd.update_outputs(tree, &st) {
                                 return (out, Some(format!("step {k}: {e}")));
@@ -731,7 +740,7 @@ impl Harness {
                                 substeps: s.substeps - 1,
                                 ..Default::default()
                             };
-                            record(&mut out, &hd, &st, &stats);
+                            record(&mut out, &hd, &st, &stats, std::mem::take(&mut gain));
                         }
                     }
                     Err(e) => {
@@ -765,6 +774,10 @@ impl Harness {
         d.set_item("iterations", PyArray1::from_vec(py, out.iterations))?;
         d.set_item("substeps", PyArray1::from_vec(py, out.substeps))?;
         d.set_item("residual", PyArray1::from_vec(py, out.residual))?;
+        d.set_item(
+            "unresolved_gain",
+            PyArray1::from_vec(py, out.unresolved_gain),
+        )?;
         d.set_item("steps", n)?;
         d.set_item("error", error)?;
         Ok(d)

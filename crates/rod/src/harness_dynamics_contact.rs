@@ -153,16 +153,16 @@ impl HarnessDynamics {
         }))
     }
 
-    /// Whether the step just taken from `start` gained energy beyond the clips' work and the
-    /// tolerance (then the dissipated energies are put back: the step will be redone).
-    pub(crate) fn energy_grew(
+    /// The energy the step just taken from `start` gained beyond the clips' work, relative to
+    /// the energies at play (0 where moving geometry did work that is not counted).
+    pub(crate) fn energy_gain(
         &mut self,
         h: &Harness,
         st: &HarnessState,
         start: &EnergyStart,
-    ) -> Result<bool, HarnessError> {
+    ) -> Result<f64, HarnessError> {
         if self.cables.iter().any(|d| d.obstacles_moved()) {
-            return Ok(false); // moving geometry does work that is not counted
+            return Ok(0.0); // moving geometry does work that is not counted
         }
         self.update_outputs(h, st)?;
         let work_of = |r0: &Reaction, r1: &Reaction| {
@@ -184,13 +184,14 @@ impl HarnessDynamics {
         let (e0, e1) = (&start.energies, &self.energies);
         let total = |e: &Energies| e.kinetic + e.elastic + e.load_potential + e.contact;
         let scale = e0.kinetic + e1.kinetic + e0.elastic.abs() + e0.contact + work.abs();
-        let grew = total(e1) - total(e0) - work > self.opts.energy_tolerance * scale;
-        if grew {
-            for (dy, &(d, p)) in self.cables.iter_mut().zip(&start.dissipated) {
-                (dy.energies.dissipated, dy.power_n) = (d, p);
-            }
+        Ok((total(e1) - total(e0) - work) / scale)
+    }
+
+    /// Puts back the dissipated energies of `start` (a step that will be redone).
+    pub(crate) fn restore_dissipated(&mut self, start: &EnergyStart) {
+        for (dy, &(d, p)) in self.cables.iter_mut().zip(&start.dissipated) {
+            (dy.energies.dissipated, dy.power_n) = (d, p);
         }
-        Ok(grew)
     }
 
     /// Every cable's own clips (not the joined ends): reaction on the cable and pose.

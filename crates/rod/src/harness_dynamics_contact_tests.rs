@@ -181,3 +181,42 @@ fn dynamic_iteration_matrix_with_contact_matches_finite_differences() {
     assert!(fdev < 1e-6 * fscale, "forces {fdev:e} of {fscale:e}");
     assert!(mdev < 1e-6 * mscale, "moments {mdev:e} of {mscale:e}");
 }
+
+/// The harness's step guard reports the steps it has to accept at its deepest level (here
+/// `max_depth` 0: every step) with the energy they gained, as the single cable's
+/// (crates/rod/tests/contact.rs): the reported gain is the energy balance of the step measured
+/// from outside (the Y is free and its clips still: no work), and 0 within the tolerance.
+#[test]
+fn an_unresolved_impact_of_the_harness_is_reported_with_its_energy_gain() {
+    let (h, mut st, mut hd, clips) = dropped_y_tilted(0.0);
+    let tolerance = hd.opts.energy_tolerance;
+    let total = |e: &Energies| e.kinetic + e.elastic + e.load_potential + e.contact;
+    let (mut reported, mut within) = (0, 0);
+    for k in 0..200 {
+        hd.update_outputs(&h, &st).unwrap();
+        let e0 = hd.energies;
+        let s = hd
+            .advance(&h, &mut st, 1e-3, &clips, &clips, 0)
+            .unwrap_or_else(|e| panic!("step {k}: {}", e.0));
+        hd.update_outputs(&h, &st).unwrap();
+        let e1 = hd.energies;
+        let scale = e0.kinetic + e1.kinetic + e0.elastic.abs() + e0.contact;
+        let gain = (total(&e1) - total(&e0)) / scale;
+        if s.unresolved_gain > 0.0 {
+            reported += 1;
+            assert!(
+                (s.unresolved_gain - gain).abs() < 1e-9 * gain,
+                "step {k}: reported {} vs {gain}",
+                s.unresolved_gain
+            );
+            assert!(gain > tolerance);
+        } else {
+            within += 1;
+            assert!(gain <= tolerance, "step {k}: gain {gain} not reported");
+        }
+    }
+    assert!(
+        reported > 0 && within > 0,
+        "{reported} reported, {within} within"
+    );
+}

@@ -1213,3 +1213,70 @@ fn a_clip_driven_into_the_geometry_keeps_newton_converging() {
         }
     }
 }
+
+/// The step guard reports what it cannot split further: a step taken at the deepest level
+/// (here `max_depth` 0, so every step) that gains more than `energy_tolerance` of the energies
+/// at play near the geometry is accepted with that gain in `StepStats::unresolved_gain` — the
+/// same number as the energy balance of the step measured from outside (a free cable: no clip
+/// work), and 0 for the steps within the tolerance.
+#[test]
+fn an_unresolved_impact_is_reported_with_its_energy_gain() {
+    let r = 0.001;
+    let (l, n) = (0.4, 40);
+    let sec = circle(r, 5e7, 0.45, 1500.0);
+    let rod = Rod::new(CableSpec {
+        length: l,
+        segments: n,
+        section: sec,
+        natural_curvature: Vector3::zeros(),
+        clips: vec![],
+        loads: vec![],
+        gravity: Vector3::new(0.0, 0.0, -9.81),
+    })
+    .unwrap();
+    let x = rod
+        .arc
+        .iter()
+        .map(|&s| Vector3::new(s, 0.0, r + 0.02 + 0.01 * s))
+        .collect();
+    let mut st = state_through(&rod, x, Vector3::z());
+    let floor = Obstacle::new("floor", 0, Box::new(Plane), 0.0, &origin());
+    let opts = DynamicOptions {
+        tau_bend: Vector3::new(1e-3, 1e-3, 1e-3),
+        tau_shear: Vector3::new(1e-4, 1e-4, 1e-4),
+        ..Default::default()
+    };
+    let tolerance = opts.energy_tolerance;
+    let mut dy = Dynamics::new(&rod, &st, &[], opts);
+    dy.contact = Some(contact(&rod, vec![floor], r));
+    dy.start(&rod, &st).unwrap();
+    let total = |e: &rod::dynamics::Energies| e.kinetic + e.elastic + e.load_potential + e.contact;
+    let (mut reported, mut within) = (0, 0);
+    for k in 0..200 {
+        dy.update_outputs(&rod, &st).unwrap();
+        let e0 = dy.energies;
+        let s = dy
+            .advance(&rod, &mut st, 1e-3, &[], &[], 0)
+            .unwrap_or_else(|e| panic!("step {k}: {e}"));
+        dy.update_outputs(&rod, &st).unwrap();
+        let e1 = dy.energies;
+        let gain =
+            (total(&e1) - total(&e0)) / (e0.kinetic + e1.kinetic + e0.elastic.abs() + e0.contact);
+        if s.unresolved_gain > 0.0 {
+            reported += 1;
+            assert!(
+                (s.unresolved_gain - gain).abs() < 1e-9 * gain,
+                "step {k}: reported {} vs {gain}",
+                s.unresolved_gain
+            );
+            assert!(gain > tolerance);
+        } else {
+            within += 1;
+            assert!(gain <= tolerance, "step {k}: gain {gain} not reported");
+        }
+    }
+    assert!(
+        reported > 0 && within > 0,
+        "{reported} reported, {within} within"
+    );
+}
