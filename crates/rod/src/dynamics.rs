@@ -182,6 +182,17 @@ impl StepStats {
     }
 }
 
+/// The step guard's verdict on a step near the geometry that gained `gain` of the energies at
+/// play: None to split it (a gain above `tolerance` with splits left), else the gain to report
+/// as unresolved (0 within the tolerance or for NaN, nothing at play).
+pub(crate) fn guard_verdict(gain: f64, tolerance: f64, max_depth: usize) -> Option<f64> {
+    match (gain > tolerance, max_depth) {
+        (false, _) => Some(0.0),
+        (true, 0) => Some(gain),
+        (true, _) => None,
+    }
+}
+
 /// Energies after a step, J.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Energies {
@@ -908,21 +919,19 @@ impl Dynamics {
                 let total = |e: &Energies| e.kinetic + e.elastic + e.load_potential + e.contact;
                 let scale = e0.kinetic + e1.kinetic + e0.elastic.abs() + e0.contact + work.abs();
                 let gain = (total(&e1) - total(&e0) - work) / scale;
-                let grew = gain > self.opts.energy_tolerance; // NaN (nothing at play): no
-                if !grew {
-                    Ok(s)
-                } else if max_depth == 0 {
-                    Ok(StepStats {
-                        unresolved_gain: gain,
+                match guard_verdict(gain, self.opts.energy_tolerance, max_depth) {
+                    Some(unresolved_gain) => Ok(StepStats {
+                        unresolved_gain,
                         ..s
-                    })
-                } else {
-                    (self.energies.dissipated, self.power_n) = dissipated;
-                    Err(SolveError::NotConverged {
-                        iterations: s.iterations,
-                        residual: s.residual,
-                        load_factor: 1.0,
-                    })
+                    }),
+                    None => {
+                        (self.energies.dissipated, self.power_n) = dissipated;
+                        Err(SolveError::NotConverged {
+                            iterations: s.iterations,
+                            residual: s.residual,
+                            load_factor: 1.0,
+                        })
+                    }
                 }
             }
             (r, _) => r,

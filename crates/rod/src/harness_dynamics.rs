@@ -15,8 +15,8 @@
 //! factor, 1 + O(hΔq), is left out).
 use crate::assembly::{KinkAt, Part};
 use crate::dynamics::{
-    ClipMotion, DynamicOptions, Dynamics, Energies, GenAlpha, StepStats, STALL_TOLERANCE,
-    TOLERANCE_FLOOR,
+    guard_verdict, ClipMotion, DynamicOptions, Dynamics, Energies, GenAlpha, StepStats,
+    STALL_TOLERANCE, TOLERANCE_FLOOR,
 };
 use crate::harness::{Harness, HarnessError, HarnessState, HarnessStatics};
 use crate::harness_solver::vec_to_junction;
@@ -774,20 +774,18 @@ impl HarnessDynamics {
         let result = match (self.step(h, st, dt, to), start) {
             (Ok(s), Some(e0)) => {
                 let gain = self.energy_gain(h, st, &e0)?;
-                let grew = gain > self.opts.energy_tolerance; // NaN (nothing at play): no
-                if !grew {
-                    Ok(s)
-                } else if max_depth == 0 {
-                    Ok(StepStats {
-                        unresolved_gain: gain,
+                match guard_verdict(gain, self.opts.energy_tolerance, max_depth) {
+                    Some(unresolved_gain) => Ok(StepStats {
+                        unresolved_gain,
                         ..s
-                    })
-                } else {
-                    self.restore_dissipated(&e0);
-                    Err(HarnessError(format!(
-                        "the step gained energy at contact ({} iterations)",
-                        s.iterations
-                    )))
+                    }),
+                    None => {
+                        self.restore_dissipated(&e0);
+                        Err(HarnessError(format!(
+                            "the step gained energy at contact ({} iterations)",
+                            s.iterations
+                        )))
+                    }
                 }
             }
             (r, _) => r,
