@@ -275,43 +275,51 @@ def test_modes_and_damping_calibration_rest_on_the_table(scene_dict):
     assert omega1 == pytest.approx(m.omega[0], rel=1e-9)  # 1 mode vs 3: the eigensolver
 
 
-def slapped_wire(d: dict, amplitude: float) -> dict:
-    """The shared hose made a thin wire (r = 1 mm, 0.4 m) clamped at one end to an arm shaken
-    vertically at 20 Hz, 6 cm above a floor: with 5 cm amplitude (80 g) it slaps the floor."""
-    shake = {"type": "sine", "amplitude": amplitude, "frequency": 20.0, "fade_in": 0.05}
-    d["simulation"].update(mode="dynamic", duration=0.3, time_step=1e-3)
-    d = with_table(d)
-    d["bodies"][0]["geometry"][0]["point"] = [0, 0, 0]
-    d["bodies"].append({"name": "arm", "motion": [{"channel": "z", "signal": shake}]})
-    cable = d["cables"][0]
-    cable.update(length=0.4, section={"shape": "circle", "radius": 0.001})
-    cable["clips"] = cable["clips"][:1]
-    cable["clips"][0].update(body="arm", position=[0, 0, 0.06])
-    return d
-
-
-def test_an_unresolved_impact_is_a_warning_and_is_saved(scene_dict, tmp_path):
-    """The step guard's report of impacts it had to accept unresolved (its exactness against
-    the step's energy balance: crates/rod/tests/contact.rs) reaches the user as an
-    ImpactWarning naming the cable, the largest gain and when, and is kept in the result file;
-    a gentler shake of the same wire reports nothing."""
-    from cablelife.validity import ImpactWarning
-
-    with pytest.warns(ImpactWarning, match=r"cable 'hose': an impact .* gained up to") as rec:
-        result = simulate(scene_from_dict(slapped_wire(copy.deepcopy(scene_dict), 0.05)))
-    gains = result.cable.solver["unresolved_gain"]
-    assert gains.shape == (result.cable.n_steps,)
-    assert gains.max() > 1e-3  # the guard's tolerance: only gains above it are reported
-    (message,) = [str(w.message) for w in rec if w.category is ImpactWarning]
-    assert f"{100 * gains.max():.3g} %" in message
-    back = load_result(result.save(tmp_path / "r.h5")).cable
-    np.testing.assert_array_equal(back.solver["unresolved_gain"], gains)
+def test_an_unresolved_impact_is_a_warning_and_is_saved(scene_dict, tmp_path, monkeypatch):
+    """The path of the step guard's report of impacts it had to accept unresolved (its physics:
+    the report equals the step's energy balance, crates/rod/src/harness_dynamics_contact_tests.rs)
+    to the user: a run whose solver reports a gain gives an ImpactWarning naming the cable, the
+    largest gain and when, and keeps the gains in the result file; a run without gives none.
+    The solver's output is given a reported gain here, so that the test does not hang on an
+    impact that one solver version happens not to resolve."""
+    import importlib
     import warnings
 
+    from cablelife.validity import ImpactWarning
+
+    sim = importlib.import_module("cablelife.simulate")  # the module, not the function
+
+    class Reporting:
+        """A cable whose dynamic run reports an unresolved gain of 0.88 % at its 5th step."""
+
+        def __init__(self, core):
+            self._core = core
+
+        def __getattr__(self, name):
+            return getattr(self._core, name)
+
+        def run_dynamic(self, *args, **kwargs):
+            out = self._core.run_dynamic(*args, **kwargs)
+            out["unresolved_gain"][5] = 0.0088
+            return out
+
+    d = with_table(scene_dict, friction=0.3)
+    d["simulation"].update(mode="dynamic", duration=0.02, time_step=1e-3)
     with warnings.catch_warnings():
         warnings.simplefilter("error", ImpactWarning)
-        calm = simulate(scene_from_dict(slapped_wire(scene_dict, 0.005))).cable
+        calm = simulate(scene_from_dict(d)).cable
+    assert calm.solver["unresolved_gain"].shape == (calm.n_steps,)
     assert np.all(calm.solver["unresolved_gain"] == 0.0)
+    build = sim.build_cable
+    monkeypatch.setattr(sim, "build_cable", lambda scene, cable: Reporting(build(scene, cable)))
+    with pytest.warns(ImpactWarning, match=r"cable 'hose': an impact .* in 1 saved step") as rec:
+        result = simulate(scene_from_dict(d))
+    (message,) = [str(w.message) for w in rec if w.category is ImpactWarning]
+    assert "0.88 %" in message and "t = 0.005 s" in message
+    back = load_result(result.save(tmp_path / "r.h5")).cable
+    gains = result.cable.solver["unresolved_gain"]
+    np.testing.assert_array_equal(back.solver["unresolved_gain"], gains)
+    assert back.solver["unresolved_gain"][5] == 0.0088
 
 
 def test_impact_message_names_the_worst_step():

@@ -305,8 +305,9 @@ impl ContactOptions {
     }
 }
 
-/// Below this fraction of d̂ the contact's normal damping coefficient stops growing (it is
-/// κ w b''(g) φ(g) τ_c/h above).
+/// The contact's normal damping coefficient saturates at its value at this fraction of d̂:
+/// it is κ w φ(g) τ_c/h times the harmonic mean of b''(g) and b''(d̂ · this), ≈ b''(g) well
+/// above it.
 pub const DAMPING_SATURATION: f64 = 1e-2;
 
 /// The fade φ(g) of the contact's normal damping and φ'(g): 1 up to 3/4 of d̂, then
@@ -431,18 +432,19 @@ pub fn sample_terms(
         // Faded out towards d̂ (C¹ there: b'' alone would switch its slope b''' on at d̂,
         // and Newton stalls on samples that enter and leave).
         let (phi, dphi) = damping_fade(g, dhat);
-        // Saturated below d̂/100: b'' grows as 1/g², and a sample a clip drives into the
-        // geometry (its node prescribed) would meet a damping force without bound that no
-        // free node can balance (bench_harness --contact: Newton stalled at 100 N).
-        let floor = DAMPING_SATURATION * dhat;
-        let capped = g < floor;
-        let b2c = if capped { barrier(floor, dhat).2 } else { b2 };
+        // Saturated towards its value at d̂/100: b'' grows as 1/g², and a sample a clip drives
+        // into the geometry (its node prescribed) would meet a damping force without bound that
+        // no free node can balance (bench_harness --contact: Newton stalled at 100 N). Smoothly:
+        // the harmonic mean of b''(g) and b''(d̂/100), below both, with a continuous slope (the
+        // former hard cap's kink at d̂/100 made Newton cycle at impacts; docs/contact.md).
+        let floor = barrier(DAMPING_SATURATION * dhat, dhat).2;
+        let b2c = 1.0 / (1.0 / b2 + 1.0 / floor);
+        let b3c = barrier_third(g, dhat) * (b2c / b2) * (b2c / b2);
         let c = damping_rate * kw * b2c * phi;
         normal_grad += c * dg * n;
         damping_work = c * dg * dg;
         if want_jac {
             // ∂c/∂x = (τ_c/h) κ w (b''' φ + b'' φ') n;  ∂Δg/∂x = n;  ∂n/∂x = H.
-            let b3c = if capped { 0.0 } else { barrier_third(g, dhat) };
             let c3 = damping_rate * kw * (b3c * phi + b2c * dphi);
             jac += (c3 * dg + c) * n * n.transpose() + c * dg * q.hessian;
         }

@@ -457,6 +457,51 @@ fn friction_holds_on_an_incline_below_the_friction_angle_and_slides_above() {
 /// the horizontal momentum of a tilted impact stays; with friction it is stopped too). A
 /// solver error fails with its step (the energy bounds are asserted on every step before it).
 fn drop(r: f64, mu: f64, line_search: bool, tilt: f64) {
+    let (rod, st, dy) =
+        drop_run(r, mu, line_search, tilt, 3000, true).unwrap_or_else(|e| panic!("{e}"));
+    let drop_energy = rod.node_mass.iter().sum::<f64>() * 9.81 * 0.02;
+    // At rest on the floor after 3 s: vertical motion below 1e-4 of the drop energy (frictionless, the horizontal momentum
+    // the tilted impact gave it stays), lying on the floor within 1 % of r.
+    let vertical: f64 = dy
+        .velocities()
+        .iter()
+        .zip(&rod.node_mass)
+        .map(|(v, m)| 0.5 * m * v[2] * v[2])
+        .sum();
+    assert!(
+        vertical < 1e-4 * drop_energy,
+        "r = {r}: still bouncing, {vertical} J"
+    );
+    if mu > 0.0 {
+        // Friction stops the sliding too: every node at rest within the stick zone's creep.
+        let v_max = dy
+            .velocities()
+            .iter()
+            .map(|v| v.fixed_rows::<3>(0).norm())
+            .fold(0.0, f64::max);
+        let creep = ContactOptions::for_radius(r).stick_velocity;
+        assert!(
+            v_max < creep,
+            "r = {r}, μ = {mu}: still sliding at {v_max} m/s"
+        );
+    }
+    assert!(st.x.iter().all(|x| (x.z - r).abs() < 0.01 * r));
+    let ct = dy.contact.as_ref().unwrap();
+    assert!(ct.node_state.iter().all(|&s| s == STICK));
+}
+
+/// The drop of `drop` for `steps` steps of 1 ms: Err names the first violation — a solver
+/// error, the total energy above the start, a step whose energy grew by more than the step
+/// guard's bound (with `strict`, any such step; else only one the guard did not report as an
+/// unresolved impact, `StepStats::unresolved_gain`), or the capsules through the plane.
+fn drop_run(
+    r: f64,
+    mu: f64,
+    line_search: bool,
+    tilt: f64,
+    steps: usize,
+    strict: bool,
+) -> Result<(Rod, State, Dynamics), String> {
     let l = 0.4;
     let n = 40;
     let rho = 1500.0;
@@ -497,60 +542,64 @@ fn drop(r: f64, mu: f64, line_search: bool, tilt: f64) {
     let (mut last_kinetic, mut last_elastic, mut last_contact) = (0.0, dy.energies.elastic, 0.0);
     let h = 1e-3;
     let mut min_gap = f64::INFINITY;
-    for k in 0..3000 {
-        if let Err(e) = dy.advance(&rod, &mut st, h, &[], &[], 6) {
-            panic!("r = {r}, μ = {mu}: step {k}: {e}");
-        }
+    let case = format!("r = {r}, μ = {mu}, tilt {tilt}, line search {line_search}");
+    for k in 0..steps {
+        let stats = dy
+            .advance(&rod, &mut st, h, &[], &[], 6)
+            .map_err(|e| format!("{case}: step {k}: {e}"))?;
         let e = total(&dy);
         let en = dy.energies;
         // Never above the start; per step, within the step guard's bound on the growth of the
         // energy in motion (`energy_tolerance` = 1e-3 of the energies at play, a larger growth
         // splits the step; its scale differs from this one by the clip work and the start's
         // contact energy: a factor 2 of margin; measured 1.13e-3 (r = 1 mm), 1.22e-3 (30 mm)).
-        assert!(
-            e <= e0 + 1e-6 * drop_energy,
-            "r = {r}, μ = {mu}: step {k}: {e} > {e0}"
-        );
+        if e > e0 + 1e-6 * drop_energy {
+            return Err(format!("{case}: step {k}: {e} > {e0}"));
+        }
         // With friction too (before the contact's normal damping, session 8, the μ = 0.3 drop
         // gained 0.67 % of the energy in motion at step 248 and was exempt).
         let scale = last_kinetic + en.kinetic + last_elastic.abs() + last_contact;
-        assert!(
-            e <= last + 2e-3 * scale,
-            "r = {r}, μ = {mu}: energy grew at step {k}: {last} → {e} (scale {scale}, {en:?})"
-        );
+        if e > last + 2e-3 * scale && (strict || stats.unresolved_gain == 0.0) {
+            return Err(format!(
+                "{case}: energy grew at step {k}: {last} → {e} (scale {scale}, {en:?}; \
+                 reported unresolved gain {})",
+                stats.unresolved_gain
+            ));
+        }
         (last, last_kinetic, last_elastic, last_contact) = (e, en.kinetic, en.elastic, en.contact);
         let ct = dy.contact.as_ref().unwrap();
         min_gap = min_gap.min(ct.surface_gap(&st).0);
     }
-    assert!(min_gap > -0.01 * r, "r = {r}: tunnelled to gap {min_gap}");
-    // At rest on the floor after 3 s: vertical motion below 1e-4 of the drop energy (frictionless, the horizontal momentum
-    // the tilted impact gave it stays), lying on the floor within 1 % of r.
-    let vertical: f64 = dy
-        .velocities()
-        .iter()
-        .zip(&rod.node_mass)
-        .map(|(v, m)| 0.5 * m * v[2] * v[2])
-        .sum();
-    assert!(
-        vertical < 1e-4 * drop_energy,
-        "r = {r}: still bouncing, {vertical} J"
-    );
-    if mu > 0.0 {
-        // Friction stops the sliding too: every node at rest within the stick zone's creep.
-        let v_max = dy
-            .velocities()
-            .iter()
-            .map(|v| v.fixed_rows::<3>(0).norm())
-            .fold(0.0, f64::max);
-        let creep = ContactOptions::for_radius(r).stick_velocity;
-        assert!(
-            v_max < creep,
-            "r = {r}, μ = {mu}: still sliding at {v_max} m/s"
-        );
+    if min_gap <= -0.01 * r {
+        return Err(format!("{case}: tunnelled to gap {min_gap}"));
     }
-    assert!(st.x.iter().all(|x| (x.z - r).abs() < 0.01 * r));
-    let ct = dy.contact.as_ref().unwrap();
-    assert!(ct.node_state.iter().all(|&s| s == STICK));
+    Ok((rod, st, dy))
+}
+
+/// Thin cables dropped flat or tilted, with and without the line search (r = 0.9–2 mm, tilt
+/// 0–0.02; 50 drops of 0.3 s through the impact and the first bounces): every run completes,
+/// never rises above its start, never goes through the plane, and every step whose energy
+/// grew beyond the guard's bound is one the guard reported as an unresolved impact. Before
+/// session 10's smooth damping saturation 5 of these runs stopped with Newton not converging
+/// (a period-4 cycle at h/64) and 4 gained energy unreported; the named drop tests above had
+/// passed by their parameters.
+#[test]
+fn thin_cables_dropped_any_way_complete_and_report_what_they_gain() {
+    let mut failures = Vec::new();
+    for r in [0.0009, 0.001, 0.0011, 0.0015, 0.002] {
+        for tilt in [0.0, 0.005, 0.01, 0.015, 0.02] {
+            for line_search in [false, true] {
+                if let Err(e) = drop_run(r, 0.0, line_search, tilt, 300, false) {
+                    failures.push(e);
+                }
+            }
+        }
+    }
+    assert!(
+        failures.is_empty(),
+        "{} of 50: {failures:#?}",
+        failures.len()
+    );
 }
 
 #[test]
