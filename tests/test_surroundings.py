@@ -796,10 +796,42 @@ def test_dynamic_run_uses_the_saved_steps(scene_dict):
         assert np.allclose(c.clearance[k], expected, rtol=0, atol=1e-14)
 
 
-def test_vectorised_mesh_reading_equals_trimesh(tmp_path, monkeypatch):
+def test_vertex_welding_equals_the_rounded_rows_first_appearance():
+    """`merge_vertices` (Rust, one hash-map pass) against numpy: the unique rows of the
+    coordinates rounded to 8 decimals (ties to even), in order of first appearance, faces
+    re-indexed — on a soup with exact repeats, noise below and above the rounding, −0.0, and
+    coordinates beyond 9e10 (merged only when equal)."""
+    from cablelife.surroundings import meshes
+
+    rng = np.random.default_rng(7)
+    base = rng.normal(size=(2000, 3))
+    picks = rng.integers(0, len(base), size=(30000,))
+    noise = rng.choice([0.0, 0.0, 3e-9, -4e-9, 2e-8], size=(len(picks), 3))
+    v = base[picks] + noise
+    v[::97, 2] = -0.0
+    faces = rng.integers(0, len(v), size=(10000, 3))
+
+    def reference(v, faces, exact=False):
+        q = (v + 0.0).view(np.int64) if exact else np.rint(v * 1e8).astype(np.int64)
+        _, first, inverse = np.unique(q, axis=0, return_index=True, return_inverse=True)
+        order = np.argsort(first, kind="stable")
+        rank = np.empty_like(order)
+        rank[order] = np.arange(len(order))
+        return v[first[order]], rank[inverse.reshape(-1)][faces]
+
+    for vv, exact in ((v, False), (v * 1e11, True)):
+        got_v, got_f = meshes.merge_vertices(vv, faces)
+        ref_v, ref_f = reference(vv, faces, exact)
+        assert np.array_equal(got_v, ref_v) and np.array_equal(got_f, ref_f)
+        assert len(ref_v) < len(vv)
+    with pytest.raises(ValueError, match="face 0 indexes vertex 30000"):
+        meshes.merge_vertices(v, np.array([[0, 1, 30000]]))
+
+
+def test_vectorised_mesh_reading_equals_trimesh(tmp_path):
     """The STL path (trimesh's reader, vertices merged and checked here) against trimesh's own
     processing: the same merged vertices and faces (up to vertex order), watertightness,
-    boundary edges, orientation and shells — also when the row hash collides everywhere."""
+    boundary edges, orientation and shells."""
     from cablelife.surroundings import meshes
 
     a = trimesh.creation.icosphere(subdivisions=3, radius=0.1)
@@ -817,24 +849,21 @@ def test_vectorised_mesh_reading_equals_trimesh(tmp_path, monkeypatch):
         assert len(m.vertices) == len(ref.vertices)
         assert np.array_equal(tris, ref_tris)
 
-    for collide in (False, True):
-        if collide:
-            monkeypatch.setattr(meshes, "row_hash", lambda v: np.zeros(len(v), np.uint64))
-        m = meshes.load_mesh(tmp_path / "two.stl", None, "t", 1.0)
-        ref = trimesh.load(tmp_path / "two.stl", process=True)
-        same(m, ref)
-        assert m.watertight and ref.is_watertight and m.boundary_edges == 0
-        assert len(m.shells) == ref.body_count == 2
-        assert sorted(len(s) for s in m.shells) == sorted([len(a.faces), len(b.faces)])
-        with pytest.warns(SurroundingsWarning, match=r"open \((\d+) boundary edges\)") as w:
-            m = meshes.load_mesh(tmp_path / "cap.stl", None, "t", 1.0)
-        ref = trimesh.load(tmp_path / "cap.stl", process=True)
-        same(m, ref)
-        n_boundary = len(trimesh.grouping.group_rows(ref.edges_sorted, require_count=1))
-        assert m.boundary_edges == n_boundary > 0 and f"({n_boundary} boundary" in str(w[0].message)
-        assert not m.watertight and m.shells is None
-        with pytest.warns(SurroundingsWarning, match="face inwards; flipped"):
-            m = meshes.load_mesh(tmp_path / "inv.stl", None, "t", 1.0)
-        tri = m.vertices[m.faces]
-        volume = np.einsum("ij,ij->", tri[:, 0], np.cross(tri[:, 1], tri[:, 2])) / 6
-        assert volume == pytest.approx(b.volume, rel=1e-6)
+    m = meshes.load_mesh(tmp_path / "two.stl", None, "t", 1.0)
+    ref = trimesh.load(tmp_path / "two.stl", process=True)
+    same(m, ref)
+    assert m.watertight and ref.is_watertight and m.boundary_edges == 0
+    assert len(m.shells) == ref.body_count == 2
+    assert sorted(len(s) for s in m.shells) == sorted([len(a.faces), len(b.faces)])
+    with pytest.warns(SurroundingsWarning, match=r"open \((\d+) boundary edges\)") as w:
+        m = meshes.load_mesh(tmp_path / "cap.stl", None, "t", 1.0)
+    ref = trimesh.load(tmp_path / "cap.stl", process=True)
+    same(m, ref)
+    n_boundary = len(trimesh.grouping.group_rows(ref.edges_sorted, require_count=1))
+    assert m.boundary_edges == n_boundary > 0 and f"({n_boundary} boundary" in str(w[0].message)
+    assert not m.watertight and m.shells is None
+    with pytest.warns(SurroundingsWarning, match="face inwards; flipped"):
+        m = meshes.load_mesh(tmp_path / "inv.stl", None, "t", 1.0)
+    tri = m.vertices[m.faces]
+    volume = np.einsum("ij,ij->", tri[:, 0], np.cross(tri[:, 1], tri[:, 2])) / 6
+    assert volume == pytest.approx(b.volume, rel=1e-6)

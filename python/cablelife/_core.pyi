@@ -305,3 +305,9 @@ def fatigue_damage_many(
 def fatigue_turning_points(series, hysteresis=0.0) -> Any:
     """Turning points of a 1-D series: (indices int64, values float64)."""
     ...
+
+def weld_vertices(vertices, faces) -> Any:
+    """Merges the vertices (N, 3) of a triangle soup that agree to 8 decimals (first appearance's
+    order and coordinates kept) and re-indexes the faces (F, 3): (vertices (M, 3), faces (F, 3)).
+    """
+    ...

@@ -19,6 +19,7 @@ pub mod closest;
 pub mod coherence;
 pub mod mesh;
 pub mod primitives;
+pub mod weld;
 mod wide;
 
 use nalgebra::Vector3;
@@ -29,6 +30,7 @@ pub use clearance::{clearance, Clearance, Part, RigidMap};
 pub use coherence::Candidates;
 pub use mesh::{MeshError, TriMesh};
 pub use primitives::{Cuboid, Cylinder, HalfSpace, Sphere};
+pub use weld::weld_vertices;
 
 /// Closest point of a surface to a query point.
 #[derive(Clone, Copy, Debug, PartialEq)]

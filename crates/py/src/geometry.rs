@@ -328,7 +328,39 @@ impl Surroundings {
     }
 }
 
+/// Merged vertices (M, 3) and re-indexed faces (F, 3).
+type Welded<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<i64>>);
+
+/// Merges the vertices (N, 3) of a triangle soup that agree to 8 decimals (first appearance's
+/// order and coordinates kept) and re-indexes the faces (F, 3): (vertices (M, 3), faces (F, 3)).
+#[pyfunction]
+fn weld_vertices<'py>(
+    py: Python<'py>,
+    vertices: PyReadonlyArray2<'py, f64>,
+    faces: PyReadonlyArray2<'py, i64>,
+) -> PyResult<Welded<'py>> {
+    let v = vertices.as_array();
+    let f = faces.as_array();
+    if v.ncols() != 3 || f.ncols() != 3 {
+        return Err(PyValueError::new_err(format!(
+            "vertices {:?} and faces {:?}: must be (N, 3) and (F, 3)",
+            v.shape(),
+            f.shape()
+        )));
+    }
+    let v: Vec<[f64; 3]> = v.rows().into_iter().map(|r| [r[0], r[1], r[2]]).collect();
+    let mut f: Vec<[i64; 3]> = f.rows().into_iter().map(|r| [r[0], r[1], r[2]]).collect();
+    let merged = py
+        .detach(|| ::geometry::weld_vertices(&v, &mut f))
+        .map_err(PyValueError::new_err)?;
+    let (m, n) = (merged.len(), f.len());
+    let merged = PyArray1::from_vec(py, merged.into_iter().flatten().collect()).reshape([m, 3])?;
+    let faces = PyArray1::from_vec(py, f.into_iter().flatten().collect()).reshape([n, 3])?;
+    Ok((merged, faces))
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Surroundings>()?;
+    m.add_function(wrap_pyfunction!(weld_vertices, m)?)?;
     Ok(())
 }

@@ -155,31 +155,12 @@ def read_triangles(path: Path, trimesh) -> tuple[np.ndarray | None, np.ndarray]:
 def merge_vertices(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Merges vertices that agree to 8 decimals of the file's unit, as trimesh does (an STL
     repeats each shared vertex per triangle, exports leave float noise at seams), keeping the
-    order and coordinates of first appearance; faces re-indexed. Rows are grouped by a
-    64-bit hash of their rounded values, then checked equal (a collision falls back to a
-    row sort)."""
+    order and coordinates of first appearance; faces re-indexed (``_core.weld_vertices``: one
+    hash-map pass in Rust, 0.67 s → 0.1 s for a 1 M-triangle STL)."""
+    from cablelife import _core
+
     v = np.ascontiguousarray(vertices, float)
-    if np.abs(v).max() < 9e10:
-        q = np.rint(v * 1e8).astype(np.int64)
-    else:  # beyond int64 at 8 decimals: equal coordinates
-        q = (v + 0.0).view(np.int64)  # -0.0 → 0.0
-    _, first, inverse = np.unique(row_hash(q), return_index=True, return_inverse=True)
-    if not np.array_equal(q[first[inverse]], q):  # a hash collision
-        _, first, inverse = np.unique(q, axis=0, return_index=True, return_inverse=True)
-    inverse = inverse.reshape(-1)
-    order = np.argsort(first, kind="stable")  # first appearance
-    rank = np.empty_like(order)
-    rank[order] = np.arange(len(order))
-    return v[first[order]], rank[inverse][faces]
-
-
-def row_hash(q: np.ndarray) -> np.ndarray:
-    """A 64-bit hash of each row of three int64 (multiply-xorshift mixing)."""
-    bits = q.view(np.uint64)
-    key = bits[:, 0] * np.uint64(0x9E3779B97F4A7C15)
-    key ^= (bits[:, 1] + (key >> np.uint64(29))) * np.uint64(0xBF58476D1CE4E5B9)
-    key ^= (bits[:, 2] + (key >> np.uint64(31))) * np.uint64(0x94D049BB133111EB)
-    return key
+    return _core.weld_vertices(v, np.ascontiguousarray(faces, np.int64))
 
 
 def drop_unused(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
