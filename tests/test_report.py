@@ -360,3 +360,23 @@ def test_interactive_plots_draw_what_the_matplotlib_plots_draw(files):
     np.testing.assert_allclose(10 ** z[rf.counts > 0], rf.counts[rf.counts > 0])
     assert np.isnan(z[rf.counts == 0]).all()
     assert heat.x[-1] == pytest.approx(rf.mean_edges[-1] / 1e6)  # MPa
+
+
+def test_an_unresolved_impact_is_in_the_report_as_on_the_terminal(dynamic_files):
+    """The report says what the run's ImpactWarning said (an impact the step guard accepted
+    unresolved, saved per step in the solver data), in the run's section; nothing without."""
+    import html
+
+    from cablelife.report import ReportRun, build_report
+    from cablelife.results import load_result
+    from cablelife.validity import impact_messages
+
+    res = load_result(dynamic_files[0])
+    page = build_report([ReportRun("D", res)], voxel=None, frames=2)
+    assert "an impact on the geometry" not in page
+    c = res.cable
+    c.solver["unresolved_gain"] = np.zeros(c.n_steps)
+    c.solver["unresolved_gain"][7] = 0.0123
+    page = build_report([ReportRun("D", res)], voxel=None, frames=2)
+    (message,) = impact_messages("cable 'hose'", c.solver["unresolved_gain"], c.time)
+    assert html.escape(message) in page

@@ -454,12 +454,30 @@ def _frequencies(page: Page, res: Result, name: str, cache: dict, run_label: str
     )
 
 
+def _impact_notes(res) -> list[str]:
+    """The warnings of impacts the dynamic step guard accepted unresolved (saved per step in
+    ``solver["unresolved_gain"]``; one for a harness, whose cables share it)."""
+    from cablelife.validity import impact_messages
+
+    named = [(f"cable '{n}'", c) for n, c in res.cables.items()]
+    if res.junctions and named:
+        named = [("harness", named[0][1])]
+    return [
+        m
+        for name, c in named
+        if c.solver.get("unresolved_gain") is not None
+        for m in impact_messages(name, c.solver["unresolved_gain"], c.time)
+    ]
+
+
 def _run_section(page, k, run: ReportRun, volumes, color_by, frames, factor, cache, alone):
     """A run's section; its load plots only when ``alone`` (else the comparison has them)."""
     res = run.result
     page.h(2, f"Run {run.label} ({res.mode})", f"run-{k}")
     if not res.complete:
         page.note(f"incomplete run: {res.message}", "warning")
+    for message in _impact_notes(res):  # as the terminal said (ImpactWarning)
+        page.note(message, "warning")
     if res.junctions:
         _harness_section(page, run, color_by, frames)
     for name, c in res.cables.items():
