@@ -4,6 +4,7 @@
 //! (`Statics::newton`): the step bound "close at most 90 % of a gap" over every cable (a joined
 //! end node moves with its junction), the trial's gap test, the lagged friction reference
 //! (the last equilibrium) and the penetration check.
+use crate::contact::Contact;
 use crate::harness::{Harness, HarnessError, HarnessState};
 use crate::harness_solver::HarnessStatics;
 use crate::statics::{SolveError, SolveStats};
@@ -76,27 +77,11 @@ impl HarnessStatics {
         }
     }
 
-    /// Starts every cable contact's record of its smallest gaps (`Contact::begin_solve`).
-    pub(crate) fn begin_contact_solve(&mut self) {
-        for c in self.contact.iter_mut().flatten() {
-            c.begin_solve();
-        }
-    }
-
-    /// `Contact::adapt_stiffness` on every cable's contact: whether any stiffness changed.
-    pub(crate) fn adapt_contact_stiffness(&mut self) -> bool {
+    /// Applies `f` to every cable's contact (all of them); whether any returned true.
+    pub(crate) fn any_contact(&mut self, f: &mut dyn FnMut(&mut Contact) -> bool) -> bool {
         let mut any = false;
         for c in self.contact.iter_mut().flatten() {
-            any |= c.adapt_stiffness();
-        }
-        any
-    }
-
-    /// `Contact::stiffen_after_failure` on every cable's contact: whether any changed.
-    pub(crate) fn stiffen_contact_after_failure(&mut self) -> bool {
-        let mut any = false;
-        for c in self.contact.iter_mut().flatten() {
-            any |= c.stiffen_after_failure();
+            any |= f(c);
         }
         any
     }

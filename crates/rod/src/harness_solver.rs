@@ -10,7 +10,7 @@ use crate::junction::HeldEnds;
 use crate::model::{Pose, Rod};
 use crate::rotation::slerp;
 use crate::sliding::SlidingClips;
-use crate::statics::{continue_load, NewtonOptions, SolveError, SolveStats};
+use crate::statics::{continue_load, solve_load_scaled, NewtonOptions, SolveError, SolveStats};
 use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 
 #[inline]
@@ -723,31 +723,13 @@ impl HarnessStatics {
         h: &Harness,
         st: &mut HarnessState,
     ) -> Result<SolveStats, HarnessError> {
-        let start = st.clone();
-        let mut iterations = 0;
-        let (mut adapted, mut stiffened) = (0, 0);
-        loop {
-            self.begin_contact_solve();
-            match self.solve_static_once(h, st) {
-                Ok(mut s) => {
-                    iterations += s.iterations;
-                    if adapted < 4 && self.adapt_contact_stiffness() {
-                        adapted += 1;
-                        continue;
-                    }
-                    s.iterations = iterations;
-                    return Ok(s);
-                }
-                Err(e) => {
-                    if stiffened < 3 && self.stiffen_contact_after_failure() {
-                        stiffened += 1;
-                        st.clone_from(&start);
-                        continue;
-                    }
-                    return Err(e);
-                }
-            }
-        }
+        solve_load_scaled(
+            self,
+            st,
+            |s, f| s.any_contact(f),
+            |_| true,
+            |s, st| s.solve_static_once(h, st),
+        )
     }
 
     fn solve_static_once(
@@ -968,7 +950,7 @@ impl HarnessStatics {
         };
         // The barrier scaled to the load (as `solve_static`): once more from the equilibrium.
         if let Ok(s) = &result {
-            if self.adapt_contact_stiffness() {
+            if self.any_contact(&mut |c| c.adapt_stiffness()) {
                 let first = s.iterations;
                 result = self.step_from_reference(h, st, target).map(|mut s| {
                     s.iterations += first;

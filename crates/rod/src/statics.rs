@@ -551,41 +551,13 @@ impl Statics {
     /// that fails with a sample pressed below the barrier's continuation gap is retried from
     /// the start with the stiffness ×30 (`Contact::stiffen_after_failure`, at most 3 times).
     pub fn solve(&mut self, rod: &Rod, st: &mut State) -> Result<SolveStats, SolveError> {
-        let start = st.clone();
-        let mut total = SolveStats::default();
-        let (mut adapted, mut stiffened) = (0, 0);
-        loop {
-            if let Some(c) = &mut self.contact {
-                c.begin_solve();
-            }
-            match self.solve_once(rod, st) {
-                Ok(s) => {
-                    total.iterations += s.iterations;
-                    let again =
-                        adapted < 4 && self.contact.as_mut().is_some_and(|c| c.adapt_stiffness());
-                    if !again {
-                        return Ok(SolveStats {
-                            iterations: total.iterations,
-                            ..s
-                        });
-                    }
-                    adapted += 1;
-                }
-                Err(e) => {
-                    let again = matches!(e, SolveError::NotConverged { .. })
-                        && stiffened < 3
-                        && self
-                            .contact
-                            .as_mut()
-                            .is_some_and(|c| c.stiffen_after_failure());
-                    if !again {
-                        return Err(e);
-                    }
-                    stiffened += 1;
-                    st.clone_from(&start);
-                }
-            }
-        }
+        solve_load_scaled(
+            self,
+            st,
+            |s, f| s.contact.as_mut().is_some_and(f),
+            |e| matches!(e, SolveError::NotConverged { .. }),
+            |s, st| s.solve_once(rod, st),
+        )
     }
 
     fn solve_once(&mut self, rod: &Rod, st: &mut State) -> Result<SolveStats, SolveError> {
@@ -1700,6 +1672,51 @@ fn scaled_norm(d: &[Vector6<f64>], length: f64) -> f64 {
         }
     }
     sum.sqrt()
+}
+
+/// A static solve with the contact barrier scaled to the load (`Contact::adapt_stiffness`,
+/// `Contact::stiffen_after_failure`), shared by the single cable and the harness: `solve` once;
+/// a converged state whose contacts adapt their stiffness is solved again from there (at most
+/// 4 times), a failure that `retry` admits and whose contacts stiffen is retried from the
+/// start (at most 3 times). `contacts(solver, f)` applies `f` to every contact term and tells
+/// whether any returned true.
+pub(crate) fn solve_load_scaled<T, S: Clone, E>(
+    solver: &mut T,
+    st: &mut S,
+    contacts: impl Fn(&mut T, &mut dyn FnMut(&mut Contact) -> bool) -> bool,
+    retry: impl Fn(&E) -> bool,
+    mut solve: impl FnMut(&mut T, &mut S) -> Result<SolveStats, E>,
+) -> Result<SolveStats, E> {
+    let start = st.clone();
+    let mut iterations = 0;
+    let (mut adapted, mut stiffened) = (0, 0);
+    loop {
+        contacts(solver, &mut |c| {
+            c.begin_solve();
+            false
+        });
+        match solve(solver, st) {
+            Ok(s) => {
+                iterations += s.iterations;
+                if adapted < 4 && contacts(solver, &mut |c| c.adapt_stiffness()) {
+                    adapted += 1;
+                    continue;
+                }
+                return Ok(SolveStats { iterations, ..s });
+            }
+            Err(e) => {
+                if retry(&e)
+                    && stiffened < 3
+                    && contacts(solver, &mut |c| c.stiffen_after_failure())
+                {
+                    stiffened += 1;
+                    st.clone_from(&start);
+                    continue;
+                }
+                return Err(e);
+            }
+        }
+    }
 }
 
 /// Load continuation from a converged state at load factor 0 (`total`: that solve's figures)
