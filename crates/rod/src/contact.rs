@@ -500,8 +500,8 @@ pub struct Contact {
     /// κ in use per obstacle, N/m²: `kappa`, raised where the contact load far exceeds the
     /// weight the automatic stiffness is set for (`adapt_stiffness`).
     pub obstacle_kappa: Vec<f64>,
-    /// Per obstacle: the smallest sample gap of the last full assembly, and the smallest of
-    /// the full assemblies since `begin_solve` (∞: no sample within reach).
+    /// Per obstacle: the smallest sample gap of the last full assembly (`min_gap`), and the
+    /// smallest of the full assemblies since `begin_solve` (∞: no sample within reach).
     obstacle_gap: Vec<f64>,
     lowest_gap: Vec<f64>,
     /// Node positions at the start of the step (friction and damping reference).
@@ -526,8 +526,6 @@ pub struct Contact {
     pub friction_force: Vec<Vector3<f64>>,
     pub node_state: Vec<u8>,
     pub body_force: Vec<Vector3<f64>>,
-    /// Smallest gap (cable surface to geometry) over the sample points, m.
-    pub min_gap: f64,
     /// Samples inside the barrier (gap below d̂) in the last assembly.
     pub active: usize,
     /// Edges (per obstacle: k · edges + e) whose broad phase uses exact signed distances (a
@@ -689,7 +687,6 @@ impl Contact {
             friction_force: vec![Vector3::zeros(); n],
             node_state: vec![NO_CONTACT; n],
             body_force: vec![Vector3::zeros(); n_bodies],
-            min_gap: f64::INFINITY,
             active: 0,
             deep: vec![false; n_obstacles * n.saturating_sub(1)],
             line: Vec::new(),
@@ -717,6 +714,14 @@ impl Contact {
             Some(h) => self.opts.stick_velocity * h,
             None => self.opts.stick_distance,
         };
+    }
+
+    /// Smallest gap (cable surface to geometry) over the sample points of the last full
+    /// assembly, m (∞: none within reach).
+    pub fn min_gap(&self) -> f64 {
+        self.obstacle_gap
+            .iter()
+            .fold(f64::INFINITY, |m, &g| m.min(g))
     }
 
     /// Starts the record of the smallest gaps of a static solve (`stiffen_after_failure`).
@@ -973,9 +978,9 @@ impl Contact {
     /// does not shrink if the cable already penetrated.
     pub fn gap_acceptable(&self, before: f64) -> bool {
         if before > 0.0 {
-            self.min_gap >= 0.1 * before.min(self.opts.distance)
+            self.min_gap() >= 0.1 * before.min(self.opts.distance)
         } else {
-            self.min_gap >= before
+            self.min_gap() >= before
         }
     }
 
@@ -1158,7 +1163,6 @@ impl Contact {
             self.cache_samples[slot * stride + i] = (q.distance, q.normal);
             if outputs {
                 let g = q.distance - self.opts.radius;
-                self.min_gap = self.min_gap.min(g);
                 self.obstacle_gap[k] = self.obstacle_gap[k].min(g);
                 self.lowest_gap[k] = self.lowest_gap[k].min(g);
             }
@@ -1250,7 +1254,6 @@ impl Term for Contact {
             self.friction_force.iter_mut().for_each(|v| v.fill(0.0));
             self.body_force.iter_mut().for_each(|v| v.fill(0.0));
             self.node_state.fill(NO_CONTACT);
-            self.min_gap = f64::INFINITY;
             self.obstacle_gap.fill(f64::INFINITY);
         }
         for k in 0..self.obstacles.len() {

@@ -53,7 +53,7 @@ impl HarnessStatics {
                 Vector3::zeros()
             };
             bound = bound.min(contact.step_bound(&st.cables[c].x, dx, 0..rod.n_edges()));
-            self.gap0[c] = contact.min_gap;
+            self.gap0[c] = contact.min_gap();
         }
         *alpha *= bound;
     }

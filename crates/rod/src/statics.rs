@@ -342,7 +342,7 @@ impl Statics {
             }
         };
         *alpha *= c.step_bound(&st.x, dx, 0..rod.n_edges());
-        c.min_gap
+        c.min_gap()
     }
 
     fn kink_err(rod: &Rod, k: KinkAt) -> SolveError {

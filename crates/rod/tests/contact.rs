@@ -244,9 +244,9 @@ fn frictionless_wrap_over(length: f64) {
         ct.obstacle_kappa
     );
     assert!(
-        ct.min_gap > 0.1 * dhat && ct.min_gap < dhat,
+        ct.min_gap() > 0.1 * dhat && ct.min_gap() < dhat,
         "gap {}",
-        ct.min_gap
+        ct.min_gap()
     );
 }
 
