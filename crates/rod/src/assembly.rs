@@ -739,6 +739,17 @@ impl Workspace {
         (dx, dth)
     }
 
+    /// The ∞-norm of `residual_norms_range` alone (forces in N, moments divided by `length`):
+    /// no squares, and the blocks' maxima taken by the vector units.
+    pub fn residual_inf_range(&self, r: std::ops::Range<usize>, length: f64) -> f64 {
+        let scale = Vector6::new(1.0, 1.0, 1.0, 1.0 / length, 1.0 / length, 1.0 / length);
+        let mut inf = Vector6::zeros();
+        for r in &self.rhs[r] {
+            inf = inf.sup(&r.abs().component_mul(&scale));
+        }
+        inf.max()
+    }
+
     /// Scaled residual norms (max over blocks): forces in N, moments divided by `length`.
     pub fn residual_norms(&self, length: f64) -> (f64, f64) {
         self.residual_norms_range(0..self.rhs.len(), length)

@@ -53,8 +53,8 @@ pub trait Shape: Send + Sync + fmt::Debug {
         self.query(p).distance
     }
     /// Broad phase: the signed distance if the point is within `bound` of the surface, else
-    /// any value ≥ `bound` (a mesh prunes its hierarchy with the bound; a point deeper than
-    /// `bound` inside a mesh also reads as far).
+    /// the exact distance or ∞ (a mesh prunes its hierarchy with the bound and answers ∞; a
+    /// point deeper than `bound` inside a mesh also reads as far).
     fn distance_within(&self, p: &Vector3<f64>, _bound: f64) -> f64 {
         self.distance(p)
     }
@@ -238,8 +238,8 @@ impl Obstacle {
             + self.shrink
     }
 
-    /// Signed distance at a global point if within `bound` of the surface, else a value ≥
-    /// `bound` (broad phase; [`Shape::distance_within`]).
+    /// Signed distance at a global point if within `bound` of the surface, else the exact
+    /// distance or ∞ (broad phase; [`Shape::distance_within`]).
     #[inline]
     pub fn distance_within(&self, p: &Vector3<f64>, bound: f64) -> f64 {
         let local = self.rotation.transpose() * (p - self.position);
@@ -550,6 +550,9 @@ struct CachedEdge {
     b: Vector3<f64>,
     /// Exact distance at the midpoint; ∞: not queried.
     d_mid: f64,
+    /// An edge the assembly found beyond the barrier's reach: a lower bound of the gap of every
+    /// point of it (−∞: none known), so that a correction moving it less is not queried again.
+    far_gap: f64,
     position: Vector3<f64>,
     rotation: Matrix3<f64>,
 }
@@ -560,6 +563,7 @@ impl Default for CachedEdge {
             a: Vector3::zeros(),
             b: Vector3::zeros(),
             d_mid: f64::INFINITY,
+            far_gap: f64::NEG_INFINITY,
             position: Vector3::zeros(),
             rotation: Matrix3::zeros(),
         }
@@ -857,12 +861,11 @@ impl Contact {
         let half = 0.5 * (b - a).norm();
         let slot = k * (x.len() - 1) + e;
         let c = &self.cache_edges[slot];
-        if c.d_mid.is_finite()
-            && c.a == a
-            && c.b == b
-            && c.position == o.position
-            && c.rotation == o.rotation
-        {
+        let same = c.a == a && c.b == b && c.position == o.position && c.rotation == o.rotation;
+        if same && c.far_gap > margin {
+            return; // every point of the edge farther than the margin (from the assembly)
+        }
+        if same && c.d_mid.is_finite() {
             if c.d_mid - half - r > margin {
                 return;
             }
@@ -1128,8 +1131,21 @@ impl Contact {
         let half = 0.5 * (b - a).norm();
         let far = o.shape.bounding_radius();
         let slot = k * rod.n_edges() + e;
-        self.cache_edges[slot].d_mid = f64::INFINITY;
-        if far.is_finite() && (mid - o.position).norm() - half - far > reach {
+        // Beyond the barrier's reach: kept with a lower bound of the edge's gap (every point of
+        // the edge is within |b − a|/2 of its midpoint).
+        let mut far_edge = |far_gap: f64| {
+            self.cache_edges[slot] = CachedEdge {
+                a,
+                b,
+                d_mid: f64::INFINITY,
+                far_gap,
+                position: o.position,
+                rotation: o.rotation,
+            };
+        };
+        let centre = (mid - o.position).norm();
+        if far.is_finite() && centre - half - far > reach {
+            far_edge(centre - half - far - self.opts.radius);
             return;
         }
         let mut d_mid = o.distance_within(&mid, half + reach);
@@ -1137,6 +1153,13 @@ impl Contact {
             d_mid = o.distance(&mid); // deeper inside than the bound, or far
         }
         if d_mid - half >= reach {
+            // d_mid exact, or ∞ beyond the bound (a mesh)
+            let d = if d_mid.is_finite() {
+                d_mid
+            } else {
+                half + reach
+            };
+            far_edge(d - half - self.opts.radius);
             return;
         }
         // Exact here (within the bound): kept with the samples' queries below.
@@ -1144,6 +1167,7 @@ impl Contact {
             a,
             b,
             d_mid,
+            far_gap: f64::NEG_INFINITY,
             position: o.position,
             rotation: o.rotation,
         };

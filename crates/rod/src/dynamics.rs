@@ -682,8 +682,7 @@ impl Dynamics {
                 if it > 0 && !touching && last_applied < STALL_TOLERANCE * scale {
                     stats.residual = self
                         .ws
-                        .residual_norms_range(seg.blocks.clone(), rod.mean_ds())
-                        .1;
+                        .residual_inf_range(seg.blocks.clone(), rod.mean_ds());
                     self.powers[k] = self.ws.dissipation;
                     self.resting[k] = false;
                     return Ok(stats);
@@ -692,8 +691,7 @@ impl Dynamics {
                     iterations: it + 1,
                     residual: self
                         .ws
-                        .residual_norms_range(seg.blocks.clone(), rod.mean_ds())
-                        .1,
+                        .residual_inf_range(seg.blocks.clone(), rod.mean_ds()),
                     load_factor: 1.0,
                 });
             }
@@ -741,9 +739,9 @@ impl Dynamics {
                 last_fresh_norm = f64::INFINITY;
                 budget = (budget + 1).min(4 * self.opts.max_iterations);
             }
-            self.increments[k] = self.apply_correction(rod, st, h, c_mass, seg);
+            (self.increments[k], self.local_errors[k]) =
+                self.apply_correction(rod, st, h, c_mass, seg);
             last_applied = norm;
-            self.local_errors[k] = self.local_error(seg.blocks.clone());
             stats.iterations = it + 1;
             let scale = self.increments.iter().cloned().fold(0.0, f64::max);
             let error = self.local_errors.iter().cloned().fold(0.0, f64::max);
@@ -765,8 +763,7 @@ impl Dynamics {
             if alpha == 1.0 && norm < tolerance {
                 stats.residual = self
                     .ws
-                    .residual_norms_range(seg.blocks.clone(), rod.mean_ds())
-                    .1;
+                    .residual_inf_range(seg.blocks.clone(), rod.mean_ds());
                 self.powers[k] = self.ws.dissipation;
                 // Nothing moved and nothing was corrected: at rest (kept while its clips are).
                 self.resting[k] = it == 0
@@ -794,8 +791,7 @@ impl Dynamics {
             iterations: stats.iterations,
             residual: self
                 .ws
-                .residual_norms_range(seg.blocks.clone(), rod.mean_ds())
-                .1,
+                .residual_inf_range(seg.blocks.clone(), rod.mean_ds()),
             load_factor: 1.0,
         })
     }
@@ -1010,7 +1006,8 @@ impl Dynamics {
 
     /// Applies the Newton correction `delta` of a segment (v̇ += c_m δq on inertial slots, the
     /// swivel twists directly) and updates v and q_{n+1} there; returns the segment's largest
-    /// increment h|Δq| (as `update_kinematics`).
+    /// increment h|Δq| (as `update_kinematics`) and its local error estimate at the new v̇
+    /// (as `local_error` over the segment's blocks, in the same pass).
     pub(crate) fn apply_correction(
         &mut self,
         rod: &Rod,
@@ -1018,13 +1015,14 @@ impl Dynamics {
         h: f64,
         c_mass: f64,
         seg: &Segment,
-    ) -> f64 {
+    ) -> (f64, f64) {
         let mut dx_max = 0.0f64;
         let mut dth_max = 0.0f64;
+        let (mut ex, mut eth) = (0.0f64, 0.0f64);
         let (k_dq, k_v) = (self.k_dq, self.k_v);
         let r = seg.blocks.clone();
         // Nodes, then edges (zipped slices: no bounds checks in the loops).
-        for (((((((half, d), vdot), dq0), v0), v), x), x_n) in self.inertial_half[r.clone()]
+        for ((((((((half, d), vdot), dq0), v0), v), x), x_n), vd_n) in self.inertial_half[r.clone()]
             .iter()
             .zip(&self.delta[r.clone()])
             .zip(&mut self.vdot[r.clone()])
@@ -1033,11 +1031,13 @@ impl Dynamics {
             .zip(&mut self.rates.v[r.clone()])
             .zip(&mut st.x[r.clone()])
             .zip(&self.x_n[r.clone()])
+            .zip(&self.vdot_n[r.clone()])
         {
             if half[0] {
                 let mut vd: Vector3<f64> = vdot.fixed_rows::<3>(0).into();
                 vd += c_mass * d.fixed_rows::<3>(0);
                 vdot.fixed_rows_mut::<3>(0).copy_from(&vd);
+                ex = ex.max((vd - vd_n.fixed_rows::<3>(0)).amax());
                 let dq: Vector3<f64> = dq0.fixed_rows::<3>(0) + k_dq * vd;
                 v.fixed_rows_mut::<3>(0)
                     .copy_from(&(v0.fixed_rows::<3>(0) + k_v * vd));
@@ -1047,20 +1047,23 @@ impl Dynamics {
             }
         }
         let re = r.start..r.end.min(st.p.len());
-        for (((((((half, d), vdot), dq0), v0), v), p), p_n) in self.inertial_half[re.clone()]
-            .iter()
-            .zip(&self.delta[re.clone()])
-            .zip(&mut self.vdot[re.clone()])
-            .zip(&self.dq0[re.clone()])
-            .zip(&self.v0[re.clone()])
-            .zip(&mut self.rates.v[re.clone()])
-            .zip(&mut st.p[re.clone()])
-            .zip(&self.p_n[re.clone()])
+        for ((((((((half, d), vdot), dq0), v0), v), p), p_n), vd_n) in self.inertial_half
+            [re.clone()]
+        .iter()
+        .zip(&self.delta[re.clone()])
+        .zip(&mut self.vdot[re.clone()])
+        .zip(&self.dq0[re.clone()])
+        .zip(&self.v0[re.clone()])
+        .zip(&mut self.rates.v[re.clone()])
+        .zip(&mut st.p[re.clone()])
+        .zip(&self.p_n[re.clone()])
+        .zip(&self.vdot_n[re.clone()])
         {
             if half[1] {
                 let mut vd: Vector3<f64> = vdot.fixed_rows::<3>(3).into();
                 vd += c_mass * d.fixed_rows::<3>(3);
                 vdot.fixed_rows_mut::<3>(3).copy_from(&vd);
+                eth = eth.max((vd - vd_n.fixed_rows::<3>(3)).amax());
                 let dq: Vector3<f64> = dq0.fixed_rows::<3>(3) + k_dq * vd;
                 v.fixed_rows_mut::<3>(3)
                     .copy_from(&(v0.fixed_rows::<3>(3) + k_v * vd));
@@ -1070,7 +1073,9 @@ impl Dynamics {
             }
         }
         self.apply_massless(rod, st, seg);
-        (dx_max / self.length).max(dth_max)
+        let error =
+            (self.ga.beta - 1.0 / 6.0).abs() * self.h * self.h * (ex / self.length).max(eth);
+        ((dx_max / self.length).max(dth_max), error)
     }
 
     /// The estimated local time-discretisation error of blocks `r` at the current v̇_{n+1}:

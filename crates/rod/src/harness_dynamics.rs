@@ -561,10 +561,12 @@ impl HarnessDynamics {
             for (d, t) in dy.delta.iter_mut().zip(&self.tree.delta[c]) {
                 *d = scale * t;
             }
+            // (the segments hold every unknown: their local errors are the cable's)
             for seg in &rod.segments {
-                inc = inc.max(dy.apply_correction(rod, &mut st.cables[c], dt, c_mass, seg));
+                let (i, e) = dy.apply_correction(rod, &mut st.cables[c], dt, c_mass, seg);
+                inc = inc.max(i);
+                err = err.max(e);
             }
-            err = err.max(dy.local_error(0..rod.arc.len()));
         }
         for j in 0..self.jv.len() {
             let d = scale * self.tree.dj[j];
@@ -725,7 +727,8 @@ impl HarnessDynamics {
     fn residual_inf(&self, h: &Harness) -> f64 {
         let mut r = 0.0f64;
         for (c, rod) in h.cables.iter().enumerate() {
-            r = r.max(self.cables[c].ws.residual_norms(rod.mean_ds()).1);
+            let ws = &self.cables[c].ws;
+            r = r.max(ws.residual_inf_range(0..ws.rhs.len(), rod.mean_ds()));
         }
         for v in &self.tree.junction_residual {
             r = r.max(top(v).amax());

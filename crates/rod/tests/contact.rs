@@ -1034,11 +1034,18 @@ fn a_route_through_a_table_is_pushed_out_onto_it() {
     assert!(kappa[0] > s.contact.as_ref().unwrap().obstacle_kappa[0]);
     s.contact.as_mut().unwrap().obstacle_kappa = kappa;
     s.solve(&rod, &mut st).unwrap();
-    let worst =
+    // The same state up to the scene's mirror symmetry y → −y: the 0.2 m of slack lies on the
+    // table bent to one side, and which side a solve reaches is decided by round-off (the two
+    // paths chose opposite sides in a build for another CPU target, session 11).
+    let apart = |mirror: f64| {
         st.x.iter()
             .zip(&reference.x)
-            .map(|(a, b)| (a - b).norm())
-            .fold(0.0, f64::max);
+            .map(|(a, b)| (a - Vector3::new(b.x, mirror * b.y, b.z)).norm())
+            .fold(0.0, f64::max)
+    };
+    let bulge = st.x.iter().map(|x| x.y.abs()).fold(0.0, f64::max);
+    assert!(bulge > 0.05, "the slack bends sideways: {bulge} m");
+    let worst = apart(1.0).min(apart(-1.0));
     assert!(worst < 1e-6, "push-out vs rising table: {worst} m");
 }
 
