@@ -360,6 +360,74 @@ def test_run_stores_and_summarises_clearance(scene_dict, tmp_path):
     assert "min clearance [m]" in out.output
 
 
+def test_clearance_reports_progress_and_stops_on_request(scene_dict, monkeypatch, tmp_path):
+    """The clearance says how far it is (``progress("clearance of <cable>", done, total)``),
+    and a stop request while it runs (Ctrl-C, ``interrupt.request_stop``) ends the call with
+    the whole run kept, without the clearance (SimulationError: interrupted)."""
+    from cablelife import interrupt
+    from cablelife.simulate import SimulationError, simulate
+    from cablelife.surroundings import clearance as clearance_module
+
+    d = copy.deepcopy(scene_dict)
+    d["bodies"] = [
+        {
+            "name": "floor",
+            "geometry": [{"shape": "plane", "point": [0, 0, -0.26], "normal": [0, 0, 1]}],
+        }
+    ]
+    d["simulation"] |= {"mode": "dynamic", "duration": 0.05, "time_step": 0.001}
+    sc = scene_from_dict(d)
+    reports = []
+    res = simulate(sc, progress=lambda what, k, n: reports.append((what, k, n)))
+    steps = res.cable.n_steps
+    mine = [r for r in reports if r[0] == "clearance of hose"]
+    assert mine and mine[-1] == ("clearance of hose", steps, steps), reports[-3:]
+    assert all(r[2] == steps and 0 <= r[1] <= steps for r in mine)
+
+    # asked to stop once the clearance starts (the body maps are its first step)
+    maps = clearance_module.body_maps
+
+    def stop_then_maps(*args):
+        interrupt.request_stop()
+        return maps(*args)
+
+    monkeypatch.setattr(clearance_module, "body_maps", stop_then_maps)
+    try:
+        with pytest.raises(SimulationError) as err:
+            simulate(sc)
+    finally:
+        interrupt.reset()
+    assert err.value.interrupted and "without the clearance" in err.value.kept
+    stopped = err.value.result
+    assert stopped.complete is False and stopped.message == interrupt.INTERRUPTED
+    assert stopped.cable.n_steps == steps  # every step of the run kept
+    assert stopped.cable.surroundings is None and stopped.cable.clearance is None
+    assert np.array_equal(stopped.cable.positions, res.cable.positions)
+
+    # the command line: exit 130, the run saved without the clearance, and says so
+    import tomli_w
+    from cablelife.cli import app
+    from cablelife.results import load_result
+    from typer.testing import CliRunner
+
+    scene_file = tmp_path / "s.toml"
+    scene_file.write_text(tomli_w.dumps(d))
+    try:
+        out = CliRunner().invoke(app, ["run", str(scene_file), "-q", "-o", str(tmp_path / "r.h5")])
+    finally:
+        interrupt.reset()
+    assert out.exit_code == interrupt.EXIT_CODE, out.output
+    text = " ".join(out.output.split())
+    assert "every step of the run, without the clearance" in text, text
+    assert "interrupted: the clearance was not computed" in text, text
+    from cablelife.resultcheck import PartialResultWarning
+
+    with pytest.warns(PartialResultWarning, match="interrupted"):
+        back = load_result(tmp_path / "r.h5")
+    assert back.complete is False and back.message == "interrupted"
+    assert back.cable.n_steps == steps and back.cable.clearance is None
+
+
 # ---------------------------------------------------------------------------- bad meshes
 
 

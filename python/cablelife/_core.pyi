@@ -241,10 +241,13 @@ class Surroundings:
     def add_sphere(self, body, center, radius) -> Any:
         """Adds a solid sphere."""
         ...
-    def clearance(self, positions, radius, to_body) -> Any:
+    def clearance(self, positions, radius, to_body, progress=None, stop=None) -> Any:
         """Clearance of a cable of outer `radius` with node positions (T, N, 3) (global);
         `to_body` (B, T, 3, 4): per body and step the map [M | v] of global points into the
-        body's reference frame, X = M x + v. Returns (clearance (T, N) m, part (T, N) index).
+        body's reference frame, X = M x + v. Returns (clearance (T, N) m, part (T, N) index),
+        or None if it was stopped: by `stop` (a `StopFlag`, read before every step) or by
+        Ctrl-C when called on the main thread (KeyboardInterrupt is raised again on return).
+        `progress(done, total)` is called with the steps done every 50 ms.
         """
         ...
     def closest_to_segments(self, part, a, b) -> Any:

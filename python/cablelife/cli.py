@@ -147,6 +147,8 @@ def _progress_bar():
     :func:`cablelife.simulate.simulate`; not imported with --quiet (start-up time)."""
     from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
+    from cablelife.surroundings.clearance import CLEARANCE_LABEL
+
     progress = Progress(
         TextColumn("{task.description}"),
         BarColumn(),
@@ -158,7 +160,9 @@ def _progress_bar():
 
     def on_progress(cable: str, done: int, total: int) -> None:
         if cable not in tasks:
-            tasks[cable] = progress.add_task(escape(f"cable '{cable}'"), total=total)
+            # a cable's steps, or the clearance of a cable ("clearance of <cable>")
+            what = cable if cable.startswith(CLEARANCE_LABEL) else f"cable '{cable}'"
+            tasks[cable] = progress.add_task(escape(what), total=total)
         progress.update(tasks[cable], completed=done)
 
     return progress, on_progress
@@ -215,12 +219,14 @@ def run(
         raise fail(str(err)) from None
     except SimulationError as err:
         what = "interruption" if err.interrupted else "failure"
+        kept = err.kept or f"steps before the {what}"
         if output is not None:
             err.result.save(output)
-            err_console.print(escape(f"partial result (steps before the {what}) saved to {output}"))
+            err_console.print(escape(f"partial result ({kept}) saved to {output}"))
         if err.interrupted:
             raise interrupted(
-                "the run stopped early" + ("" if output else " (nothing saved)")
+                ("the clearance was not computed" if err.kept else "the run stopped early")
+                + ("" if output else " (nothing saved)")
             ) from None
         raise fail(str(err), code=1) from None
     if output is not None:  # saved first: a summary that cannot be printed loses nothing

@@ -29,11 +29,13 @@ Progress = Callable[[str, int, int], None]
 
 class SimulationError(RuntimeError):
     """A run that stopped early; ``result`` holds every step computed before the stop
-    (``result.complete`` is False, ``result.message`` says why: "interrupted" after Ctrl-C)."""
+    (``result.complete`` is False, ``result.message`` says why: "interrupted" after Ctrl-C);
+    ``kept`` says what it holds, when not the steps before the stop."""
 
-    def __init__(self, message: str, result: Result):
+    def __init__(self, message: str, result: Result, kept: str | None = None):
         super().__init__(message)
         self.result = result
+        self.kept = kept
 
     @property
     def interrupted(self) -> bool:
@@ -490,11 +492,27 @@ def _simulate_harness(scene: Scene, mode: str, times: np.ndarray, env, progress)
         junctions=junctions,
         harness_energies=energies,
     )
-    if env is not None:
-        add_clearance(env, scene, result, times, output_every(scene) if mode == "dynamic" else 1)
+    _clearance(env, scene, result, times, mode, progress, stopped)
     if errors:
         raise SimulationError(result.message, result)
     return result
+
+
+def _clearance(env, scene: Scene, result: Result, times, mode: str, progress, stopped: bool):
+    """The clearance of the run's cables, unless the run was interrupted (Ctrl-C: the user
+    asked it to stop, and a partial run's clearance may take long); Ctrl-C while it is computed
+    ends the command with the whole run saved without it (SimulationError)."""
+    if env is None or stopped:
+        return
+    every = output_every(scene) if mode == "dynamic" else 1
+    if not add_clearance(env, scene, result, times, every, progress):
+        result.complete = False
+        result.message = interrupt.INTERRUPTED
+        raise SimulationError(
+            result.message,
+            result,
+            kept="every step of the run, without the clearance: interrupted while computing it",
+        )
 
 
 def simulate(scene: Scene, mode: str | None = None, progress: Progress | None = None) -> Result:
@@ -540,8 +558,7 @@ def simulate(scene: Scene, mode: str | None = None, progress: Progress | None = 
         message=interrupt.INTERRUPTED if errors and stopped else "; ".join(errors),
         precision=scene.simulation.output_precision,
     )
-    if env is not None:
-        add_clearance(env, scene, result, times, output_every(scene) if mode == "dynamic" else 1)
+    _clearance(env, scene, result, times, mode, progress, stopped)
     if errors:
         raise SimulationError(result.message, result)
     return result

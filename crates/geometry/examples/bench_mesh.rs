@@ -86,7 +86,7 @@ fn main() {
     }];
     let maps = vec![geometry::RigidMap::identity(); steps];
     let t0 = Instant::now();
-    geometry::clearance(&parts, &pos, 101, 0.006, &maps).unwrap();
+    geometry::clearance(&parts, &pos, 101, 0.006, &maps, Default::default()).unwrap();
     let n = pos.len() as f64;
     println!(
         "clearance {:.2} µs/node",

@@ -76,7 +76,7 @@ fn main() {
     }];
     let maps = vec![RigidMap::identity(); steps];
     let (t0, c0) = (Instant::now(), cpu_time());
-    let c = clearance(&parts, &pos, edges + 1, 0.006, &maps).unwrap();
+    let c = clearance(&parts, &pos, edges + 1, 0.006, &maps, Default::default()).unwrap();
     let run = t0.elapsed().as_secs_f64();
     let cpu = cpu_time() - c0;
     let sum: f64 = c.value.iter().sum();

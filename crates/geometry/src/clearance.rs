@@ -9,6 +9,10 @@
 //! half-edges [x_i, (x_{i−1} + x_i)/2] and [x_i, (x_i + x_{i+1})/2] (the capsule between two
 //! nodes sees a corner that lies between them). Steps run in parallel in contiguous chunks so
 //! that each node's query is warm-started with the feature found at the previous step.
+//! A caller may stop it (a flag read before every step) and follow its progress ([`Control`]).
+use std::fmt;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+
 use nalgebra::Matrix3;
 use rayon::prelude::*;
 
@@ -47,31 +51,65 @@ pub struct Clearance {
     pub part: Vec<u32>,
 }
 
+/// What a caller shares with a running [`clearance`]: a stop request, read before every step,
+/// and the number of steps done (for a progress display).
+#[derive(Clone, Copy, Default)]
+pub struct Control<'a> {
+    pub stop: Option<&'a AtomicBool>,
+    pub done: Option<&'a AtomicUsize>,
+}
+
+impl Control<'_> {
+    fn stopped(&self) -> bool {
+        self.stop.is_some_and(|s| s.load(Ordering::Relaxed))
+    }
+}
+
+/// Why a clearance was not computed.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ClearanceError {
+    /// Input that does not fit (no geometry, shapes, non-finite positions).
+    Input(String),
+    /// The stop flag of its [`Control`] was set: it ended early, nothing is returned.
+    Stopped,
+}
+
+impl fmt::Display for ClearanceError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            ClearanceError::Input(why) => f.write_str(why),
+            ClearanceError::Stopped => f.write_str("stopped"),
+        }
+    }
+}
+
 /// Clearance of one cable: `positions` (T × n_nodes, global), `maps[b * T + t]` the map of
-/// body b at step t.
+/// body b at step t; `control`: a stop request and the steps done.
 pub fn clearance(
     parts: &[Part],
     positions: &[V3],
     n_nodes: usize,
     radius: f64,
     maps: &[RigidMap],
-) -> Result<Clearance, String> {
+    control: Control<'_>,
+) -> Result<Clearance, ClearanceError> {
+    let input = |why: String| Err(ClearanceError::Input(why));
     if parts.is_empty() {
-        return Err("no geometry to measure the clearance against".into());
+        return input("no geometry to measure the clearance against".into());
     }
     if n_nodes == 0 || !positions.len().is_multiple_of(n_nodes) {
-        return Err(format!(
+        return input(format!(
             "{} positions are not a whole number of steps of {n_nodes} nodes",
             positions.len()
         ));
     }
     if positions.iter().any(|p| !p.iter().all(|x| x.is_finite())) {
-        return Err("the cable positions contain non-finite values".into());
+        return input("the cable positions contain non-finite values".into());
     }
     let n_steps = positions.len() / n_nodes;
     let n_bodies = parts.iter().map(|p| p.body + 1).max().unwrap_or(0);
     if maps.len() != n_bodies * n_steps {
-        return Err(format!(
+        return input(format!(
             "{} body maps given, {n_bodies} bodies × {n_steps} steps needed",
             maps.len()
         ));
@@ -101,6 +139,9 @@ pub fn clearance(
                 .zip(prt.chunks_mut(n_nodes))
                 .enumerate()
             {
+                if control.stopped() {
+                    return;
+                }
                 let t = first + j;
                 let x = &positions[t * n_nodes..(t + 1) * n_nodes];
                 for b in 0..n_bodies {
@@ -121,8 +162,14 @@ pub fn clearance(
                     vrow,
                     prow,
                 );
+                if let Some(done) = control.done {
+                    done.fetch_add(1, Ordering::Relaxed);
+                }
             }
         });
+    if control.stopped() {
+        return Err(ClearanceError::Stopped);
+    }
     Ok(Clearance { value, part })
 }
 
@@ -300,7 +347,7 @@ mod tests {
             maps.push(m);
         }
         maps.extend((0..steps).map(|_| RigidMap::identity()));
-        let c = clearance(&parts, &positions, 2, 0.01, &maps).unwrap();
+        let c = clearance(&parts, &positions, 2, 0.01, &maps, Control::default()).unwrap();
         // step 0: plane 0.5 away, sphere surface 0.3 − 0.1 = 0.2 from the half-edge ends at x = 0.5
         assert!((c.value[0] - (0.2 - 0.01)).abs() < 1e-15);
         assert_eq!(c.part[0], 1);
@@ -311,6 +358,36 @@ mod tests {
             c.value[4]
         );
         assert_eq!(c.part[4], 0);
+    }
+
+    #[test]
+    fn a_stop_request_ends_it_and_steps_are_counted() {
+        let parts = vec![Part {
+            shape: Shape::HalfSpace(HalfSpace::new(V3::zeros(), V3::z())),
+            body: 0,
+        }];
+        let steps = 40;
+        let positions: Vec<V3> = (0..steps)
+            .flat_map(|t| (0..3).map(move |i| V3::new(i as f64, 0.0, 0.1 + 0.01 * t as f64)))
+            .collect();
+        let maps = vec![RigidMap::identity(); steps];
+        let (stop, done) = (AtomicBool::new(false), AtomicUsize::new(0));
+        let control = Control {
+            stop: Some(&stop),
+            done: Some(&done),
+        };
+        let c = clearance(&parts, &positions, 3, 0.01, &maps, control).unwrap();
+        assert_eq!(done.load(Ordering::Relaxed), steps);
+        assert!((c.value[3 * steps - 1] - (0.1 + 0.01 * (steps - 1) as f64 - 0.01)).abs() < 1e-15);
+        // asked to stop (before any step): nothing computed, nothing returned
+        stop.store(true, Ordering::Relaxed);
+        done.store(0, Ordering::Relaxed);
+        let r = clearance(&parts, &positions, 3, 0.01, &maps, control);
+        assert_eq!(r.err(), Some(ClearanceError::Stopped));
+        assert_eq!(done.load(Ordering::Relaxed), 0);
+        // bad input is named, whatever the flag
+        let r = clearance(&parts, &positions[..5], 3, 0.01, &maps, control);
+        assert!(matches!(r, Err(ClearanceError::Input(ref why)) if why.contains("5 positions")));
     }
 
     #[test]
@@ -355,10 +432,18 @@ mod tests {
             }
         }
         let maps = vec![RigidMap::identity(); steps];
-        let c = clearance(&parts, &positions, nodes, 0.005, &maps).unwrap();
+        let c = clearance(&parts, &positions, nodes, 0.005, &maps, Control::default()).unwrap();
         for t in 0..steps {
             let one = &positions[t * nodes..(t + 1) * nodes];
-            let cold = clearance(&parts, one, nodes, 0.005, &maps[t..t + 1]).unwrap();
+            let cold = clearance(
+                &parts,
+                one,
+                nodes,
+                0.005,
+                &maps[t..t + 1],
+                Control::default(),
+            )
+            .unwrap();
             assert_eq!(cold.value, c.value[t * nodes..(t + 1) * nodes], "step {t}");
         }
     }
@@ -424,7 +509,7 @@ mod tests {
         }
         let maps = vec![RigidMap::identity(); steps];
         let radius = 0.004;
-        let c = clearance(&parts, &positions, nodes, radius, &maps).unwrap();
+        let c = clearance(&parts, &positions, nodes, radius, &maps, Control::default()).unwrap();
         let Shape::Mesh(mesh) = &parts[0].shape else {
             unreachable!()
         };
@@ -497,7 +582,7 @@ mod tests {
             })
             .collect();
         let maps = vec![RigidMap::identity(); steps];
-        let c = clearance(&parts, &positions, nodes, 0.0, &maps).unwrap();
+        let c = clearance(&parts, &positions, nodes, 0.0, &maps, Control::default()).unwrap();
         for t in 0..steps {
             let z = positions[t * nodes].z;
             let expect = if z < 0.05 { z } else { z - 0.1 };

@@ -26,7 +26,7 @@ use nalgebra::Vector3;
 
 pub type V3 = Vector3<f64>;
 
-pub use clearance::{clearance, Clearance, Part, RigidMap};
+pub use clearance::{clearance, Clearance, ClearanceError, Control, Part, RigidMap};
 pub use coherence::Candidates;
 pub use mesh::{MeshError, TriMesh};
 pub use primitives::{Cuboid, Cylinder, HalfSpace, Sphere};

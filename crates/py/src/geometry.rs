@@ -1,7 +1,11 @@
 //! Bindings of the surroundings' distance queries and the clearance kernel. Parts are added
 //! in their body's reference frame; queries and the clearance run without the GIL.
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::time::Duration;
+
 use ::geometry::{
-    clearance, Cuboid, Cylinder, HalfSpace, Part, RigidMap, Shape, Sphere, Surface, TriMesh, V3,
+    clearance, ClearanceError, Control, Cuboid, Cylinder, HalfSpace, Part, RigidMap, Shape, Sphere,
+    Surface, TriMesh, V3,
 };
 use nalgebra::Matrix3;
 use numpy::{
@@ -10,6 +14,8 @@ use numpy::{
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+
+use crate::stop::{Poller, StopFlag};
 
 fn rows3(a: &PyReadonlyArray2<'_, f64>, what: &str) -> PyResult<Vec<V3>> {
     let v = a.as_array();
@@ -255,14 +261,20 @@ impl Surroundings {
 
     /// Clearance of a cable of outer `radius` with node positions (T, N, 3) (global);
     /// `to_body` (B, T, 3, 4): per body and step the map [M | v] of global points into the
-    /// body's reference frame, X = M x + v. Returns (clearance (T, N) m, part (T, N) index).
+    /// body's reference frame, X = M x + v. Returns (clearance (T, N) m, part (T, N) index),
+    /// or None if it was stopped: by `stop` (a `StopFlag`, read before every step) or by Ctrl-C
+    /// when called on the main thread (KeyboardInterrupt is raised again on return).
+    /// `progress(done, total)` is called with the steps done every 50 ms.
+    #[pyo3(signature = (positions, radius, to_body, progress=None, stop=None))]
     fn clearance<'py>(
         &self,
         py: Python<'py>,
         positions: PyReadonlyArray3<'py, f64>,
         radius: f64,
         to_body: PyReadonlyArray4<'py, f64>,
-    ) -> PyResult<ClearanceArrays<'py>> {
+        progress: Option<Py<PyAny>>,
+        stop: Option<Bound<'py, StopFlag>>,
+    ) -> PyResult<Option<ClearanceArrays<'py>>> {
         let pos = positions.as_array();
         let (t, n, k) = pos.dim();
         if k != 3 {
@@ -302,13 +314,47 @@ impl Surroundings {
             )));
         }
         let parts = &self.parts;
-        let out = py
-            .detach(|| clearance(parts, &points, n, radius, &maps))
-            .map_err(PyValueError::new_err)?;
-        Ok((
-            PyArray1::from_vec(py, out.value).reshape([t, n])?,
-            PyArray1::from_vec(py, out.part).reshape([t, n])?,
-        ))
+        // The kernel runs in a thread of its own; this one watches it: the stop flag, Ctrl-C
+        // (on the main thread) and progress, every 10 ms (Poller: Python every 50 ms).
+        // The kernel reads the stop flag itself (a flag set before the call stops it before its
+        // first step); Ctrl-C seen here sets it too (or a flag of this call's own).
+        let mut poller = Poller::new(stop.as_ref(), progress, t.max(1), t);
+        let shared = stop.as_ref().map(|s| s.get().flag());
+        let own = AtomicBool::new(false);
+        let halt: &AtomicBool = shared.as_deref().unwrap_or(&own);
+        let done = AtomicUsize::new(0);
+        let control = Control {
+            stop: Some(halt),
+            done: Some(&done),
+        };
+        let out = py.detach(|| {
+            std::thread::scope(|s| {
+                let kernel = s.spawn(|| clearance(parts, &points, n, radius, &maps, control));
+                while !kernel.is_finished() {
+                    std::thread::park_timeout(Duration::from_millis(10));
+                    if poller.poll(done.load(Ordering::Relaxed).min(t)).is_some() {
+                        halt.store(true, Ordering::Relaxed);
+                    }
+                }
+                let out = kernel.join();
+                if !halt.load(Ordering::Relaxed) {
+                    poller.poll(t); // the last progress report: all steps
+                }
+                out
+            })
+        });
+        match out {
+            Ok(Ok(out)) => Ok(Some((
+                PyArray1::from_vec(py, out.value).reshape([t, n])?,
+                PyArray1::from_vec(py, out.part).reshape([t, n])?,
+            ))),
+            Ok(Err(ClearanceError::Stopped)) => {
+                py.check_signals()?; // Ctrl-C on the main thread: KeyboardInterrupt now
+                Ok(None)
+            }
+            Ok(Err(ClearanceError::Input(why))) => Err(PyValueError::new_err(why)),
+            Err(panic) => std::panic::resume_unwind(panic),
+        }
     }
 }
 

@@ -51,6 +51,13 @@ impl StopFlag {
     }
 }
 
+impl StopFlag {
+    /// The shared flag itself (for kernels that read it directly).
+    pub(crate) fn flag(&self) -> Arc<AtomicBool> {
+        self.0.clone()
+    }
+}
+
 /// Polled by a solver loop after each step.
 pub struct Poller {
     stop: Option<Arc<AtomicBool>>,
