@@ -1034,13 +1034,8 @@ impl Dynamics {
             .zip(&self.vdot_n[r.clone()])
         {
             if half[0] {
-                let mut vd: Vector3<f64> = vdot.fixed_rows::<3>(0).into();
-                vd += c_mass * d.fixed_rows::<3>(0);
-                vdot.fixed_rows_mut::<3>(0).copy_from(&vd);
-                ex = ex.max((vd - vd_n.fixed_rows::<3>(0)).amax());
-                let dq: Vector3<f64> = dq0.fixed_rows::<3>(0) + k_dq * vd;
-                v.fixed_rows_mut::<3>(0)
-                    .copy_from(&(v0.fixed_rows::<3>(0) + k_v * vd));
+                let (dq, e) = correct_slots(0, (c_mass, k_dq, k_v), d, vdot, dq0, v0, v, vd_n);
+                ex = ex.max(e);
                 let dx = h * dq;
                 *x = x_n + dx;
                 dx_max = dx_max.max(dx.amax());
@@ -1060,13 +1055,8 @@ impl Dynamics {
         .zip(&self.vdot_n[re.clone()])
         {
             if half[1] {
-                let mut vd: Vector3<f64> = vdot.fixed_rows::<3>(3).into();
-                vd += c_mass * d.fixed_rows::<3>(3);
-                vdot.fixed_rows_mut::<3>(3).copy_from(&vd);
-                eth = eth.max((vd - vd_n.fixed_rows::<3>(3)).amax());
-                let dq: Vector3<f64> = dq0.fixed_rows::<3>(3) + k_dq * vd;
-                v.fixed_rows_mut::<3>(3)
-                    .copy_from(&(v0.fixed_rows::<3>(3) + k_v * vd));
+                let (dq, e) = correct_slots(3, (c_mass, k_dq, k_v), d, vdot, dq0, v0, v, vd_n);
+                eth = eth.max(e);
                 let dth = h * dq;
                 *p = rotate_body(p_n, &dth);
                 dth_max = dth_max.max(dth.amax());
@@ -1297,4 +1287,28 @@ impl Dynamics {
     pub fn velocities(&self) -> &[Vector6<f64>] {
         &self.rates.v
     }
+}
+
+/// The Newton correction of three inertial slots of a block (from `k`: 0 the node's position,
+/// 3 the edge's rotation): v̇ += c_m δ, then v = v₀ + k_v v̇; returns the new Δq = Δq₀ + k_dq v̇
+/// there and max |v̇ − v̇_n| (the local error estimate's part).
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn correct_slots(
+    k: usize,
+    (c_mass, k_dq, k_v): (f64, f64, f64),
+    d: &Vector6<f64>,
+    vdot: &mut Vector6<f64>,
+    dq0: &Vector6<f64>,
+    v0: &Vector6<f64>,
+    v: &mut Vector6<f64>,
+    vd_n: &Vector6<f64>,
+) -> (Vector3<f64>, f64) {
+    let mut vd: Vector3<f64> = vdot.fixed_rows::<3>(k).into();
+    vd += c_mass * d.fixed_rows::<3>(k);
+    vdot.fixed_rows_mut::<3>(k).copy_from(&vd);
+    v.fixed_rows_mut::<3>(k)
+        .copy_from(&(v0.fixed_rows::<3>(k) + k_v * vd));
+    let error = (vd - vd_n.fixed_rows::<3>(k)).amax();
+    (dq0.fixed_rows::<3>(k) + k_dq * vd, error)
 }
