@@ -329,7 +329,12 @@ impl Surroundings {
         };
         let out = py.detach(|| {
             std::thread::scope(|s| {
-                let kernel = s.spawn(|| clearance(parts, &points, n, radius, &maps, control));
+                let watcher = std::thread::current();
+                let kernel = s.spawn(move || {
+                    let out = clearance(parts, &points, n, radius, &maps, control);
+                    watcher.unpark(); // done: no need to wait out the watch interval
+                    out
+                });
                 while !kernel.is_finished() {
                     std::thread::park_timeout(Duration::from_millis(10));
                     if poller.poll(done.load(Ordering::Relaxed).min(t)).is_some() {
