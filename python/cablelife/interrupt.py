@@ -78,6 +78,18 @@ def _ctrl_c_as_flag() -> Iterator[threading.Event]:
         signal.signal(signal.SIGINT, previous)
 
 
+@contextmanager
+def deferred() -> Iterator[None]:
+    """Ctrl-C in the block is held until the block ends and then raised (KeyboardInterrupt):
+    for third-party code that swallows it. trimesh imports its optional dependencies under
+    ``except BaseException``, so a Ctrl-C while a mesh was being read was lost and the run went
+    on to its end (exit 0). Main thread only; elsewhere the block runs as it is."""
+    with _ctrl_c_as_flag() as pressed:
+        yield
+    if pressed.is_set():
+        raise KeyboardInterrupt
+
+
 def wait_stopping(futures, stop: Callable[[], None], stop_on_error: bool = True) -> bool:
     """Waits for every future of a thread pool; on Ctrl-C (and, with ``stop_on_error``, when
     one of them fails) calls ``stop()`` once and goes on waiting. Returns whether Ctrl-C came.

@@ -40,12 +40,16 @@ def load_mesh(path: Path, scale: float | None, what: str, scene_size: float) -> 
     trimesh reads the file (its binary STL reader is numpy); merging the vertices and the
     checks are vectorised here (``merge_vertices``, ``edge_counts``): a 1 M-triangle STL takes
     a fraction of a second instead of seconds of trimesh's general processing."""
-    import trimesh
+    from cablelife import interrupt
 
     if not path.is_file():
         raise SceneError(f"{what}: mesh file {str(path)!r} does not exist")
     try:
-        raw, faces = read_triangles(path, trimesh)
+        # trimesh swallows KeyboardInterrupt while it imports (interrupt.deferred)
+        with interrupt.deferred():
+            import trimesh
+
+            raw, faces = read_triangles(path, trimesh)
     except Exception as err:  # trimesh raises many types for broken files
         raise SceneError(
             f"{what}: cannot read mesh file {str(path)!r} "
