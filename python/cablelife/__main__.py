@@ -21,7 +21,17 @@ def _exit_interrupted() -> None:
     os._exit(EXIT_INTERRUPTED)
 
 
+def _quiet_unraisable(unraisable) -> None:
+    """Ctrl-C while the interpreter shuts down lands in callbacks Python can only report
+    ("Exception ignored in: <function WeakValueDictionary…>" with a traceback, seen once with
+    ``cablelife demo``): dropped; every other unraisable exception is reported as before."""
+    if issubclass(unraisable.exc_type, KeyboardInterrupt):
+        return
+    sys.__unraisablehook__(unraisable)
+
+
 def main() -> None:
+    sys.unraisablehook = _quiet_unraisable
     try:
         from cablelife.cli import app
         from cablelife.interrupt import report_exit
