@@ -213,10 +213,15 @@ def check_result_values(result, path) -> None:
 def warn_partial(result, path) -> None:
     """A warning when the result is of a run that stopped early."""
     if not getattr(result, "complete", True):
-        why = f": {result.message}" if result.message else ""
+        message = result.message or ""
+        # "interrupted: …" says itself what is missing (the clearance); else the run stopped
+        why = (
+            message
+            if message.startswith("interrupted: ")
+            else "the run stopped early" + (f": {message}" if message else "")
+        )
         warnings.warn(
-            f"{str(path)!r} is a partial result (the run stopped early{why}); the analysis "
-            "covers only the saved steps",
+            f"{str(path)!r} is a partial result ({why}); the analysis covers only the saved steps",
             PartialResultWarning,
             stacklevel=3,
         )

@@ -26,6 +26,11 @@ from cablelife.surroundings.clearance import add_clearance
 
 Progress = Callable[[str, int, int], None]
 
+#: ``Result.message`` of a run whose clearance Ctrl-C stopped (every step of it is saved).
+CLEARANCE_INTERRUPTED = (
+    f"{interrupt.INTERRUPTED}: the clearance was not computed (every step of the run is saved)"
+)
+
 
 class SimulationError(RuntimeError):
     """A run that stopped early; ``result`` holds every step computed before the stop
@@ -40,7 +45,7 @@ class SimulationError(RuntimeError):
     @property
     def interrupted(self) -> bool:
         """The run was stopped on request (Ctrl-C), not by a solver failure."""
-        return self.result.message == interrupt.INTERRUPTED
+        return self.result.message.startswith(interrupt.INTERRUPTED)
 
 
 def frame_matrix(direction, normal=None) -> np.ndarray:
@@ -507,7 +512,7 @@ def _clearance(env, scene: Scene, result: Result, times, mode: str, progress, st
     every = output_every(scene) if mode == "dynamic" else 1
     if not add_clearance(env, scene, result, times, every, progress):
         result.complete = False
-        result.message = interrupt.INTERRUPTED
+        result.message = CLEARANCE_INTERRUPTED
         raise SimulationError(
             result.message,
             result,
