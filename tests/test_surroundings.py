@@ -428,6 +428,31 @@ def test_clearance_reports_progress_and_stops_on_request(scene_dict, monkeypatch
     assert back.cable.n_steps == steps and back.cable.clearance is None
 
 
+def test_a_failing_clearance_progress_callback_is_an_error_not_an_interruption(scene_dict):
+    sc = scene_with(
+        scene_dict,
+        [
+            {
+                "name": "floor",
+                "geometry": [{"shape": "plane", "point": [0, 0, -1], "normal": [0, 0, 1]}],
+            }
+        ],
+    )
+    env = load_surroundings(sc)
+    positions = np.zeros((4, 5, 3))
+    maps = np.zeros((1, 4, 3, 4))
+    maps[0, :, :, :3] = np.eye(3)
+
+    def broken(done, total):
+        raise ValueError("display gone")
+
+    with pytest.raises(RuntimeError, match="progress callback failed: ValueError: display gone"):
+        env.core.clearance(positions, RADIUS, maps, broken)
+    calls = []
+    value, _ = env.core.clearance(positions, RADIUS, maps, lambda k, n: calls.append((k, n)))
+    assert calls[-1] == (4, 4) and np.allclose(value, 1.0 - RADIUS)
+
+
 # ---------------------------------------------------------------------------- bad meshes
 
 

@@ -11,11 +11,11 @@ use nalgebra::Matrix3;
 use numpy::{
     PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2, PyReadonlyArray3, PyReadonlyArray4,
 };
-use pyo3::exceptions::PyValueError;
+use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::stop::{Poller, StopFlag};
+use crate::stop::{Poller, StopFlag, INTERRUPTED};
 
 fn rows3(a: &PyReadonlyArray2<'_, f64>, what: &str) -> PyResult<Vec<V3>> {
     let v = a.as_array();
@@ -335,19 +335,28 @@ impl Surroundings {
                     watcher.unpark(); // done: no need to wait out the watch interval
                     out
                 });
+                let mut why = None;
                 while !kernel.is_finished() {
                     std::thread::park_timeout(Duration::from_millis(10));
-                    if poller.poll(done.load(Ordering::Relaxed).min(t)).is_some() {
-                        halt.store(true, Ordering::Relaxed);
+                    if why.is_none() {
+                        why = poller.poll(done.load(Ordering::Relaxed).min(t));
+                        if why.is_some() {
+                            halt.store(true, Ordering::Relaxed);
+                        }
                     }
                 }
                 let out = kernel.join();
-                if !halt.load(Ordering::Relaxed) {
-                    poller.poll(t); // the last progress report: all steps
+                if why.is_none() && !halt.load(Ordering::Relaxed) {
+                    why = poller.poll(t); // the last progress report: all steps
                 }
-                out
+                (out, why)
             })
         });
+        let (out, why) = out;
+        // A progress callback that failed (not Ctrl-C) is an error, not an interruption.
+        if let Some(why) = why.filter(|w| w != INTERRUPTED) {
+            return Err(PyRuntimeError::new_err(why));
+        }
         match out {
             Ok(Ok(out)) => Ok(Some((
                 PyArray1::from_vec(py, out.value).reshape([t, n])?,
