@@ -427,6 +427,22 @@ def test_clearance_reports_progress_and_stops_on_request(scene_dict, monkeypatch
     assert back.complete is False and back.message == CLEARANCE_INTERRUPTED
     assert back.cable.n_steps == steps and back.cable.clearance is None
 
+    # a run that failed before (here: a strain error) keeps saying so
+    import sys
+
+    # (the package's attribute `simulate` is the function, not the module)
+    simulate_module = sys.modules["cablelife.simulate"]
+    monkeypatch.setattr(simulate_module, "_check_strains", lambda *a: ["cable 'hose': too long"])
+    try:
+        with pytest.raises(SimulationError) as err:
+            simulate(sc)
+    finally:
+        interrupt.reset()
+    assert err.value.interrupted and "before the failure" in err.value.kept
+    assert err.value.result.message == (
+        "interrupted: the clearance was not computed; cable 'hose': too long"
+    )
+
 
 def test_a_failing_clearance_progress_callback_is_an_error_not_an_interruption(scene_dict):
     sc = scene_with(

@@ -510,14 +510,15 @@ def _clearance(env, scene: Scene, result: Result, times, mode: str, progress, st
     if env is None or stopped:
         return
     every = output_every(scene) if mode == "dynamic" else 1
+    failure = "" if result.complete else result.message  # a run that failed before
     if not add_clearance(env, scene, result, times, every, progress):
         result.complete = False
         result.message = CLEARANCE_INTERRUPTED
-        raise SimulationError(
-            result.message,
-            result,
-            kept="every step of the run, without the clearance: interrupted while computing it",
-        )
+        kept = "every step of the run, without the clearance: interrupted while computing it"
+        if failure:
+            result.message = f"{interrupt.INTERRUPTED}: the clearance was not computed; {failure}"
+            kept = "the steps before the failure, without the clearance: interrupted"
+        raise SimulationError(result.message, result, kept=kept)
 
 
 def simulate(scene: Scene, mode: str | None = None, progress: Progress | None = None) -> Result:
