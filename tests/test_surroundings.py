@@ -391,14 +391,18 @@ def test_clearance_reports_progress_and_stops_on_request(scene_dict, monkeypatch
         interrupt.request_stop()
         return maps(*args)
 
+    def stopped_run() -> SimulationError:
+        try:
+            with pytest.raises(SimulationError) as err:
+                simulate(sc)
+        finally:
+            interrupt.reset()
+        return err.value
+
     monkeypatch.setattr(clearance_module, "body_maps", stop_then_maps)
-    try:
-        with pytest.raises(SimulationError) as err:
-            simulate(sc)
-    finally:
-        interrupt.reset()
-    assert err.value.interrupted and "without the clearance" in err.value.kept
-    stopped = err.value.result
+    err = stopped_run()
+    assert err.interrupted and "without the clearance" in err.kept
+    stopped = err.result
     assert stopped.complete is False and stopped.message == CLEARANCE_INTERRUPTED
     assert stopped.cable.n_steps == steps  # every step of the run kept
     assert stopped.cable.surroundings is None and stopped.cable.clearance is None
@@ -433,13 +437,9 @@ def test_clearance_reports_progress_and_stops_on_request(scene_dict, monkeypatch
     # (the package's attribute `simulate` is the function, not the module)
     simulate_module = sys.modules["cablelife.simulate"]
     monkeypatch.setattr(simulate_module, "_check_strains", lambda *a: ["cable 'hose': too long"])
-    try:
-        with pytest.raises(SimulationError) as err:
-            simulate(sc)
-    finally:
-        interrupt.reset()
-    assert err.value.interrupted and "before the failure" in err.value.kept
-    assert err.value.result.message == (
+    err = stopped_run()
+    assert err.interrupted and "before the failure" in err.kept
+    assert err.result.message == (
         "interrupted: the clearance was not computed; cable 'hose': too long"
     )
 
