@@ -16,6 +16,7 @@ import warnings
 import h5py
 import numpy as np
 
+from cablelife import _core
 from cablelife.limits import MAX_RUN_BYTES, MIN_SEGMENTS, human_bytes
 
 
@@ -217,7 +218,7 @@ def warn_partial(result, path) -> None:
         # "interrupted: …" says itself what is missing (the clearance); else the run stopped
         why = (
             message
-            if message.startswith("interrupted: ")
+            if message.startswith(f"{_core.INTERRUPTED}: ")
             else "the run stopped early" + (f": {message}" if message else "")
         )
         warnings.warn(

@@ -101,7 +101,7 @@ impl Record {
             iterations: Vec::with_capacity(n),
             substeps: Vec::with_capacity(n),
             residual: Vec::with_capacity(n),
-            unresolved_gain: Vec::new(),
+            unresolved_gain: Vec::with_capacity(n),
             unstable: Vec::with_capacity(n),
             snap_fraction: Vec::with_capacity(n),
             snap_jump: Vec::with_capacity(n),

@@ -1143,10 +1143,12 @@ impl Contact {
                 rotation: o.rotation,
             };
         };
-        let centre = (mid - o.position).norm();
-        if far.is_finite() && centre - half - far > reach {
-            far_edge(centre - half - far - self.opts.radius);
-            return;
+        if far.is_finite() {
+            let beyond = (mid - o.position).norm() - half - far; // (no root for unbounded shapes)
+            if beyond > reach {
+                far_edge(beyond - self.opts.radius);
+                return;
+            }
         }
         let mut d_mid = o.distance_within(&mid, half + reach);
         if self.deep[slot] && d_mid >= half + reach {

@@ -10,7 +10,9 @@ use crate::junction::HeldEnds;
 use crate::model::{Pose, Rod};
 use crate::rotation::slerp;
 use crate::sliding::SlidingClips;
-use crate::statics::{continue_load, solve_load_scaled, NewtonOptions, SolveError, SolveStats};
+use crate::statics::{
+    continue_load, restep_load_scaled, solve_load_scaled, NewtonOptions, SolveError, SolveStats,
+};
 use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 
 #[inline]
@@ -941,23 +943,19 @@ impl HarnessStatics {
             }
             st.sync_ends(h);
         }
-        let mut result = match self.step_from_reference(h, st, target) {
+        let first = match self.step_from_reference(h, st, target) {
             Ok(s) => Ok(s),
             Err(_) => {
                 st.clone_from(&self.last);
                 self.step_from_reference(h, st, target)
             }
         };
-        // The barrier scaled to the load (as `solve_static`): once more from the equilibrium.
-        if let Ok(s) = &result {
-            if self.any_contact(&mut |c| c.adapt_stiffness()) {
-                let first = s.iterations;
-                result = self.step_from_reference(h, st, target).map(|mut s| {
-                    s.iterations += first;
-                    s
-                });
-            }
-        }
+        let result = restep_load_scaled(
+            self,
+            first,
+            |s, f| s.any_contact(f),
+            |s| s.step_from_reference(h, st, target),
+        );
         let result = result.and_then(|mut s| {
             self.ensure_stable(h, st, &mut s)?; // an unstable equilibrium is left (harness_escape)
             Ok(s)

@@ -1637,23 +1637,19 @@ impl Statics {
         if self.has_prev {
             st.extrapolate_free(rod, &self.prev, &self.last);
         }
-        let mut result = match self.step_to(rod, st, target) {
+        let first = match self.step_to(rod, st, target) {
             Ok(s) => Ok(s),
             Err(_) => {
                 st.clone_from(&self.last);
                 self.step_to(rod, st, target)
             }
         };
-        // The barrier scaled to the load (as `solve`): once more from the equilibrium.
-        if let Ok(s) = &result {
-            if self.contact.as_mut().is_some_and(|c| c.adapt_stiffness()) {
-                let first = s.iterations;
-                result = self.step_to(rod, st, target).map(|mut s| {
-                    s.iterations += first;
-                    s
-                });
-            }
-        }
+        let result = restep_load_scaled(
+            self,
+            first,
+            |s, f| s.contact.as_mut().is_some_and(f),
+            |s| s.step_to(rod, st, target),
+        );
         std::mem::swap(&mut self.prev, &mut self.last);
         self.has_prev = true;
         let stats = result?;
@@ -1716,6 +1712,27 @@ pub(crate) fn solve_load_scaled<T, S: Clone, E>(
                 return Err(e);
             }
         }
+    }
+}
+
+/// A quasistatic step with the barrier scaled to the load (as `solve_load_scaled`): after the
+/// `first` solve of the step converged and a contact adapted its stiffness, the step once more
+/// from that equilibrium (`restep`), the iterations summed. Shared by the single cable and the
+/// harness.
+pub(crate) fn restep_load_scaled<T, E>(
+    solver: &mut T,
+    first: Result<SolveStats, E>,
+    contacts: impl Fn(&mut T, &mut dyn FnMut(&mut Contact) -> bool) -> bool,
+    restep: impl FnOnce(&mut T) -> Result<SolveStats, E>,
+) -> Result<SolveStats, E> {
+    match first {
+        Ok(s) if contacts(solver, &mut |c| c.adapt_stiffness()) => {
+            restep(solver).map(|r| SolveStats {
+                iterations: s.iterations + r.iterations,
+                ..r
+            })
+        }
+        r => r,
     }
 }
 

@@ -25,11 +25,14 @@ def cable_clearance(
     steps: np.ndarray,
     progress: Callable[[int, int], None] | None = None,
     stop=None,
+    maps: np.ndarray | None = None,
 ) -> CableClearance | None:
     """Clearance of one cable with node ``positions`` (S, N+1, 3) at the saved ``steps``
     (indices into the run's time grid ``times``); None if ``stop`` (a ``StopFlag``) was set
-    before it was done. ``progress(done, total)``: steps done, every 50 ms."""
-    maps = body_maps(scene, env.bodies, times, steps)
+    before it was done. ``progress(done, total)``: steps done, every 50 ms. ``maps``: the
+    bodies' maps at those steps (``body_maps``) when the caller has them."""
+    if maps is None:
+        maps = body_maps(scene, env.bodies, times, steps)
     out = env.core.clearance(np.ascontiguousarray(positions, float), radius, maps, progress, stop)
     if out is None:
         return None
@@ -84,8 +87,10 @@ def add_clearance(
             steps = np.arange(c.n_steps) * every
             label = f"{CLEARANCE_LABEL}{cable.name}"
             report = (lambda k, n, label=label: progress(label, k, n)) if progress else None
+            # the bodies' maps of the longest run, above (every cable's steps start at 0)
+            maps = np.ascontiguousarray(to_body[:, : c.n_steps])
             done[cable.name] = cable_clearance(
-                env, scene, c.positions, radius, times, steps, report, stop
+                env, scene, c.positions, radius, times, steps, report, stop, maps
             )
             if done[cable.name] is None:
                 break  # stopped
