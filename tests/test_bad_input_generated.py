@@ -1,5 +1,6 @@
-"""Generated bad scenes: every leaf value of a rich scene (bodies, motions, loads, damping)
-replaced by a boolean, a NaN and 1e300. Each must give exit code 2 with the leaf's key in the
+"""Generated bad scenes: every leaf value of a rich scene (bodies, motions, loads, damping) and
+of a scene with surroundings (geometry parts of every kind, contact, clearance) replaced by a
+boolean, a NaN and 1e300. Each must give exit code 2 with the leaf's key in the
 message, or (for a huge value a scene may hold) a run whose outputs are finite — never a
 traceback, a panic, or a misleading solver failure (exit code 1)."""
 
@@ -42,6 +43,93 @@ def _rich_scene() -> dict:
     return d
 
 
+# A tetrahedron (ASCII STL, metres; 30 cm above the hose) for the mesh part of the
+# surroundings scene.
+TETRAHEDRON = """solid t
+facet normal 0 0 -1
+outer loop
+vertex 0.4 -0.3 0.3
+vertex 0.4 -0.2 0.3
+vertex 0.5 -0.3 0.3
+endloop
+endfacet
+facet normal 0 -1 0
+outer loop
+vertex 0.4 -0.3 0.3
+vertex 0.5 -0.3 0.3
+vertex 0.4 -0.3 0.4
+endloop
+endfacet
+facet normal -1 0 0
+outer loop
+vertex 0.4 -0.3 0.3
+vertex 0.4 -0.3 0.4
+vertex 0.4 -0.2 0.3
+endloop
+endfacet
+facet normal 0.577 0.577 0.577
+outer loop
+vertex 0.5 -0.3 0.3
+vertex 0.4 -0.2 0.3
+vertex 0.4 -0.3 0.4
+endloop
+endfacet
+endsolid t
+"""
+
+
+def _surroundings_scene() -> dict:
+    """The hose over a table, between a box, a cylinder, a sphere and a mesh (all out of its
+    way but for the table), contact with friction on, a clearance limit."""
+    d = scene()
+    d["simulation"].update(mode="quasistatic", duration=0.02, time_step=0.01)
+    d["bodies"] = [
+        {
+            "name": "engine",
+            "origin": [0.8, 0.2, 0.0],
+            "motion": [
+                {"channel": "z", "signal": {"type": "sine", "amplitude": 0.01, "frequency": 1.0}}
+            ],
+            "geometry": [
+                {
+                    "shape": "box",
+                    "center": [0.9, 0.5, 0.0],
+                    "size": [0.1, 0.1, 0.1],
+                    "orientation": [0.0, 0.0, 0.3],
+                    "friction": 0.4,
+                },
+                {"mesh": "part.stl", "scale": 1.0, "name": "block"},
+            ],
+        },
+        {
+            "name": "car-body",
+            "geometry": [
+                {"shape": "plane", "point": [0.0, 0.0, -0.05], "normal": [0.0, 0.0, 1.0]},
+                {
+                    "shape": "cylinder",
+                    "center": [0.4, 0.5, 0.0],
+                    "axis": [0.0, 0.0, 1.0],
+                    "radius": 0.02,
+                    "length": 0.2,
+                },
+                {"shape": "sphere", "center": [0.4, -0.5, 0.0], "radius": 0.05, "frame": "body"},
+            ],
+        },
+    ]
+    d["cables"][0]["clips"][1]["body"] = "engine"
+    d["contact"] = {
+        "enabled": True,
+        "friction": 0.3,
+        "distance": 5e-5,
+        "stiffness": 0.0,
+        "stick_distance": 5e-6,
+        "stick_velocity": 1e-3,
+        "damping": 5e-4,
+    }
+    d["clearance"] = {"min_clearance": 0.01}
+    return d
+
+
 def _leaves(node, path=()):
     if isinstance(node, dict):
         for k, v in node.items():
@@ -61,19 +149,29 @@ def _key(path) -> str:
     return text.lstrip(".")
 
 
-BASE = _rich_scene()
+SCENES = {"rich": _rich_scene(), "surroundings": _surroundings_scene()}
 VALUES = [("bool", True), ("nan", float("nan")), ("huge", 1e300)]
-CASES = [(path, name, value) for path in _leaves(BASE) for name, value in VALUES]
+CASES = [
+    (which, path, name, value)
+    for which, base in SCENES.items()
+    for path in _leaves(base)
+    for name, value in VALUES
+]
 
 
 @pytest.mark.parametrize(
-    ("path", "name", "value"), CASES, ids=[f"{_key(p)}={n}" for p, n, _ in CASES]
+    ("which", "path", "name", "value"),
+    CASES,
+    ids=[f"{w}:{_key(p)}={n}" for w, p, n, _ in CASES],
 )
-def test_generated_bad_value(tmp_path, path, name, value):
-    d = copy.deepcopy(BASE)
+def test_generated_bad_value(tmp_path, which, path, name, value):
+    d = copy.deepcopy(SCENES[which])
+    (tmp_path / "part.stl").write_text(TETRAHEDRON)
     node = d
     for p in path[:-1]:
         node = node[p]
+    if isinstance(node[path[-1]], bool) and name == "bool":
+        value = "yes"  # a flag set to a word, not coerced
     node[path[-1]] = value
     out = tmp_path / "out.h5"
     args = ["run", write_scene(tmp_path, d), "-q", "-o", out]

@@ -87,6 +87,11 @@ def test_contact_outputs_are_saved_and_read_back(scene_dict, tmp_path):
         ({"enabled": True, "friction": -0.2}, "friction"),
         ({"enabled": True, "distance": float("nan")}, "distance"),
         ({"enabled": True, "damping": -1e-3}, "damping"),
+        # Strict values: no coercion of a flag or a boolean, μ within its documented range.
+        ({"enabled": "yes"}, r"contact.enabled: Input should be a valid boolean"),
+        ({"enabled": True, "friction": True}, r"contact.friction: Input should be a valid number"),
+        ({"enabled": True, "friction": 20.0}, r"contact.friction: .*less than or equal to 10"),
+        ({"enabled": True, "distance": 2.0}, r"contact.distance: .*less than or equal to 1"),
         (
             {"enabled": True, "geometry": [{"type": "plane"}]},
             r"contact.geometry is no longer read.*\[\[bodies\]\] geometry",
@@ -113,6 +118,32 @@ def test_part_friction_must_not_be_negative(scene_dict):
     scene_dict["bodies"][0]["geometry"][0]["friction"] = -1.0
     with pytest.raises(SceneError, match="friction"):
         scene_from_dict(scene_dict)
+
+
+@pytest.mark.parametrize(
+    ("key", "value", "message"),
+    [
+        ("friction", True, "Input should be a valid number"),
+        ("point", [0.0, 0.0, 1e300], "less than or equal to 10000"),
+        ("normal", [0.0, 0.0, 1e-12], "must not be the zero vector"),
+    ],
+)
+def test_part_values_are_strict_and_bounded(scene_dict, key, value, message):
+    with_table(scene_dict)
+    scene_dict["bodies"][0]["geometry"][0][key] = value
+    with pytest.raises(SceneError, match=rf"bodies\[0\]\.geometry\[0\].*{key}.*{message}"):
+        scene_from_dict(scene_dict)
+
+
+def test_contact_gap_is_capped_at_the_barrier_reach(scene_dict):
+    # A table far below the hose: no sample comes within the barrier's reach d̂ = 1 % of r, so
+    # the smallest gap reads d̂ (it was ∞: the broad phase computes no gap for far edges).
+    d = with_table(scene_dict)
+    d["bodies"][0]["geometry"][0]["point"] = [0.0, 0.0, -2.0]
+    d["simulation"].update(mode="dynamic", duration=0.01, time_step=1e-3)
+    res = simulate(scene_from_dict(d)).cable
+    assert not (res.contact["contact_state"] > 0).any()
+    np.testing.assert_array_equal(res.contact["contact_gap"], 0.01 * 0.005)
 
 
 def rising_box(d, part):

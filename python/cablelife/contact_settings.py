@@ -4,10 +4,10 @@ global poses over time for the Rust solver."""
 
 from __future__ import annotations
 
-from typing import Annotated
-
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import BaseModel, ConfigDict, model_validator
+
+from cablelife.scene_types import Flag, Friction, Time, bounded
 
 
 class ContactSettings(BaseModel):
@@ -17,15 +17,15 @@ class ContactSettings(BaseModel):
 
     model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
 
-    enabled: bool = False
-    friction: Annotated[float, Field(ge=0.0)] = 0.0
-    distance: Annotated[float, Field(ge=0.0)] = 0.0  # d̂, m (0: 1 % of the cable radius)
+    enabled: Flag = False
+    friction: Friction = 0.0
+    distance: bounded("contact_length") = 0.0  # d̂, m (0: 1 % of the cable radius)
     # κ, N/m² (0: automatic — from the weight per length, raised per part by the static solve
     # to the contact load it carries; docs/contact.md "The barrier scaled to the load")
-    stiffness: Annotated[float, Field(ge=0.0)] = 0.0
-    stick_distance: Annotated[float, Field(ge=0.0)] = 0.0  # ε_x, m (0: 0.1 % of r)
-    stick_velocity: Annotated[float, Field(gt=0.0)] = 1e-3  # ε_v, m/s
-    damping: Annotated[float, Field(ge=0.0)] = 5e-4  # τ_c, s: normal damping of dynamic contact
+    stiffness: bounded("contact_stiffness") = 0.0
+    stick_distance: bounded("contact_length") = 0.0  # ε_x, m (0: 0.1 % of r)
+    stick_velocity: bounded("stick_velocity") = 1e-3  # ε_v, m/s
+    damping: Time = 5e-4  # τ_c, s: normal damping of dynamic contact
 
     @model_validator(mode="before")
     @classmethod

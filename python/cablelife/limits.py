@@ -26,6 +26,12 @@ LIMITS: dict[str, tuple[float, float]] = {
     "direction": (-1e6, 1e6),  # 1, components of direction and normal vectors (any length)
     "damping_ratio": (0.0, 1e3),  # 1, fraction of critical damping
     "time": (0.0, 1e6),  # s, retardation times, fades (11 days)
+    "friction": (0.0, 10.0),  # 1, Coulomb μ (rubber on rough surfaces ≈ 1–2)
+    "extent": (1e-6, 2e4),  # m, sizes of geometry primitives (1 µm … 20 km)
+    "mesh_scale": (1e-6, 1e3),  # 1, file units → m (0.001 for millimetres)
+    "contact_length": (0.0, 1.0),  # m, barrier distance d̂ and stick distance (0: default)
+    "contact_stiffness": (0.0, 1e15),  # N/m², barrier stiffness κ (0: automatic)
+    "stick_velocity": (1e-9, 1e3),  # m/s, stick zone of dynamic friction
 }
 
 # Segments of one cable. Fewer than MIN_SEGMENTS cannot represent a cable bent between two

@@ -72,7 +72,8 @@ ENERGIES = (
 )
 # Contact outputs (docs/contact.md): per node normal and friction force of the geometry on the
 # cable (T, N+1, 3, N, global), node state (T, N+1: 0 none, 1 stick, 2 slip), force per body
-# (T, B, 3; B = world and the scene's bodies), smallest gap of the sampled cable surface (T,).
+# (T, B, 3; B = world and the scene's bodies), smallest gap of the sampled cable surface (T,;
+# capped at the barrier's reach d̂).
 CONTACT_KEYS = (
     "contact_normal",
     "contact_friction",

@@ -12,7 +12,6 @@ from typing import Annotated, Literal
 
 import numpy as np
 from pydantic import (
-    AfterValidator,
     BaseModel,
     ConfigDict,
     Field,
@@ -24,46 +23,36 @@ from pydantic import (
 
 from cablelife import _core
 from cablelife.contact_settings import ContactSettings, check_geometry
-from cablelife.limits import LIMITS, MAX_SEGMENTS, MIN_SEGMENTS, check_name
+from cablelife.limits import LIMITS, MAX_SEGMENTS, MIN_SEGMENTS
 from cablelife.paths import SceneFileError, resolve_scene_file, shown_names
 from cablelife.rotations import euler_matrix
+from cablelife.scene_types import (
+    Acceleration,
+    AxialStiffness,
+    BendingStiffness,
+    Curvature,
+    Density,
+    Direction,
+    Flag,
+    Force,
+    Friction,
+    Length,
+    Modulus,
+    Moment,
+    Name,
+    NonNegativeFloat,
+    Point,
+    PositiveFloat,
+    PositiveInt,
+    Radius,
+    Time,
+    Vec3,
+    bounded,
+)
 from cablelife.sections import SectionProperties, from_material, from_measured
 from cablelife.signals.spec import ChannelMotion, TableSignal
 from cablelife.surroundings.models import ClearanceSettings, GeometryPart
 from cablelife.tomlfile import read_toml
-
-# Strict numbers: a TOML number is a number (ints are fine where floats are wanted); booleans
-# and strings are refused instead of coerced (``length = true`` is not 1 m).
-Real = Annotated[float, Strict()]
-PositiveFloat = Annotated[float, Strict(), Field(gt=0)]
-NonNegativeFloat = Annotated[float, Strict(), Field(ge=0)]
-PositiveInt = Annotated[int, Strict(), Field(gt=0)]
-Vec3 = tuple[Real, Real, Real]
-
-
-def _bounded(name: str):
-    """A strict float within the documented range ``LIMITS[name]`` (docs/scene.md, Limits)."""
-    lo, hi = LIMITS[name]
-    return Annotated[float, Strict(), Field(ge=lo, le=hi)]
-
-
-Length = _bounded("length")  # m, cable length
-Coordinate = _bounded("coordinate")  # m
-Point = tuple[Coordinate, Coordinate, Coordinate]
-Radius = _bounded("radius")  # m, section radii
-Modulus = _bounded("modulus")  # Pa, E and G
-Density = _bounded("density")  # kg/m³
-AxialStiffness = _bounded("axial_stiffness")  # N
-BendingStiffness = _bounded("bending_stiffness")  # N m²
-Curvature = _bounded("curvature")  # 1/m
-Acceleration = _bounded("acceleration")  # m/s²
-Force = _bounded("force")  # N
-Moment = _bounded("moment")  # N m
-Component = _bounded("direction")  # 1
-Direction = tuple[Component, Component, Component]
-Time = _bounded("time")  # s
-# Cable, clip and body names: HDF5 group names and table entries (limits.check_name).
-Name = Annotated[str, Strict(), Field(min_length=1), AfterValidator(check_name)]
 
 
 class SceneError(ValueError):
@@ -136,10 +125,10 @@ class MeasuredStiffness(_Model):
     EI1: BendingStiffness | None = None  # N m² (non-round cables: both)
     EI2: BendingStiffness | None = None
     GJ: BendingStiffness  # N m²
-    mass_per_length: _bounded("mass_per_length")  # kg/m
+    mass_per_length: bounded("mass_per_length")  # kg/m
     radius: Radius  # m, outer radius (contact, pictures, stresses)
-    rotary_inertia: _bounded("rotary_inertia") | None = None  # kg m (ρI per length, d1 and d2)
-    polar_rotary_inertia: _bounded("rotary_inertia") | None = None  # kg m (ρI₃ about the axis d3)
+    rotary_inertia: bounded("rotary_inertia") | None = None  # kg m (ρI per length, d1 and d2)
+    polar_rotary_inertia: bounded("rotary_inertia") | None = None  # kg m (ρI₃ about the axis d3)
 
     @model_validator(mode="after")
     def _bending(self):
@@ -162,7 +151,7 @@ class Clip(_Model):
     type: Literal["fixed", "swivel", "ball", "hinge", "sliding"] = "fixed"
     length: NonNegativeFloat = 0.0  # held length; 0 = point clip
     axis: Direction | None = None  # hinge: the turning axis in the clip frame (d1, d2, d3)
-    friction: NonNegativeFloat = 0.0  # sliding: Coulomb friction coefficient μ
+    friction: Friction = 0.0  # sliding: Coulomb friction coefficient μ
     frame: Literal["global", "body"] = "global"  # frame of position/direction/normal
 
     @field_validator("direction", "normal", "axis")
@@ -506,7 +495,7 @@ class Files(_Model):
     """Files named in the scene (measured signals, motion_file): outside the scene's folder
     only with ``allow_outside = true`` (or the CLI flag ``--allow-outside-files``)."""
 
-    allow_outside: Annotated[bool, Strict()] = False
+    allow_outside: Flag = False
 
 
 class Simulation(_Model):

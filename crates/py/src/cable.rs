@@ -191,7 +191,7 @@ impl Record {
         for f in &c.body_force {
             self.body_contact_force.extend_from_slice(f.as_slice());
         }
-        self.contact_gap.push(c.min_gap());
+        self.contact_gap.push(c.reported_gap());
     }
 
     /// Updates the peaks of the viscous section loads (dynamic runs). The shear force and

@@ -728,6 +728,12 @@ impl Contact {
             .fold(f64::INFINITY, |m, &g| m.min(g))
     }
 
+    /// The smallest gap as a result reports it: capped at the barrier's reach d̂ (gaps beyond
+    /// it are not all computed: the broad phase skips far edges), so never ∞.
+    pub fn reported_gap(&self) -> f64 {
+        self.min_gap().min(self.opts.distance)
+    }
+
     /// Starts the record of the smallest gaps of a static solve (`stiffen_after_failure`).
     pub fn begin_solve(&mut self) {
         self.lowest_gap.fill(f64::INFINITY);

@@ -69,8 +69,11 @@ pub struct HarnessStatics {
     /// Junction residuals (∂V/∂(X, Θ)).
     pub junction_residual: Vec<Vector6<f64>>,
     held_junction: Vec<bool>,
-    /// Per end: A⁻¹ B_k, six block-vector columns over its cable.
-    z: Vec<[Vec<Vector6<f64>>; 6]>,
+    /// Per end: A⁻¹ B_k over its cable, one 6×6 block per cable block (its six columns side
+    /// by side, so that applying a junction's correction is one pass over the cable).
+    z: Vec<Vec<Matrix6<f64>>>,
+    /// Per cable: one block vector for solving a column of A⁻¹ B_k.
+    column: Vec<Vec<Vector6<f64>>>,
     /// Junction pivots (after the tree elimination) and their inverses.
     pivot: Vec<Matrix6<f64>>,
     pivot_inv: Vec<Matrix6<f64>>,
@@ -149,8 +152,9 @@ impl HarnessStatics {
             held_junction: h.held.clone(),
             z: h.ends
                 .iter()
-                .map(|e| std::array::from_fn(|_| blocks(e.cable)))
+                .map(|e| vec![Matrix6::zeros(); h.cables[e.cable].arc.len()])
                 .collect(),
+            column: per_cable(),
             pivot: vec![Matrix6::zeros(); nj],
             pivot_inv: vec![Matrix6::zeros(); nj],
             link_ab: vec![Matrix6::zeros(); h.links.len()],
@@ -303,18 +307,21 @@ impl HarnessStatics {
             let range = rod.segments[s].blocks.clone();
             let blocks = e.topo.blocks();
             let eb = &self.held[e.cable].ends[e.local];
+            let column = &mut self.column[e.cable];
             for col in 0..6 {
-                let z = &mut self.z[k][col];
-                for v in &mut z[range.clone()] {
+                for v in &mut column[range.clone()] {
                     v.fill(0.0);
                 }
                 for (i, &b) in blocks.iter().enumerate() {
                     let bk = cols_to_junction(&eb.ce[i], &e.rel);
                     if range.contains(&b) {
-                        z[b] += bk.column(col);
+                        column[b] += bk.column(col);
                     }
                 }
-                self.ws[e.cable].jac.solve_range(range.clone(), z);
+                self.ws[e.cable].jac.solve_range(range.clone(), column);
+                for (zb, v) in self.z[k][range.clone()].iter_mut().zip(&column[range.clone()]) {
+                    zb.set_column(col, v);
+                }
             }
         }
         // Schur complements: S_kl = −C_k A⁻¹ B_l for the ends k, l of one cable segment.
@@ -330,15 +337,8 @@ impl HarnessStatics {
                 if h.ends[l].segment != Some(s) {
                     continue;
                 }
-                let mut m = Matrix6::zeros();
-                for col in 0..6 {
-                    let z = &self.z[l][col];
-                    let mut v = Vector6::zeros();
-                    for i in 0..2 {
-                        v += ck[i] * z[blocks[i]];
-                    }
-                    m.set_column(col, &v);
-                }
+                let z = &self.z[l];
+                let m = ck[0] * z[blocks[0]] + ck[1] * z[blocks[1]];
                 if l == k {
                     self.pivot[e.junction] -= m;
                 } else if let Some(li) = h.links.iter().position(|x| x.end_a == k && x.end_b == l) {
@@ -452,14 +452,11 @@ impl HarnessStatics {
             let Some(s) = e.segment else { continue };
             let range = h.cables[e.cable].segments[s].blocks.clone();
             let d = dj[e.junction];
-            for col in 0..6 {
-                if d[col] == 0.0 {
-                    continue;
-                }
-                let z = &self.z[k][col];
-                for b in range.clone() {
-                    out[e.cable][b] -= z[b] * d[col];
-                }
+            if d == Vector6::zeros() {
+                continue;
+            }
+            for (o, z) in out[e.cable][range.clone()].iter_mut().zip(&self.z[k][range]) {
+                *o -= z * d;
             }
         }
         for v in out.iter() {

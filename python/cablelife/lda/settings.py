@@ -5,11 +5,12 @@ from __future__ import annotations
 
 from typing import Annotated, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, PositiveFloat, PositiveInt, ValidationError
+from pydantic import BaseModel, ConfigDict, Field, Strict, ValidationError
 
 from cablelife.lda.pipeline import DEFAULT_POINTS
 from cablelife.lda.planes import DEFAULT_PLANE_STEP_DEG
 from cablelife.lda.wohler import PSEUDO_K, WohlerCurve, pseudo_damage_curve
+from cablelife.scene_types import PositiveFloat, PositiveInt
 
 
 class LdaSettings(BaseModel):
@@ -21,11 +22,11 @@ class LdaSettings(BaseModel):
     wohler_alpha: PositiveFloat | None = None  # Pa^k; None: pseudo-damage curve
     knee_range: PositiveFloat | None = None  # Pa
     knee_kind: Literal["haibach", "cutoff"] = "haibach"
-    points: Annotated[int, Field(ge=4)] = DEFAULT_POINTS
-    plane_step: Annotated[float, Field(gt=0.0, le=90.0)] = DEFAULT_PLANE_STEP_DEG
+    points: Annotated[int, Strict(), Field(ge=4)] = DEFAULT_POINTS
+    plane_step: Annotated[float, Strict(), Field(gt=0.0, le=90.0)] = DEFAULT_PLANE_STEP_DEG
     section_step: PositiveInt = 1
     residue: Literal["half", "discard", "full", "repeated"] = "half"
-    hysteresis: Annotated[float, Field(ge=0.0)] = 0.0  # Pa
+    hysteresis: Annotated[float, Strict(), Field(ge=0.0)] = 0.0  # Pa
 
     @classmethod
     def from_options(cls, **options) -> LdaSettings:

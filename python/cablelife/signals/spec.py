@@ -13,6 +13,7 @@ from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, Strict, model_validator
 
+from cablelife.scene_types import NonNegativeFloat, PositiveFloat, Real
 from cablelife.signals.profiles import get_profile
 from cablelife.signals.psd import PowerLawPsd
 from cablelife.signals.units import (
@@ -28,10 +29,6 @@ Frame = Literal["global", "body"]
 TRANSLATIONS = ("x", "y", "z")
 ROTATIONS = ("rx", "ry", "rz")
 
-# Strict numbers: a TOML number is a number (ints are fine), booleans and strings are refused.
-Real = Annotated[float, Strict()]
-PositiveFloat = Annotated[float, Strict(), Field(gt=0)]
-NonNegativeFloat = Annotated[float, Strict(), Field(ge=0)]
 # Fades and sweep durations: at most 1e6 s (11 days; longer overflows the ramp polynomials).
 Seconds = Annotated[float, Strict(), Field(ge=0, le=1e6)]
 

@@ -6,10 +6,11 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Annotated, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, PositiveFloat, ValidationError, model_validator
+from pydantic import BaseModel, ConfigDict, Field, Strict, ValidationError, model_validator
 
 from cablelife.lda.settings import LdaSettings
-from cablelife.scene import Vec3, format_validation_errors
+from cablelife.scene import format_validation_errors
+from cablelife.scene_types import Flag, PositiveFloat, Real, Vec3
 from cablelife.tomlfile import read_toml
 
 ParameterName = Annotated[str, Field(min_length=1, pattern=r"^[A-Za-z_][A-Za-z0-9_\-]*$")]
@@ -25,7 +26,7 @@ class _Model(BaseModel):
 
 class _Parameter(_Model):
     name: ParameterName
-    values: list[float] = []  # the grid values (combine = "grid")
+    values: list[Real] = []  # the grid values (combine = "grid")
 
 
 class ClipPosition(_Parameter):
@@ -37,7 +38,7 @@ class ClipPosition(_Parameter):
     cable: str | None = None
     clip: str
     direction: Vec3 | None = None
-    slide: bool = False
+    slide: Flag = False
 
 
 class CableLength(_Parameter):
@@ -85,8 +86,8 @@ class VolumeSettings(_Model):
     """Motion volume per variant (its size goes into the summary); voxel 0 switches it off.
     At most ``max_steps`` saved steps are swept (every k-th step of longer runs)."""
 
-    voxel: Annotated[float, Field(ge=0.0)] = 0.004  # m
-    max_steps: Annotated[int, Field(ge=1)] = 1000
+    voxel: Annotated[float, Strict(), Field(ge=0.0)] = 0.004  # m
+    max_steps: Annotated[int, Strict(), Field(ge=1)] = 1000
 
 
 class StudySettings(_Model):
@@ -95,7 +96,7 @@ class StudySettings(_Model):
     mode: Literal["static", "quasistatic", "dynamic"] | None = None  # default: the scene's
     duration: PositiveFloat | None = None  # s, overrides simulation.duration
     combine: Literal["grid", "list"] = "grid"
-    threads: Annotated[int, Field(ge=1)] = 1  # threads per variant (LDA kernels)
+    threads: Annotated[int, Strict(), Field(ge=1)] = 1  # threads per variant (LDA kernels)
 
 
 class StudyFile(_Model):
@@ -105,7 +106,7 @@ class StudyFile(_Model):
     lda: LdaSettings = LdaSettings()
     volume: VolumeSettings = VolumeSettings()
     parameters: Annotated[list[Parameter], Field(min_length=1)]
-    variants: list[dict[str, float | str]] = []
+    variants: list[dict[str, Real | str]] = []
 
     @model_validator(mode="after")
     def _check(self) -> StudyFile:

@@ -11,31 +11,27 @@ import math
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
-from pydantic import (
-    BaseModel,
-    ConfigDict,
-    Discriminator,
-    Field,
-    NonNegativeFloat,
-    PositiveFloat,
-    Tag,
-    field_validator,
-)
+from pydantic import BaseModel, ConfigDict, Discriminator, Field, Tag, field_validator
 
-Vec3 = tuple[float, float, float]
+from cablelife.scene_types import Coordinate, Direction, Friction, Point, Vec3, bounded
+
+Extent = bounded("extent")  # m, sizes of primitives
 
 
 class _Part(BaseModel):
     model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
 
     name: Annotated[str, Field(min_length=1)] | None = None
-    friction: NonNegativeFloat | None = None  # Coulomb μ of contact with this part
+    friction: Friction | None = None  # Coulomb μ of contact with this part
     frame: Literal["global", "body"] = "global"
 
 
 def _nonzero(v: Vec3, what: str) -> Vec3:
-    if math.hypot(*v) == 0:
-        raise ValueError(f"{what} must not be the zero vector")
+    if math.hypot(*v) < 1e-9:
+        raise ValueError(
+            f"{what} must not be the zero vector; allowed: a length of at least 1e-9 (its "
+            "length does not matter otherwise)"
+        )
     return v
 
 
@@ -43,7 +39,7 @@ class MeshPart(_Part):
     """A triangle mesh file (STL ascii or binary, OBJ, PLY), path relative to the scene."""
 
     mesh: Annotated[str, Field(min_length=1)]
-    scale: PositiveFloat | None = None  # file units → m (0.001 for millimetres); default 1
+    scale: bounded("mesh_scale") | None = None  # file units → m (0.001 for millimetres); default 1
 
     @field_validator("mesh")
     @classmethod
@@ -62,8 +58,8 @@ class PlanePart(_Part):
     """The half-space below a plane (``normal`` points out of the solid)."""
 
     shape: Literal["plane"]
-    point: Vec3
-    normal: Vec3
+    point: Point
+    normal: Direction
 
     @field_validator("normal")
     @classmethod
@@ -76,8 +72,8 @@ class BoxPart(_Part):
     as for bodies: R = Rz Ry Rx (rotations about the global axes, x first)."""
 
     shape: Literal["box"]
-    center: Vec3
-    size: tuple[PositiveFloat, PositiveFloat, PositiveFloat]
+    center: Point
+    size: tuple[Extent, Extent, Extent]
     orientation: Vec3 = (0.0, 0.0, 0.0)
 
 
@@ -85,10 +81,10 @@ class CylinderPart(_Part):
     """A solid cylinder with flat ends: centre, axis direction, radius, length."""
 
     shape: Literal["cylinder"]
-    center: Vec3
-    axis: Vec3
-    radius: PositiveFloat
-    length: PositiveFloat
+    center: Point
+    axis: Direction
+    radius: Extent
+    length: Extent
 
     @field_validator("axis")
     @classmethod
@@ -98,8 +94,8 @@ class CylinderPart(_Part):
 
 class SpherePart(_Part):
     shape: Literal["sphere"]
-    center: Vec3
-    radius: PositiveFloat
+    center: Point
+    radius: Extent
 
 
 def _kind(v: Any) -> str | None:
@@ -134,7 +130,7 @@ class ClearanceSettings(BaseModel):
 
     model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
 
-    min_clearance: NonNegativeFloat = 0.0  # m
+    min_clearance: Annotated[Coordinate, Field(ge=0.0)] = 0.0  # m
 
 
 def part_label(body: str, index: int, part: _Part) -> str:
