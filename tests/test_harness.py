@@ -129,6 +129,12 @@ def test_quasistatic_harness_follows_a_moving_clip():
             "loop",
         ),
         (lambda s: [c["clips"].clear() for c in s["cables"]], "held by no clip"),
+        (lambda s: s["junctions"][0].update(mass=1e12), r"mass.*less than or equal to 1000"),
+        (
+            lambda s: s["junctions"][0].update(rotary_inertia=1e-300),
+            r"rotary_inertia = 1e-300 kg m²; allowed: 0 \(none\) or 1e-12 … 100",
+        ),
+        (lambda s: s["junctions"][0].update(rotary_inertia=1e12), "allowed: 0"),
     ],
 )
 def test_bad_junctions_are_named(change, message):

@@ -32,6 +32,11 @@ LIMITS: dict[str, tuple[float, float]] = {
     "contact_length": (0.0, 1.0),  # m, barrier distance d̂ and stick distance (0: default)
     "contact_stiffness": (0.0, 1e15),  # N/m², barrier stiffness κ (0: automatic)
     "stick_velocity": (1e-9, 1e3),  # m/s, stick zone of dynamic friction
+    "junction_mass": (0.0, 1e3),  # kg, tape or connector of a junction
+    # kg m², a junction's rotary inertia: 0 (none) or within this range (a tape of 1 g at
+    # 1 mm is 1e-9; below 1e-12 the inertia is rounding noise next to the branches' stiffness
+    # and turned a dynamic step's matrix singular, measured)
+    "junction_inertia": (1e-12, 1e2),
 }
 
 # Segments of one cable. Fewer than MIN_SEGMENTS cannot represent a cable bent between two

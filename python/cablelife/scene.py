@@ -450,9 +450,17 @@ class Junction(_Model):
     position: Point  # m
     directions: list[Direction]
     normals: list[Direction] | None = None
-    mass: NonNegativeFloat = 0.0  # kg
-    rotary_inertia: NonNegativeFloat = 0.0  # kg m², about each axis
+    mass: bounded("junction_mass") = 0.0  # kg
+    rotary_inertia: NonNegativeFloat = 0.0  # kg m², about each axis: 0 or LIMITS' range
     clip: JunctionClip | None = None  # a clip holding the junction (default: free)
+
+    @field_validator("rotary_inertia")
+    @classmethod
+    def _inertia(cls, v):
+        lo, hi = LIMITS["junction_inertia"]
+        if v != 0.0 and not lo <= v <= hi:
+            raise ValueError(f"rotary_inertia = {v:g} kg m²; allowed: 0 (none) or {lo:g} … {hi:g}")
+        return v
 
     @model_validator(mode="after")
     def _ends(self):

@@ -20,7 +20,7 @@ use crate::block_tridiag::BlockTridiag;
 use crate::contact::Contact;
 use crate::model::{EdgeKind, NodeKind, Pose, Rod, Segment};
 use crate::rotation::{log_vec, right_jacobian, rotate_body, rotation_matrix, skew, slerp, Quat};
-use crate::sliding::SlidingClips;
+use crate::sliding::{SlidingClips, STICK_TOLERANCE};
 use crate::state::State;
 use crate::statics::SolveError;
 use nalgebra::{Matrix3, Vector3, Vector6};
@@ -472,7 +472,7 @@ impl Dynamics {
         self.outputs_current = false;
         self.obstacles_moved = false;
         if let Some(s) = &mut self.sliding {
-            s.begin_step(rod, st, Some(h));
+            s.begin_step(rod, st, Some((h, clips)));
         }
         if let Some(c) = &mut self.contact {
             c.begin_step(&st.x, Some(h));
@@ -643,6 +643,7 @@ impl Dynamics {
         let mut budget = self.opts.max_iterations;
         let mut next = 0;
         let mut strikes = 0;
+        let friction = self.sliding.as_ref().is_some_and(|s| s.has_friction(rod));
         while next < budget {
             let it = next;
             next += 1;
@@ -671,7 +672,13 @@ impl Dynamics {
             if refactor && norm >= last_fresh_norm {
                 strikes += 1;
             }
-            let allowed = if self.contact.is_some() { 3 } else { 1 };
+            // So is the path through a frictional guide's stick zone (a fresh matrix at an
+            // iterate inside it sees the stick spring: a larger correction, then convergence).
+            let allowed = if self.contact.is_some() || friction {
+                3
+            } else {
+                1
+            };
             if !norm.is_finite() || strikes >= allowed {
                 // … unless the correction that led to the current iterate was already below
                 // `STALL_TOLERANCE` of the step's increment (the former fixed tolerance): the
@@ -732,6 +739,28 @@ impl Dynamics {
                 }
                 None => 1.0,
             };
+            // Frictional guides: no node jumps across the friction's stick zone, and one stopped
+            // in it needs a fresh matrix (the stick spring; a stale one from the slip side sends
+            // it back: a cycle, measured).
+            let alpha = match self.sliding.as_ref().filter(|_| friction) {
+                Some(s) => {
+                    let kx = h * self.k_dq * c_mass;
+                    let (delta, half) = (&self.delta, &self.inertial_half);
+                    let dx = |n: usize| {
+                        if half[n][0] {
+                            kx * delta[n].fixed_rows::<3>(0).into_owned()
+                        } else {
+                            Vector3::zeros()
+                        }
+                    };
+                    let bound = s.step_bound(rod, st, Some(&self.rates), dx, seg.blocks.clone());
+                    if bound < 1.0 {
+                        self.factors[k].valid = false;
+                    }
+                    alpha.min(bound)
+                }
+                None => alpha,
+            };
             if alpha < 1.0 {
                 for d in &mut self.delta[seg.blocks.clone()] {
                     *d *= alpha;
@@ -759,6 +788,10 @@ impl Dynamics {
             // The tighter tolerance while samples are inside the contact barrier.
             if self.contact.as_ref().is_some_and(|c| c.active > 0) {
                 tolerance = tolerance.min((tight * scale).max(self.opts.abs_tolerance));
+            }
+            // Frictional guides: a correction small against the stick width.
+            if let Some(s) = self.sliding.as_ref().filter(|_| friction) {
+                tolerance = tolerance.min(STICK_TOLERANCE * s.stick_width() / l);
             }
             if alpha == 1.0 && norm < tolerance {
                 stats.residual = self

@@ -22,6 +22,7 @@ use crate::harness::{Harness, HarnessError, HarnessState, HarnessStatics};
 use crate::harness_solver::vec_to_junction;
 use crate::model::Pose;
 use crate::rotation::{log_vec, right_jacobian, rotate_body, rotation_matrix, skew};
+use crate::sliding::STICK_TOLERANCE;
 use crate::statics::{NewtonOptions, SolveError};
 use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 
@@ -623,6 +624,12 @@ impl HarnessDynamics {
         // With contact, the single cable's rules (`Dynamics::solve_segment`): iterations whose
         // correction the barrier shortened do not count (up to 4× the limit), three strikes.
         let contact = self.has_contact();
+        // Frictional guides, too (`Dynamics::solve_segment`).
+        let friction = h
+            .cables
+            .iter()
+            .zip(&self.cables)
+            .any(|(rod, dy)| dy.sliding.as_ref().is_some_and(|s| s.has_friction(rod)));
         let mut budget = self.opts.max_iterations;
         let mut strikes = 0;
         let mut next = 0;
@@ -646,7 +653,7 @@ impl HarnessDynamics {
             if refactor && norm >= last_fresh_norm {
                 strikes += 1;
             }
-            if !norm.is_finite() || strikes >= if contact { 3 } else { 1 } {
+            if !norm.is_finite() || strikes >= if contact || friction { 3 } else { 1 } {
                 // Diverging; the iterate is kept when the correction that led to it was
                 // below `STALL_TOLERANCE` of the step's increment (as `Dynamics`).
                 let touching = contact && self.contact_active();
@@ -661,12 +668,17 @@ impl HarnessDynamics {
             if refactor {
                 last_fresh_norm = norm;
             }
-            // Contact: no cable dives through its barrier (the correction is shortened).
-            let alpha = if contact {
-                self.contact_alpha(h, st, dt, c_mass)
+            // Contact: no cable dives through its barrier (the correction is shortened); no
+            // node jumps across a frictional guide's stick zone, and one stopped in it needs a
+            // fresh matrix (the stick spring; a stale one from the slip side sends it back).
+            let (alpha, stick) = if contact || friction {
+                self.correction_alpha(h, st, dt, c_mass)
             } else {
-                1.0
+                (1.0, false)
             };
+            if stick {
+                self.factor_valid = false;
+            }
             if alpha < 1.0 {
                 last_fresh_norm = f64::INFINITY;
                 budget = (budget + 1).min(4 * self.opts.max_iterations);
@@ -687,6 +699,12 @@ impl HarnessDynamics {
             if active {
                 let tight = self.opts.contact_tolerance * scale;
                 tolerance = tolerance.min(tight.max(self.opts.abs_tolerance));
+            }
+            // Frictional guides: a correction small against the stick width (`Dynamics`).
+            for (rod, dy) in h.cables.iter().zip(&self.cables) {
+                if let Some(s) = dy.sliding.as_ref().filter(|s| s.has_friction(rod)) {
+                    tolerance = tolerance.min(STICK_TOLERANCE * s.stick_width() / rod.spec.length);
+                }
             }
             if alpha == 1.0 && norm < tolerance {
                 converged = true;

@@ -42,20 +42,24 @@ impl HarnessDynamics {
     }
 
     /// The largest α ≤ 1 such that the Newton correction in the tree's `delta` and `dj`,
-    /// scaled by α, dives through no cable's barrier. A node moves by h k_dq c_mass δx (v̇ +=
+    /// scaled by α, dives through no cable's barrier and carries no node across a frictional
+    /// guide's stick zone (`SlidingClips::step_bound`). A node moves by h k_dq c_mass δx (v̇ +=
     /// c_mass δx, x = x_n + h(dq0 + k_dq v̇)), a joined end's node with its junction alike.
-    pub(crate) fn contact_alpha(
+    /// With it: whether a guide's bound cut the correction (a node stops inside its stick
+    /// zone).
+    pub(crate) fn correction_alpha(
         &self,
         h: &Harness,
         st: &HarnessState,
         dt: f64,
         c_mass: f64,
-    ) -> f64 {
-        let mut alpha = 1.0f64;
+    ) -> (f64, bool) {
+        let (mut alpha, mut stick) = (1.0f64, false);
         for (c, dy) in self.cables.iter().enumerate() {
-            let Some(contact) = &dy.contact else {
+            let guide = dy.sliding.as_ref().filter(|s| s.has_friction(&h.cables[c]));
+            if dy.contact.is_none() && guide.is_none() {
                 continue;
-            };
+            }
             let kx = dt * dy.k_dq * c_mass;
             let (delta, dj, inertial) = (&self.tree.delta[c], &self.tree.dj, &dy.inertial);
             let dx = |n: usize| {
@@ -70,10 +74,19 @@ impl HarnessDynamics {
                 }
                 Vector3::zeros()
             };
-            let edges = 0..h.cables[c].n_edges();
-            alpha = alpha.min(contact.step_bound(&st.cables[c].x, dx, edges));
+            if let Some(contact) = &dy.contact {
+                let edges = 0..h.cables[c].n_edges();
+                alpha = alpha.min(contact.step_bound(&st.cables[c].x, dx, edges));
+            }
+            if let Some(guide) = guide {
+                let nodes = 0..h.cables[c].arc.len();
+                let rod = &h.cables[c];
+                let bound = guide.step_bound(rod, &st.cables[c], Some(&dy.rates), dx, nodes);
+                stick |= bound < 1.0;
+                alpha = alpha.min(bound);
+            }
         }
-        alpha
+        (alpha, stick)
     }
 
     /// Shortens the predictor (from t_n) of every cable and junction by one factor so that no

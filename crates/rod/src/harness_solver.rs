@@ -319,7 +319,10 @@ impl HarnessStatics {
                     }
                 }
                 self.ws[e.cable].jac.solve_range(range.clone(), column);
-                for (zb, v) in self.z[k][range.clone()].iter_mut().zip(&column[range.clone()]) {
+                for (zb, v) in self.z[k][range.clone()]
+                    .iter_mut()
+                    .zip(&column[range.clone()])
+                {
                     zb.set_column(col, v);
                 }
             }
@@ -455,7 +458,10 @@ impl HarnessStatics {
             if d == Vector6::zeros() {
                 continue;
             }
-            for (o, z) in out[e.cable][range.clone()].iter_mut().zip(&self.z[k][range]) {
+            for (o, z) in out[e.cable][range.clone()]
+                .iter_mut()
+                .zip(&self.z[k][range])
+            {
                 *o -= z * d;
             }
         }
