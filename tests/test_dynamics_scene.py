@@ -10,7 +10,7 @@ import warnings
 import numpy as np
 import pytest
 from cablelife.modal import cable_modes, retardation_times
-from cablelife.scene import scene_from_dict
+from cablelife.scene import SceneError, scene_from_dict
 from cablelife.simulate import simulate
 from decay import free_decay
 
@@ -243,3 +243,34 @@ def test_default_damping_is_held_for_a_first_mode_hardly_bending(scene_dict):
     scene = scene_from_dict(scene_dict)
     hints = run_hints(scene, simulate(scene))
     assert any(f"only {100 * share:.0f} % bending" in h for h in hints), hints
+
+
+def test_a_clip_turning_faster_than_the_step_can_follow_is_a_scene_error(scene_dict):
+    # A rotation amplitude given in degrees where radians are meant (30 → 30 rad at 20 Hz:
+    # 3.8 rad per 1 ms step) fails with the clip, the turn and the allowed bound instead of a
+    # Newton failure at the first step; the same amplitude in radians runs.
+    d = copy.deepcopy(scene_dict)
+    d["simulation"].update(mode="dynamic", duration=0.02, time_step=1e-3)
+    sine = {"type": "sine", "amplitude": 30.0, "frequency": 20.0, "fade_in": 0.01}
+    d["bodies"] = [
+        {"name": "arm", "origin": [0.8, 0.2, 0.0], "motion": [{"channel": "rz", "signal": sine}]}
+    ]
+    d["cables"][0]["clips"][1]["body"] = "arm"
+    with pytest.raises(
+        SceneError,
+        match=r"clip 'b' \(body 'arm'\): the body motion turns the clip by \d\.\d+ rad within "
+        r"one time step .*allowed: at most 1 rad per step",
+    ):
+        simulate(scene_from_dict(d))
+    sine["amplitude"] = 30.0 * np.pi / 180.0
+    assert simulate(scene_from_dict(d)).complete
+    # a harness run checks its clips too
+    from test_harness import y_scene
+
+    y = y_scene()
+    y["simulation"] = {"mode": "dynamic", "duration": 0.02, "time_step": 1e-3}
+    y["bodies"] = y.get("bodies", []) + d["bodies"]
+    sine["amplitude"] = 30.0
+    y["cables"][1]["clips"][-1]["body"] = "arm"
+    with pytest.raises(SceneError, match=r"the body motion turns the clip by"):
+        simulate(scene_from_dict(y))

@@ -222,6 +222,7 @@ def run_harness(scene: Scene, times: np.ndarray, mode: str, progress, stop):
         _stability_info,
         body_motions,
         build_cable,
+        check_turn_per_step,
         clip_kinematics,
         output_every,
     )
@@ -256,6 +257,8 @@ def run_harness(scene: Scene, times: np.ndarray, mode: str, progress, stop):
     if mode == "dynamic":
         from cablelife.modal import mode1_bending_damping, retardation_times, uses_mode1
 
+        for c, k in zip(cables, kin, strict=True):
+            check_turn_per_step(c, k, scene.simulation.time_step)
         every = output_every(scene)
         # Default bending damping calibrated on mode 1 of the whole harness (docs/harness.md).
         mode1 = None

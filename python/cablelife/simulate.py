@@ -207,6 +207,28 @@ def _check_clip_motion(cable: Cable, times: np.ndarray, kin: dict[str, np.ndarra
             )
 
 
+# A dynamic step cannot follow a clip that turns by more than this within it (rad): the
+# generalised-α step linearises the rotation over the step.
+MAX_TURN_PER_STEP = 1.0
+
+
+def check_turn_per_step(cable: Cable, kin: dict[str, np.ndarray], time_step: float) -> None:
+    """A dynamic run's clips turn by at most ``MAX_TURN_PER_STEP`` per time step (a rotation
+    amplitude in degrees given as radians, or a runaway signal, fails here with names instead
+    of as a Newton failure at the first step)."""
+    turn = np.linalg.norm(kin["angular_velocities"], axis=-1) * time_step  # (T, C)
+    if turn.size and turn.max() > MAX_TURN_PER_STEP:
+        t, j = np.unravel_index(np.argmax(turn), turn.shape)
+        clip = cable.clips[j]
+        raise SceneError(
+            f"cable '{cable.name}', clip '{clip.name}' (body '{clip.body}'): the body motion "
+            f"turns the clip by {turn[t, j]:.3g} rad within one time step (angular velocity "
+            f"{turn[t, j] / time_step:.3g} rad/s at step {t}, time_step = {time_step:g} s); "
+            f"allowed: at most {MAX_TURN_PER_STEP:g} rad per step, which a dynamic run can follow "
+            "(check the rotation amplitude and its unit — radians — or reduce time_step)"
+        )
+
+
 def clip_poses(
     scene: Scene, cable: Cable, times: np.ndarray, with_motion: bool = True
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -327,6 +349,7 @@ def _run_cable(
             tau_shear, tau_bend, info = retardation_times(scene, cable)
             every = output_every(scene)
             kin = clip_kinematics(scene, cable, times)
+            check_turn_per_step(cable, kin, scene.simulation.time_step)
             _warn_moving_start(cable, kin)
             start = _time.perf_counter()
             out = core.run_dynamic(
