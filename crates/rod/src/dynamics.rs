@@ -705,18 +705,19 @@ impl Dynamics {
             if refactor {
                 last_fresh_norm = norm;
             }
+            // The correction's node displacements (v̇ += c_mass δ, x = x_n + h(dq0 + k_dq v̇)).
+            let kx = h * self.k_dq * c_mass;
+            let (delta, half) = (&self.delta, &self.inertial_half);
+            let dx = |n: usize| {
+                if half[n][0] {
+                    kx * delta[n].fixed_rows::<3>(0).into_owned()
+                } else {
+                    Vector3::zeros()
+                }
+            };
             // Contact: no dive through the barrier (the correction is shortened).
             let alpha = match &mut self.contact {
                 Some(c) => {
-                    let kx = h * self.k_dq * c_mass;
-                    let (delta, half) = (&self.delta, &self.inertial_half);
-                    let dx = |n: usize| {
-                        if half[n][0] {
-                            kx * delta[n].fixed_rows::<3>(0).into_owned()
-                        } else {
-                            Vector3::zeros()
-                        }
-                    };
                     if self.opts.contact_line_search {
                         // The Newton decrement −Δxᵀ r in the position unit (J δ = −r, Δx = kx δ).
                         let rhs = &self.ws.rhs;
@@ -744,15 +745,6 @@ impl Dynamics {
             // it back: a cycle, measured).
             let alpha = match self.sliding.as_ref().filter(|_| friction) {
                 Some(s) => {
-                    let kx = h * self.k_dq * c_mass;
-                    let (delta, half) = (&self.delta, &self.inertial_half);
-                    let dx = |n: usize| {
-                        if half[n][0] {
-                            kx * delta[n].fixed_rows::<3>(0).into_owned()
-                        } else {
-                            Vector3::zeros()
-                        }
-                    };
                     let bound = s.step_bound(rod, st, Some(&self.rates), dx, seg.blocks.clone());
                     if bound < 1.0 {
                         self.factors[k].valid = false;

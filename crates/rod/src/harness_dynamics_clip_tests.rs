@@ -227,28 +227,7 @@ fn frictionless_guide_passes_the_tension_in_a_dynamic_run() {
 /// Largest |E − E₀| relative to the largest kinetic energy: the guided Y with gravity,
 /// undamped (ρ∞ = 1), frictionless, released from its straight routing.
 fn guided_drift(dt: f64) -> f64 {
-    let h = y_with_guide(20, 9.81, 0.0, 0.01, 1e-6);
-    let mut st = initial(&h);
-    let m: Vec<Vec<ClipMotion>> = st
-        .cables
-        .iter()
-        .map(|x| x.clip_pose.iter().map(at_rest).collect())
-        .collect();
-    let opts = DynamicOptions {
-        rho_inf: 1.0,
-        ..Default::default()
-    };
-    let mut hd = HarnessDynamics::new(&h, &st, &m, opts);
-    hd.start(&h, &mut st).unwrap();
-    let total = |e: &Energies| e.kinetic + e.elastic + e.load_potential;
-    let e0 = total(&hd.energies);
-    let (mut drift, mut kin) = (0.0f64, 0.0f64);
-    for _ in 0..(0.2 / dt).round() as usize {
-        hd.advance(&h, &mut st, dt, &m, &m, 4).unwrap();
-        drift = drift.max((total(&hd.energies) - e0).abs());
-        kin = kin.max(hd.energies.kinetic);
-    }
-    drift / kin
+    guided_balance(0.0, dt).0
 }
 
 #[test]
