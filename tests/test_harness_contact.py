@@ -378,3 +378,33 @@ def test_dynamic_harness_resting_on_a_tray_with_the_default_damping():
     c = res.cables["trunk"]
     assert c.solver["damping_source"] == "ratio" and c.solver["omega1"] > 0
     assert any((k.contact["contact_state"][-1] > 0).any() for k in res.cables.values())
+
+
+def test_a_trunk_in_a_frictional_guide_and_on_a_frictional_box_runs_at_1_ms():
+    # The example harness with its trunk guide at μ = 0.2, the trunk resting on a box with
+    # μ = 0.3 and the 'body' branch 400 times stiffer (E = 20 GPa): before, the step at
+    # t = 5 ms failed ("Newton did not converge": contact friction had no stick-zone bound,
+    # the corrections grew with fresh matrices), at every stiffness above ≈ 6 GPa.
+    import tomllib
+    from pathlib import Path
+
+    d = tomllib.loads((Path(__file__).parents[1] / "examples/harness/scene.toml").read_text())
+    d["simulation"].update(mode="dynamic", duration=0.03, time_step=1e-3)
+    motion = d["bodies"][0]["motion"]
+    motion[:] = [m for m in motion if m["signal"]["type"] != "psd"]  # needs ≥ 0.2 s
+    d["bodies"].append(
+        {
+            "name": "car-body",
+            "geometry": [
+                {"shape": "box", "center": [0.3, 0.0, -0.03], "size": [0.05, 0.05, 0.02]},
+            ],
+        }
+    )
+    d["contact"] = {"enabled": True, "friction": 0.3}
+    d["cables"][0]["clips"][1]["friction"] = 0.2
+    d["cables"][3]["material"]["youngs_modulus"] = 2e10
+    result = simulate(scene_from_dict(d))
+    assert result.complete, result.message
+    trunk = result.cables["trunk"]
+    assert (trunk.contact["contact_state"] > 0).any()  # it rests on the box
+    assert np.isfinite(trunk.positions).all()
