@@ -48,6 +48,7 @@ from cablelife.scene_types import (
     Time,
     Vec3,
     bounded,
+    check_nonzero,
 )
 from cablelife.sections import SectionProperties, from_material, from_measured
 from cablelife.signals.spec import ChannelMotion, TableSignal
@@ -157,12 +158,7 @@ class Clip(_Model):
     @field_validator("direction", "normal", "axis")
     @classmethod
     def _nonzero(cls, v, info):
-        if v is not None and math.hypot(*v) < 1e-9:
-            raise ValueError(
-                f"{info.field_name} must not be the zero vector; allowed: a length of at least "
-                "1e-9 (its length does not matter otherwise)"
-            )
-        return v
+        return check_nonzero(v, info.field_name)
 
     @model_validator(mode="after")
     def _normal(self):
@@ -481,8 +477,7 @@ class Junction(_Model):
                 f"{len(self.normals)} normals for {len(self.ends)} ends; give one per end or none"
             )
         for i, d in enumerate(self.directions):
-            if math.hypot(*d) < 1e-9:
-                raise ValueError(f"directions[{i}] must not be the zero vector")
+            check_nonzero(d, f"directions[{i}]")
             if self.normals is not None:
                 dd = np.array(d) / np.linalg.norm(d)
                 n = np.array(self.normals[i])

@@ -8,6 +8,7 @@ is not 1, ``enabled = "yes"`` is not true).
 
 from __future__ import annotations
 
+import math
 from typing import Annotated
 
 from pydantic import AfterValidator, Field, Strict
@@ -43,6 +44,18 @@ Moment = bounded("moment")  # N m
 Component = bounded("direction")  # 1
 Direction = tuple[Component, Component, Component]
 Time = bounded("time")  # s
+
+
+def check_nonzero(v, what: str):
+    """A direction-like vector of length at least 1e-9 (its length does not matter otherwise)."""
+    if v is not None and math.hypot(*v) < 1e-9:
+        raise ValueError(
+            f"{what} must not be the zero vector; allowed: a length of at least 1e-9 (its "
+            "length does not matter otherwise)"
+        )
+    return v
+
+
 Friction = bounded("friction")  # 1, Coulomb μ
 # Cable, clip and body names: HDF5 group names and table entries (limits.check_name).
 Name = Annotated[str, Strict(), Field(min_length=1), AfterValidator(check_name)]

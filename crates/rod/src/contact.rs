@@ -18,6 +18,7 @@
 //! non-symmetric). Contact with a rigid obstacle couples only the two nodes of an edge: the
 //! block-tridiagonal structure stays.
 use crate::assembly::{Eval, KinkAt, Part, Term, Workspace};
+use crate::friction::{f1_over, stick_cut};
 use crate::model::{NodeKind, Pose, Rod};
 use crate::rotation::rotation_matrix;
 use crate::state::State;
@@ -459,12 +460,7 @@ pub fn sample_terms(
         let wt = u - un * n;
         let s = wt.norm();
         slip_ratio = s / eps;
-        // φ₁(s) = f₁(s)/s and φ₁'(s).
-        let (phi, dphi) = if s < eps {
-            (2.0 / eps - s / (eps * eps), -1.0 / (eps * eps))
-        } else {
-            (1.0 / s, -1.0 / (s * s))
-        };
+        let (phi, dphi) = f1_over(s, eps);
         friction_grad = mu * lambda * phi * wt;
         friction_work = friction_grad.dot(&u);
         if want_jac {
@@ -875,11 +871,8 @@ impl Contact {
     }
 
     /// `alpha` lowered so that a sample with slip `u` and displacement `d` (normal `normal`) is
-    /// not carried from slipping one way to slipping the other (its tangential slip passing by
-    /// the stick zone, |u_T| > ε before and after): it stops where its slip comes nearest to
-    /// zero. Outside the stick zone the friction is a force of constant size, so Newton does
-    /// not see the stick spring it jumps over (as the sliding clips' guides,
-    /// `SlidingClips::step_bound`). Measured: a harness whose trunk lies in a frictional guide
+    /// not carried across its stick zone by its tangential parts (`friction::stick_cut`, as
+    /// the sliding clips' guides). Measured: a harness whose trunk lies in a frictional guide
     /// and on a box with friction, with a branch stiffer than 6 GPa, stopped at step 5–6 at
     /// 1 ms ("Newton did not converge"); with this bound it runs. In `step_bound` (harnesses,
     /// and single cables without the line search) only: in the line search it cost the contact
@@ -895,15 +888,13 @@ impl Contact {
     ) -> f64 {
         let ut = u - normal.dot(&u) * normal;
         let dt = d - normal.dot(&d) * normal;
-        let next = ut + alpha * dt;
-        if ut.norm_squared() > self.eps * self.eps
-            && next.norm_squared() > self.eps * self.eps
-            && ut.dot(&next) < 0.0
-        {
-            alpha.min(-ut.dot(&dt) / dt.norm_squared())
-        } else {
-            alpha
-        }
+        stick_cut(
+            ut.norm_squared(),
+            ut.dot(&dt),
+            dt.norm_squared(),
+            self.eps,
+            alpha,
+        )
     }
 
     /// Calls `f(t, gap, normal)` for the samples of edge e against obstacle k at the positions

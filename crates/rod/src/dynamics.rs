@@ -643,7 +643,7 @@ impl Dynamics {
         let mut budget = self.opts.max_iterations;
         let mut next = 0;
         let mut strikes = 0;
-        let friction = self.sliding.as_ref().is_some_and(|s| s.has_friction(rod));
+        let friction = SlidingClips::frictional(&self.sliding).is_some();
         while next < budget {
             let it = next;
             next += 1;
@@ -743,7 +743,7 @@ impl Dynamics {
             // Frictional guides: no node jumps across the friction's stick zone, and one stopped
             // in it needs a fresh matrix (the stick spring; a stale one from the slip side sends
             // it back: a cycle, measured).
-            let alpha = match self.sliding.as_ref().filter(|_| friction) {
+            let alpha = match SlidingClips::frictional(&self.sliding) {
                 Some(s) => {
                     let bound = s.step_bound(rod, st, Some(&self.rates), dx, seg.blocks.clone());
                     if bound < 1.0 {
@@ -782,7 +782,7 @@ impl Dynamics {
                 tolerance = tolerance.min((tight * scale).max(self.opts.abs_tolerance));
             }
             // Frictional guides: a correction small against the stick width.
-            if let Some(s) = self.sliding.as_ref().filter(|_| friction) {
+            if let Some(s) = SlidingClips::frictional(&self.sliding) {
                 tolerance = tolerance.min(STICK_TOLERANCE * s.stick_width() / l);
             }
             if alpha == 1.0 && norm < tolerance {

@@ -22,7 +22,7 @@ use crate::harness::{Harness, HarnessError, HarnessState, HarnessStatics};
 use crate::harness_solver::vec_to_junction;
 use crate::model::Pose;
 use crate::rotation::{log_vec, right_jacobian, rotate_body, rotation_matrix, skew};
-use crate::sliding::STICK_TOLERANCE;
+use crate::sliding::{SlidingClips, STICK_TOLERANCE};
 use crate::statics::{NewtonOptions, SolveError};
 use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 
@@ -625,11 +625,10 @@ impl HarnessDynamics {
         // correction the barrier shortened do not count (up to 4× the limit), three strikes.
         let contact = self.has_contact();
         // Frictional guides, too (`Dynamics::solve_segment`).
-        let friction = h
+        let friction = self
             .cables
             .iter()
-            .zip(&self.cables)
-            .any(|(rod, dy)| dy.sliding.as_ref().is_some_and(|s| s.has_friction(rod)));
+            .any(|dy| SlidingClips::frictional(&dy.sliding).is_some());
         let mut budget = self.opts.max_iterations;
         let mut strikes = 0;
         let mut next = 0;
@@ -702,7 +701,7 @@ impl HarnessDynamics {
             }
             // Frictional guides: a correction small against the stick width (`Dynamics`).
             for (rod, dy) in h.cables.iter().zip(&self.cables) {
-                if let Some(s) = dy.sliding.as_ref().filter(|s| s.has_friction(rod)) {
+                if let Some(s) = SlidingClips::frictional(&dy.sliding) {
                     tolerance = tolerance.min(STICK_TOLERANCE * s.stick_width() / rod.spec.length);
                 }
             }

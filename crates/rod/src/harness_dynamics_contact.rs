@@ -12,6 +12,7 @@ use crate::dynamics::Energies;
 use crate::harness::{Harness, HarnessError, HarnessState};
 use crate::model::Pose;
 use crate::rotation::log_vec;
+use crate::sliding::SlidingClips;
 use nalgebra::Vector3;
 
 /// A clip's (or held junction's) reaction force and moment on the harness and its pose.
@@ -56,7 +57,7 @@ impl HarnessDynamics {
     ) -> (f64, bool) {
         let (mut alpha, mut stick) = (1.0f64, false);
         for (c, dy) in self.cables.iter().enumerate() {
-            let guide = dy.sliding.as_ref().filter(|s| s.has_friction(&h.cables[c]));
+            let guide = SlidingClips::frictional(&dy.sliding);
             if dy.contact.is_none() && guide.is_none() {
                 continue;
             }

@@ -11,6 +11,7 @@ pub mod dynamics;
 mod escape;
 #[cfg(test)]
 mod fd_check;
+pub mod friction;
 pub mod harness;
 pub mod harness_contact;
 pub mod harness_dynamics;

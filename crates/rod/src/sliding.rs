@@ -23,6 +23,7 @@
 //! (`off_end`); the solvers then fail naming the clip.
 use crate::assembly::{Eval, KinkAt, Part, Rates, Term, Workspace};
 use crate::dynamics::ClipMotion;
+use crate::friction::{f1_over, stick_cut};
 use crate::model::{ClipKind, NodeKind, Rod};
 use crate::rotation::rotation_matrix;
 use crate::state::State;
@@ -42,22 +43,15 @@ pub const HOLD_FACTOR: f64 = 100.0;
 /// they agree with those tight runs, in 3–5 iterations per step.
 pub const STICK_TOLERANCE: f64 = 0.1;
 
-/// φ(a) = f₁(a)/a and φ′(a) of the regularised friction with stick width ε (f₁(a) = 2a/ε −
-/// a²/ε² below ε, 1 beyond).
-#[inline]
-fn f1_over(a: f64, eps: f64) -> (f64, f64) {
-    if a < eps {
-        (2.0 / eps - a / (eps * eps), -1.0 / (eps * eps))
-    } else {
-        (1.0 / a, -1.0 / (a * a))
-    }
-}
-
 /// The sliding clips of a cable: a term of the assembly.
 #[derive(Clone, Debug)]
 pub struct SlidingClips {
     /// Clip indices of the sliding clips.
     pub clips: Vec<usize>,
+    /// Per sliding clip: its Coulomb friction coefficient μ.
+    mu: Vec<f64>,
+    /// Nodes of the cable (the row length of `z_ref` and `n_ref`).
+    n_nodes: usize,
     /// Per sliding clip: material coordinate σ of the cable at the clip centre (NaN: the cable
     /// does not cross the clip's plane), from the last full assembly.
     pub sigma: Vec<f64>,
@@ -121,6 +115,14 @@ impl SlidingClips {
             normal_force: vec![0.0; clips.len()],
             friction_force: vec![0.0; clips.len()],
             friction_normal: vec![0.0; clips.len()],
+            mu: clips
+                .iter()
+                .map(|&c| match rod.spec.clips[c].kind {
+                    ClipKind::Sliding { friction } => friction,
+                    _ => 0.0,
+                })
+                .collect(),
+            n_nodes: rod.arc.len(),
             z_ref: vec![f64::NAN; clips.len() * rod.arc.len()],
             step_h: None,
             n_ref: vec![f64::NAN; clips.len() * rod.arc.len()],
@@ -141,17 +143,20 @@ impl SlidingClips {
     }
 
     /// Whether a sliding clip has friction.
-    pub fn has_friction(&self, rod: &Rod) -> bool {
-        self.clips.iter().any(
-            |&c| matches!(rod.spec.clips[c].kind, ClipKind::Sliding { friction } if friction > 0.0),
-        )
+    pub fn has_friction(&self) -> bool {
+        self.mu.iter().any(|&mu| mu > 0.0)
+    }
+
+    /// The term if one of its guides has friction.
+    pub fn frictional(guides: &Option<SlidingClips>) -> Option<&SlidingClips> {
+        guides.as_ref().filter(|s| s.has_friction())
     }
 
     /// Starts a step from the state `st`: the friction reference (each node's coordinate along
     /// each guide's line); `dynamic` the time step and the clips' kinematics at its end for a
     /// dynamic step (None: static, quasistatic).
     pub fn begin_step(&mut self, rod: &Rod, st: &State, dynamic: Option<(f64, &[ClipMotion])>) {
-        let n = rod.arc.len();
+        let n = self.n_nodes;
         for (k, &c) in self.clips.iter().enumerate() {
             let pose = &st.clip_pose[c];
             let t = rotation_matrix(&pose.orientation) * Vector3::z();
@@ -161,7 +166,8 @@ impl SlidingClips {
                 let d = x - pose.position;
                 let z = t.dot(&d);
                 self.z_ref[k * n + j] = z;
-                self.n_ref[k * n + j] = if dynamic.is_some() {
+                // (the lagged normal force only where friction uses it)
+                self.n_ref[k * n + j] = if dynamic.is_some() && self.mu[k] > 0.0 {
                     self.hold[j] * window(z, half, taper).0 * (d - z * t).norm()
                 } else {
                     f64::NAN
@@ -198,8 +204,7 @@ impl SlidingClips {
         d: &Vector3<f64>,
         rates: Option<&Rates>,
     ) -> Option<(f64, Vector3<f64>)> {
-        let nodes = self.z_ref.len() / self.clips.len(); // z_ref is row-major (clip, node)
-        let z_ref = self.z_ref[k * nodes + n];
+        let z_ref = self.z_ref[k * self.n_nodes + n];
         if !z_ref.is_finite() {
             return None;
         }
@@ -215,11 +220,9 @@ impl SlidingClips {
     }
 
     /// The largest fraction α ≤ 1 of a Newton correction (node displacements `dx` over the
-    /// blocks `nodes`) that carries no node in a frictional guide from slipping one way to
-    /// slipping the other way: such a node stops at zero slip, inside the stick zone. Outside
-    /// the zone the regularised friction is a constant force (its slip derivative is zero), so
-    /// Newton does not see the stick spring it jumps over and cycles across the zone (a
-    /// two-cycle of equal corrections, measured); from inside it the next iterate sees it.
+    /// blocks `nodes`) that carries no node in a frictional guide across its stick zone
+    /// (`friction::stick_cut`; without it Newton cycled in a two-cycle of equal corrections,
+    /// measured).
     pub fn step_bound(
         &self,
         rod: &Rod,
@@ -231,7 +234,7 @@ impl SlidingClips {
         let taper = 0.5 * rod.mean_ds();
         let mut alpha = 1.0f64;
         for (k, &c) in self.clips.iter().enumerate() {
-            if !matches!(rod.spec.clips[c].kind, ClipKind::Sliding { friction } if friction > 0.0) {
+            if self.mu[k] <= 0.0 {
                 continue;
             }
             let pose = &st.clip_pose[c];
@@ -249,10 +252,7 @@ impl SlidingClips {
                     continue;
                 };
                 let du = grad_u.dot(&dx(n));
-                let next = u + alpha * du;
-                if u.abs() > self.eps && next.abs() > self.eps && next * u < 0.0 {
-                    alpha = u.abs() / du.abs();
-                }
+                alpha = stick_cut(u * u, u * du, du * du, self.eps, alpha);
             }
         }
         alpha
@@ -341,10 +341,7 @@ impl Term for SlidingClips {
             let Some(sigma) = sigma else { continue };
             let span = half + taper + 2.0 * self.reach;
             let q_proj = Matrix3::identity() - t * t.transpose();
-            let mu = match rod.spec.clips[c].kind {
-                ClipKind::Sliding { friction } => friction,
-                _ => 0.0,
-            };
+            let mu = self.mu[k];
             let mut force = Vector3::zeros();
             let mut moment = Vector3::zeros();
             let (mut normal, mut axial, mut friction_normal) = (0.0, 0.0, 0.0);
@@ -382,7 +379,7 @@ impl Term for SlidingClips {
                     None
                 };
                 if let Some((u, grad_u)) = slip {
-                    let n_ref = self.n_ref[k * rod.arc.len() + n];
+                    let n_ref = self.n_ref[k * self.n_nodes + n];
                     let lagged = n_ref.is_finite();
                     let n_friction = if lagged { n_ref } else { nf };
                     let a = u.abs();

@@ -7,13 +7,20 @@ frame: origin and axes of the body at rest).
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Discriminator, Field, Tag, field_validator
 
-from cablelife.scene_types import Coordinate, Direction, Friction, Point, Vec3, bounded
+from cablelife.scene_types import (
+    Coordinate,
+    Direction,
+    Friction,
+    Point,
+    Vec3,
+    bounded,
+    check_nonzero,
+)
 
 Extent = bounded("extent")  # m, sizes of primitives
 
@@ -24,15 +31,6 @@ class _Part(BaseModel):
     name: Annotated[str, Field(min_length=1)] | None = None
     friction: Friction | None = None  # Coulomb μ of contact with this part
     frame: Literal["global", "body"] = "global"
-
-
-def _nonzero(v: Vec3, what: str) -> Vec3:
-    if math.hypot(*v) < 1e-9:
-        raise ValueError(
-            f"{what} must not be the zero vector; allowed: a length of at least 1e-9 (its "
-            "length does not matter otherwise)"
-        )
-    return v
 
 
 class MeshPart(_Part):
@@ -64,7 +62,7 @@ class PlanePart(_Part):
     @field_validator("normal")
     @classmethod
     def _n(cls, v):
-        return _nonzero(v, "normal")
+        return check_nonzero(v, "normal")
 
 
 class BoxPart(_Part):
@@ -89,7 +87,7 @@ class CylinderPart(_Part):
     @field_validator("axis")
     @classmethod
     def _a(cls, v):
-        return _nonzero(v, "axis")
+        return check_nonzero(v, "axis")
 
 
 class SpherePart(_Part):
