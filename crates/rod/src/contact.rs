@@ -1012,6 +1012,9 @@ impl Contact {
         if dmerit(feasible) <= 0.0 {
             return feasible;
         }
+        if feasible == 1.0 && dmerit(0.95) <= 0.0 {
+            return 1.0; // Newton's own step (near convergence ψ' vanishes near 1)
+        }
         let (mut lo, mut hi) = (0.0, feasible);
         for _ in 0..40 {
             let mid = 0.5 * (lo + hi);
@@ -1023,9 +1026,6 @@ impl Contact {
             if hi - lo < 1e-3 * feasible {
                 break;
             }
-        }
-        if feasible == 1.0 && lo > 0.95 {
-            return 1.0; // Newton's own step (near convergence ψ' vanishes near 1)
         }
         lo.max(1e-3 * feasible)
     }
