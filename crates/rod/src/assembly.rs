@@ -707,12 +707,27 @@ impl Workspace {
 
     /// Factors the Jacobian rows of a segment (see `factor`).
     pub fn factor_segment(&mut self, rod: &Rod, seg: &Segment) -> Result<(), SolveError> {
-        self.jac
-            .factor_range(seg.blocks.clone())
-            .map_err(|Singular { block }| SolveError::Singular {
-                node: block,
-                s: rod.arc[block.min(rod.arc.len() - 1)],
-            })
+        self.factor_segment_dir(rod, seg, false)
+    }
+
+    /// `factor_segment` eliminating towards the segment's first block with `rev`
+    /// (`BlockTridiag::factor_range_rev`).
+    pub fn factor_segment_dir(
+        &mut self,
+        rod: &Rod,
+        seg: &Segment,
+        rev: bool,
+    ) -> Result<(), SolveError> {
+        let blocks = seg.blocks.clone();
+        if rev {
+            self.jac.factor_range_rev(blocks)
+        } else {
+            self.jac.factor_range(blocks)
+        }
+        .map_err(|Singular { block }| SolveError::Singular {
+            node: block,
+            s: rod.arc[block.min(rod.arc.len() - 1)],
+        })
     }
 
     /// The Newton correction Δ = −J⁻¹ r with the current factorisation, and its largest

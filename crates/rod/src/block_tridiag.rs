@@ -121,16 +121,7 @@ impl BlockTridiag {
             if b > r.start {
                 d -= mul6(&self.lower[b], &self.elim[b - 1]);
             }
-            // Pivots are judged against their column of D_n before the elimination: a stiffness
-            // small against the others of the block (EI ≪ GA Δs²) is not a singularity, a
-            // pivot cancelled to round-off by the elimination (a free mode) is.
-            let mut scale = [0.0; 6];
-            for (k, c) in scale.iter_mut().enumerate() {
-                *c = self.diag[b].column(k).amax();
-            }
-            let (piv, inv_diag) = lu_in_place(&mut d, &scale).map_err(|_| Singular { block: b })?;
-            let mut inv = Block::identity();
-            lu_solve_matrix(&d, &piv, &inv_diag, &mut inv);
+            let inv = self.pivot_inverse(b, d)?;
             self.inv[b] = inv;
             if b > r.start {
                 self.inv_lower[b] = mul6(&inv, &self.lower[b]);
@@ -140,6 +131,44 @@ impl BlockTridiag {
             }
         }
         Ok(())
+    }
+
+    /// `factor_range` in the other direction (block UL): the blocks eliminated from the last
+    /// to the first, so that the first block's pivot carries the whole range. Then `inv_lower`
+    /// holds D'⁻¹U (the in-sweep, from the last block) and `elim` D'⁻¹L (the out-sweep). A
+    /// coupling at the range's start then reaches a Schur complement through the first two
+    /// blocks alone (`solve_tail`).
+    pub fn factor_range_rev(&mut self, r: Range<usize>) -> Result<(), Singular> {
+        for b in r.clone().rev() {
+            let mut d = self.diag[b];
+            if b + 1 < r.end {
+                d -= mul6(&self.upper[b], &self.elim[b + 1]);
+            }
+            let inv = self.pivot_inverse(b, d)?;
+            self.inv[b] = inv;
+            if b + 1 < r.end {
+                self.inv_lower[b] = mul6(&inv, &self.upper[b]);
+            }
+            if b > r.start {
+                self.elim[b] = mul6(&inv, &self.lower[b]);
+            }
+        }
+        Ok(())
+    }
+
+    /// The inverse of pivot block `d` (block b after the elimination). Pivots are judged
+    /// against their column of D_b before the elimination: a stiffness small against the others
+    /// of the block (EI ≪ GA Δs²) is not a singularity, a pivot cancelled to round-off by the
+    /// elimination (a free mode) is.
+    fn pivot_inverse(&self, b: usize, mut d: Block) -> Result<Block, Singular> {
+        let mut scale = [0.0; 6];
+        for (k, c) in scale.iter_mut().enumerate() {
+            *c = self.diag[b].column(k).amax();
+        }
+        let (piv, inv_diag) = lu_in_place(&mut d, &scale).map_err(|_| Singular { block: b })?;
+        let mut inv = Block::identity();
+        lu_solve_matrix(&d, &piv, &inv_diag, &mut inv);
+        Ok(inv)
     }
 
     /// Symmetric block LDLᵀ factorisation of the symmetric part ½(J + Jᵀ) of the blocks `r`
@@ -255,21 +284,106 @@ impl BlockTridiag {
     /// Solves the system of blocks `r` (factored by `factor_range`) in place; `rhs` holds all
     /// blocks, only those in `r` are used and changed.
     pub fn solve_range(&self, r: Range<usize>, rhs: &mut [Vector6<f64>]) {
+        self.solve_range_dir(r, false, rhs);
+    }
+
+    /// `solve_range` with the factors of `factor_range` (`rev` false) or `factor_range_rev`.
+    pub fn solve_range_dir(&self, r: Range<usize>, rev: bool, rhs: &mut [Vector6<f64>]) {
+        self.sweep_in(r.clone(), rev, rhs);
+        self.sweep_out(r, rev, rhs);
+    }
+
+    /// The first half of a solve with the factors of `factor_range` (`rev` false) or
+    /// `factor_range_rev` (true), towards the block eliminated last:
+    /// y_b = D'_b⁻¹ r_b − (D'_b⁻¹ L_b) y_{b−1} (reversed: U_b and y_{b+1}).
+    pub fn sweep_in(&self, r: Range<usize>, rev: bool, rhs: &mut [Vector6<f64>]) {
         if r.is_empty() {
             return;
         }
-        // Forward: y_b = D'_b⁻¹ r_b − (D'_b⁻¹ L_b) y_{b−1}.
         let x = &mut rhs[r.clone()];
-        let (inv, inv_lower) = (&self.inv[r.clone()], &self.inv_lower[r.clone()]);
-        x[0] = mat_vec(&inv[0], &x[0]);
-        for b in 1..x.len() {
-            x[b] = mat_vec(&inv[b], &x[b]) - mat_vec(&inv_lower[b], &x[b - 1]);
+        let (inv, inv_lower) = (&self.inv[r.clone()], &self.inv_lower[r]);
+        let n = x.len();
+        if rev {
+            x[n - 1] = mat_vec(&inv[n - 1], &x[n - 1]);
+            for b in (0..n - 1).rev() {
+                x[b] = mat_vec(&inv[b], &x[b]) - mat_vec(&inv_lower[b], &x[b + 1]);
+            }
+        } else {
+            x[0] = mat_vec(&inv[0], &x[0]);
+            for b in 1..n {
+                x[b] = mat_vec(&inv[b], &x[b]) - mat_vec(&inv_lower[b], &x[b - 1]);
+            }
         }
-        // Backward: x_b = y_b − (D'_b⁻¹ U_b) x_{b+1}.
+    }
+
+    /// The second half, from the block eliminated last back: x_b = y_b − (D'_b⁻¹ U_b) x_{b+1}
+    /// (reversed: L_b and x_{b−1}).
+    pub fn sweep_out(&self, r: Range<usize>, rev: bool, rhs: &mut [Vector6<f64>]) {
+        if r.is_empty() {
+            return;
+        }
+        let x = &mut rhs[r.clone()];
         let elim = &self.elim[r];
-        for b in (0..x.len() - 1).rev() {
-            x[b] -= mat_vec(&elim[b], &x[b + 1]);
+        if rev {
+            for b in 1..x.len() {
+                x[b] -= mat_vec(&elim[b], &x[b - 1]);
+            }
+        } else {
+            for b in (0..x.len() - 1).rev() {
+                x[b] -= mat_vec(&elim[b], &x[b + 1]);
+            }
         }
+    }
+
+    /// The block eliminated last in `r` and the one before it (`r` of at least two blocks).
+    pub fn tail_blocks(r: &Range<usize>, rev: bool) -> (usize, usize) {
+        if rev {
+            (r.start, r.start + 1)
+        } else {
+            (r.end - 1, r.end - 2)
+        }
+    }
+
+    /// The solution at the tail (`tail_blocks`) from the in-sweep `y` there: x_last = y_last,
+    /// x_prev = y_prev − E_prev x_last.
+    pub fn tail_of(
+        &self,
+        r: &Range<usize>,
+        rev: bool,
+        y: &[Vector6<f64>],
+    ) -> (Vector6<f64>, Vector6<f64>) {
+        let (last, prev) = Self::tail_blocks(r, rev);
+        (y[last], y[prev] - mat_vec(&self.elim[prev], &y[last]))
+    }
+
+    /// The in-sweep of a right-hand side that is zero outside the tail (`u_last`, `u_prev`
+    /// there): its values at the tail, O(1).
+    pub fn sweep_in_tail(
+        &self,
+        r: &Range<usize>,
+        rev: bool,
+        u_last: &Vector6<f64>,
+        u_prev: &Vector6<f64>,
+    ) -> (Vector6<f64>, Vector6<f64>) {
+        let (last, prev) = Self::tail_blocks(r, rev);
+        let w_prev = mat_vec(&self.inv[prev], u_prev);
+        let w_last = mat_vec(&self.inv[last], u_last) - mat_vec(&self.inv_lower[last], &w_prev);
+        (w_last, w_prev)
+    }
+
+    /// X = A⁻¹ B at the tail for a block column B that is zero outside it (`b_last`,
+    /// `b_prev` there): the Schur complement of a coupling at the tail, O(1).
+    pub fn solve_tail(
+        &self,
+        r: &Range<usize>,
+        rev: bool,
+        b_last: &Block,
+        b_prev: &Block,
+    ) -> (Block, Block) {
+        let (last, prev) = Self::tail_blocks(r, rev);
+        let y_prev = mul6(&self.inv[prev], b_prev);
+        let x_last = mul6(&self.inv[last], b_last) - mul6(&self.inv_lower[last], &y_prev);
+        (x_last, y_prev - mul6(&self.elim[prev], &x_last))
     }
 
     /// y = J x (for tests and residual checks).
@@ -579,6 +693,76 @@ mod tests {
         j.solve_range(0..3, &mut rhs);
         for b in 0..n {
             assert!((rhs[b] - x[b]).norm() < 1e-12);
+        }
+    }
+
+    /// Both directions of the elimination solve a random system; the tail operations equal
+    /// a full solve there (a right-hand side zero outside the tail, as a junction's coupling).
+    #[test]
+    fn reversed_elimination_and_tail_solves_match_full_solves() {
+        let n = 8;
+        let mut seed = 11u64;
+        let mut j = BlockTridiag::new(n);
+        for b in 0..n {
+            j.diag[b] = Block::from_fn(|_, _| rnd(&mut seed)) + Block::identity() * 4.0;
+            j.lower[b] = Block::from_fn(|_, _| rnd(&mut seed));
+            j.upper[b] = Block::from_fn(|_, _| rnd(&mut seed));
+        }
+        let x: Vec<Vector6<f64>> = (0..n)
+            .map(|_| Vector6::from_fn(|_, _| rnd(&mut seed)))
+            .collect();
+        let mut rhs = vec![Vector6::zeros(); n];
+        j.mul(&x, &mut rhs);
+        let r = 1..n - 1; // a range inside: its coupling blocks to the rest are ignored
+        let mut sub = j.clone();
+        sub.lower[r.start].fill(0.0);
+        sub.upper[r.end - 1].fill(0.0);
+        let mut b = vec![Vector6::zeros(); n];
+        sub.mul(&x, &mut b);
+        for rev in [false, true] {
+            if rev {
+                j.factor_range_rev(r.clone()).unwrap();
+            } else {
+                j.factor_range(r.clone()).unwrap();
+            }
+            let mut y = b.clone();
+            j.sweep_in(r.clone(), rev, &mut y);
+            let (t_last, t_prev) = j.tail_of(&r, rev, &y);
+            j.sweep_out(r.clone(), rev, &mut y);
+            for k in r.clone() {
+                assert!((y[k] - x[k]).norm() < 1e-12, "rev {rev} block {k}");
+            }
+            let (last, prev) = BlockTridiag::tail_blocks(&r, rev);
+            assert!((t_last - x[last]).norm() < 1e-12 && (t_prev - x[prev]).norm() < 1e-12);
+            // A right-hand side (and a block column) zero outside the tail.
+            let (u_last, u_prev) = (
+                Vector6::from_fn(|_, _| rnd(&mut seed)),
+                Vector6::from_fn(|_, _| rnd(&mut seed)),
+            );
+            let mut u = vec![Vector6::zeros(); n];
+            u[last] = u_last;
+            u[prev] = u_prev;
+            let mut full = u.clone();
+            j.sweep_in(r.clone(), rev, &mut full);
+            let (w_last, w_prev) = j.sweep_in_tail(&r, rev, &u_last, &u_prev);
+            assert!((w_last - full[last]).norm() < 1e-13 && (w_prev - full[prev]).norm() < 1e-13);
+            j.sweep_out(r.clone(), rev, &mut full);
+            let (bl, bp) = (
+                Block::from_fn(|_, _| rnd(&mut seed)),
+                Block::from_fn(|_, _| rnd(&mut seed)),
+            );
+            let (xl, xp) = j.solve_tail(&r, rev, &bl, &bp);
+            for c in 0..6 {
+                let mut col = vec![Vector6::zeros(); n];
+                col[last] = bl.column(c).into();
+                col[prev] = bp.column(c).into();
+                j.solve_range_dir(r.clone(), rev, &mut col);
+                assert!(
+                    (xl.column(c) - col[last]).norm() < 1e-12,
+                    "rev {rev} column {c}"
+                );
+                assert!((xp.column(c) - col[prev]).norm() < 1e-12);
+            }
         }
     }
 

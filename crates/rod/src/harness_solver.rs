@@ -3,7 +3,7 @@
 //! segment's chain onto its junctions, then the junction tree leaves first), Newton,
 //! pseudo-transient and load continuation, sequences.
 use crate::assembly::Workspace;
-use crate::block_tridiag::{pivot_inertia, Inertia};
+use crate::block_tridiag::{pivot_inertia, BlockTridiag, Inertia};
 use crate::contact::Contact;
 use crate::harness::{Harness, HarnessError, HarnessState};
 use crate::junction::HeldEnds;
@@ -74,6 +74,16 @@ pub struct HarnessStatics {
     z: Vec<Vec<Matrix6<f64>>>,
     /// Per cable: one block vector for solving a column of A⁻¹ B_k.
     column: Vec<Vec<Vector6<f64>>>,
+    /// Per cable segment: its junction end when it is the segment's only one (the segment is
+    /// then eliminated towards that end, which takes its Schur complement from the last two
+    /// blocks: no A⁻¹ B_k columns; `BlockTridiag::solve_tail`).
+    tail_end: Vec<Vec<Option<usize>>>,
+    /// Whether `factor` took that path (not in the symmetric factorisation); tests switch it
+    /// off with `tail_path` to compare with the columns.
+    tail_factored: bool,
+    pub(crate) tail_path: bool,
+    /// Per end on that path: A⁻¹ r at its blocks (`topo.blocks()`) in the last solve.
+    tail_x: Vec<[Vector6<f64>; 2]>,
     /// Junction pivots (after the tree elimination) and their inverses.
     pivot: Vec<Matrix6<f64>>,
     pivot_inv: Vec<Matrix6<f64>>,
@@ -155,6 +165,10 @@ impl HarnessStatics {
                 .map(|e| vec![Matrix6::zeros(); h.cables[e.cable].arc.len()])
                 .collect(),
             column: per_cable(),
+            tail_end: tail_ends(h),
+            tail_factored: false,
+            tail_path: true,
+            tail_x: vec![[Vector6::zeros(); 2]; h.ends.len()],
             pivot: vec![Matrix6::zeros(); nj],
             pivot_inv: vec![Matrix6::zeros(); nj],
             link_ab: vec![Matrix6::zeros(); h.links.len()],
@@ -269,15 +283,18 @@ impl HarnessStatics {
     /// junctions, the junction tree (leaves first).
     pub fn factor(&mut self, h: &Harness) -> Result<(), HarnessError> {
         self.inertia = Inertia::default();
+        self.tail_factored = self.tail_path && !self.symmetric;
         for (c, rod) in h.cables.iter().enumerate() {
-            for seg in &rod.segments {
+            for (s, seg) in rod.segments.iter().enumerate() {
                 if self.symmetric {
                     let i = self.ws[c].jac.ldlt(seg.blocks.clone());
                     self.inertia.negative += i.negative;
                     self.inertia.zero += i.zero;
                 } else {
+                    let rev = self.tail_factored
+                        && self.tail_end[c][s].is_some_and(|k| h.ends[k].topo.at_start);
                     self.ws[c]
-                        .factor_segment(rod, seg)
+                        .factor_segment_dir(rod, seg, rev)
                         .map_err(|e| Self::cable_err(h, c, e))?;
                 }
             }
@@ -300,9 +317,12 @@ impl HarnessStatics {
         }
         self.link_ab.iter_mut().for_each(|m| m.fill(0.0));
         self.link_ba.iter_mut().for_each(|m| m.fill(0.0));
-        // Z_k = A⁻¹ B_k for every end.
+        // Z_k = A⁻¹ B_k for every end (but those of the tail path).
         for (k, e) in h.ends.iter().enumerate() {
             let Some(s) = e.segment else { continue };
+            if self.on_tail(h, k) {
+                continue;
+            }
             let rod = &h.cables[e.cable];
             let range = rod.segments[s].blocks.clone();
             let blocks = e.topo.blocks();
@@ -336,6 +356,27 @@ impl HarnessStatics {
                 rows_to_junction(&eb.ec[1], &e.rel),
             ];
             let blocks = e.topo.blocks();
+            if self.on_tail(h, k) {
+                // The segment's only junction end, eliminated last: A⁻¹ B_k at its blocks.
+                let range = &h.cables[e.cable].segments[s].blocks;
+                let rev = e.topo.at_start;
+                let (last, _) = BlockTridiag::tail_blocks(range, rev);
+                let (mut b_last, mut b_prev) = (Matrix6::zeros(), Matrix6::zeros());
+                for (i, &b) in blocks.iter().enumerate() {
+                    let bk = cols_to_junction(&eb.ce[i], &e.rel);
+                    if b == last {
+                        b_last += bk;
+                    } else {
+                        b_prev += bk;
+                    }
+                }
+                let (x_last, x_prev) = self.ws[e.cable]
+                    .jac
+                    .solve_tail(range, rev, &b_last, &b_prev);
+                let at = |b: usize| if b == last { x_last } else { x_prev };
+                self.pivot[e.junction] -= ck[0] * at(blocks[0]) + ck[1] * at(blocks[1]);
+                continue;
+            }
             for &l in &h.cable_ends[e.cable] {
                 if h.ends[l].segment != Some(s) {
                     continue;
@@ -379,6 +420,14 @@ impl HarnessStatics {
         Ok(())
     }
 
+    /// Whether end k is on the tail path of the last factorisation.
+    pub(crate) fn on_tail(&self, h: &Harness, k: usize) -> bool {
+        let e = &h.ends[k];
+        self.tail_factored
+            && e.segment
+                .is_some_and(|s| self.tail_end[e.cable][s] == Some(k))
+    }
+
     /// (S_pj, S_jp) of link l whose one junction is p.
     fn link_blocks(&self, h: &Harness, p: usize, l: usize) -> (Matrix6<f64>, Matrix6<f64>) {
         if h.links[l].a == p {
@@ -394,8 +443,21 @@ impl HarnessStatics {
         for (c, rod) in h.cables.iter().enumerate() {
             let y = &mut self.y[c];
             y.copy_from_slice(&self.ws[c].rhs);
-            for seg in &rod.segments {
-                self.ws[c].jac.solve_range(seg.blocks.clone(), y);
+            for (s, seg) in rod.segments.iter().enumerate() {
+                let jac = &self.ws[c].jac;
+                match self.tail_end[c][s].filter(|_| self.tail_factored) {
+                    Some(k) => {
+                        // Towards the end only; the way back once its junction has moved.
+                        let topo = &h.ends[k].topo;
+                        jac.sweep_in(seg.blocks.clone(), topo.at_start, y);
+                        let (x_last, x_prev) = jac.tail_of(&seg.blocks, topo.at_start, y);
+                        let (last, _) = BlockTridiag::tail_blocks(&seg.blocks, topo.at_start);
+                        self.tail_x[k] = topo
+                            .blocks()
+                            .map(|b| if b == last { x_last } else { x_prev });
+                    }
+                    None => jac.solve_range(seg.blocks.clone(), y),
+                }
             }
         }
         for (j, list) in h.junction_ends.iter().enumerate() {
@@ -406,8 +468,14 @@ impl HarnessStatics {
                     continue;
                 }
                 let eb = &self.held[e.cable].ends[e.local];
+                let tail = self.on_tail(h, k);
                 for (i, &blk) in e.topo.blocks().iter().enumerate() {
-                    b -= rows_to_junction(&eb.ec[i], &e.rel) * self.y[e.cable][blk];
+                    let x = if tail {
+                        self.tail_x[k][i]
+                    } else {
+                        self.y[e.cable][blk]
+                    };
+                    b -= rows_to_junction(&eb.ec[i], &e.rel) * x;
                 }
             }
             self.b[j] = b;
@@ -455,6 +523,30 @@ impl HarnessStatics {
             let Some(s) = e.segment else { continue };
             let range = h.cables[e.cable].segments[s].blocks.clone();
             let d = dj[e.junction];
+            if self.tail_factored && self.tail_end[e.cable][s] == Some(k) {
+                // x = A⁻¹(r + B d): B d enters the in-sweep at the tail alone, then the way back.
+                let rev = e.topo.at_start;
+                let (last, _) = BlockTridiag::tail_blocks(&range, rev);
+                let eb = &self.held[e.cable].ends[e.local];
+                let (mut u_last, mut u_prev) = (Vector6::zeros(), Vector6::zeros());
+                for (i, &b) in e.topo.blocks().iter().enumerate() {
+                    let u = cols_to_junction(&eb.ce[i], &e.rel) * d;
+                    if b == last {
+                        u_last += u;
+                    } else {
+                        u_prev += u;
+                    }
+                }
+                let jac = &self.ws[e.cable].jac;
+                let x = &mut out[e.cable];
+                let (w_last, w_prev) = jac.sweep_in_tail(&range, rev, &u_last, &u_prev);
+                let prev = BlockTridiag::tail_blocks(&range, rev).1;
+                // `out` holds −y here.
+                x[last] -= w_last;
+                x[prev] -= w_prev;
+                jac.sweep_out(range, rev, x);
+                continue;
+            }
             if d == Vector6::zeros() {
                 continue;
             }
@@ -1013,6 +1105,36 @@ impl HarnessStatics {
 }
 
 /// `e` of cable `c` of `h`, naming the cable.
+/// Per cable segment: its junction end if it is the segment's only one and couples to the
+/// two blocks that the segment's elimination towards it takes last (`tail_end`).
+fn tail_ends(h: &Harness) -> Vec<Vec<Option<usize>>> {
+    h.cables
+        .iter()
+        .enumerate()
+        .map(|(c, rod)| {
+            rod.segments
+                .iter()
+                .enumerate()
+                .map(|(s, seg)| {
+                    let mut ends = h.cable_ends[c]
+                        .iter()
+                        .filter(|&&k| h.ends[k].segment == Some(s));
+                    let (Some(&k), None) = (ends.next(), ends.next()) else {
+                        return None;
+                    };
+                    if seg.blocks.len() < 2 {
+                        return None;
+                    }
+                    let (last, prev) =
+                        BlockTridiag::tail_blocks(&seg.blocks, h.ends[k].topo.at_start);
+                    let blocks = h.ends[k].topo.blocks();
+                    blocks.iter().all(|b| *b == last || *b == prev).then_some(k)
+                })
+                .collect()
+        })
+        .collect()
+}
+
 pub(crate) fn cable_error(h: &Harness, c: usize, e: SolveError) -> HarnessError {
     HarnessError(format!("cable '{}': {e}", h.names[c]))
 }

@@ -334,42 +334,72 @@ fn coupled_jacobian_matches_finite_differences() {
     }
 }
 
+/// The tree elimination solves J Δ = −r, both ways: with a branch whose only junction end is
+/// eliminated last (its Schur complement from the last two blocks, ends at a cable's start and
+/// at its end) and with the A⁻¹ B columns of every end; the two agree to round-off.
 #[test]
 fn tree_elimination_solves_the_coupled_system() {
     let h = two_junctions(7);
     let (st, _, _) = perturbed(&h);
-    let mut s = HarnessStatics::new(&h, NewtonOptions::default());
-    s.assemble(&h, &st, 1.0, true).unwrap();
-    let (r, rj) = (
-        s.ws.iter().map(|w| w.rhs.clone()).collect::<Vec<_>>(),
-        s.junction_residual.clone(),
-    );
-    // J is read before factoring (the factorisation keeps the blocks it reads).
-    let jac: Vec<_> = s.ws.iter().map(|w| w.jac.clone()).collect();
-    s.factor(&h).unwrap();
-    s.newton_correction(&h);
-    let (d, dj) = s.correction();
-    let (d, dj) = (d.to_vec(), dj.to_vec());
-    for (w, j) in s.ws.iter_mut().zip(jac) {
-        w.jac = j;
-    }
-    let (jd, jdj) = s.jacobian_times(&h, &d, &dj);
-    let scale = r
-        .iter()
-        .flatten()
-        .chain(&rj)
-        .map(|x| x.amax())
-        .fold(0.0, f64::max);
-    for c in 0..h.cables.len() {
-        for b in 0..r[c].len() {
+    let mut corrections = Vec::new();
+    for tail in [true, false] {
+        let mut s = HarnessStatics::new(&h, NewtonOptions::default());
+        s.tail_path = tail;
+        s.assemble(&h, &st, 1.0, true).unwrap();
+        let (r, rj) = (
+            s.ws.iter().map(|w| w.rhs.clone()).collect::<Vec<_>>(),
+            s.junction_residual.clone(),
+        );
+        // J is read before factoring (the factorisation keeps the blocks it reads).
+        let jac: Vec<_> = s.ws.iter().map(|w| w.jac.clone()).collect();
+        s.factor(&h).unwrap();
+        // Tail path: the four branches with one junction end (two at their start, two at
+        // their end); the link between the junctions keeps its columns.
+        let on_tail: Vec<bool> = (0..h.ends.len()).map(|k| s.on_tail(&h, k)).collect();
+        let starts = (0..h.ends.len()).filter(|&k| on_tail[k] && h.ends[k].topo.at_start);
+        assert_eq!(
+            (on_tail.iter().filter(|&&t| t).count(), starts.count()),
+            if tail { (4, 2) } else { (0, 0) }
+        );
+        s.newton_correction(&h);
+        let (d, dj) = s.correction();
+        let (d, dj) = (d.to_vec(), dj.to_vec());
+        for (w, j) in s.ws.iter_mut().zip(jac) {
+            w.jac = j;
+        }
+        let (jd, jdj) = s.jacobian_times(&h, &d, &dj);
+        let scale = r
+            .iter()
+            .flatten()
+            .chain(&rj)
+            .map(|x| x.amax())
+            .fold(0.0, f64::max);
+        for c in 0..h.cables.len() {
+            for b in 0..r[c].len() {
+                assert!(
+                    (jd[c][b] + r[c][b]).amax() < 1e-9 * scale,
+                    "tail {tail}: cable {c} block {b}"
+                );
+            }
+        }
+        for j in 0..h.junctions.len() {
             assert!(
-                (jd[c][b] + r[c][b]).amax() < 1e-9 * scale,
-                "cable {c} block {b}"
+                (jdj[j] + rj[j]).amax() < 1e-9 * scale,
+                "tail {tail}: junction {j}"
             );
         }
+        corrections.push((d, dj));
     }
-    for j in 0..h.junctions.len() {
-        assert!((jdj[j] + rj[j]).amax() < 1e-9 * scale, "junction {j}");
+    let ((d1, j1), (d0, j0)) = (&corrections[0], &corrections[1]);
+    let size = |v: &Vector6<f64>| v.amax();
+    let scale = d0.iter().flatten().chain(j0).map(size).fold(0.0, f64::max);
+    for (a, b) in d1
+        .iter()
+        .flatten()
+        .zip(d0.iter().flatten())
+        .chain(j1.iter().zip(j0))
+    {
+        assert!((a - b).amax() < 1e-12 * scale, "{a:?} vs {b:?}");
     }
 }
 
