@@ -50,6 +50,17 @@ pub struct Workspace {
     /// energy (true by default; false: residual and Jacobian only, 13 % cheaper — the Newton
     /// iterations of a harness, whose outputs are assembled on the saved steps).
     pub section_outputs: bool,
+    /// The outputs pass of a dynamic step (`Dynamics::update_outputs`): section loads and
+    /// energies everywhere, but the gradients only where the clip reactions and the joined ends
+    /// read them (`reaction_edge`, `reaction_bend`, `reaction_block`); no residual vector and
+    /// no Jacobian. The values read are those of the full assembly to the last bit (the same
+    /// terms add to them in the same order).
+    pub outputs_only: bool,
+    /// Per edge: its shear term reaches a clip's node or edge; per bending term: it reaches a
+    /// clip's edge or a ghost rotation; per block: its node and its edge are a clip's.
+    reaction_edge: Vec<bool>,
+    reaction_bend: Vec<bool>,
+    pub(crate) reaction_block: Vec<[bool; 2]>,
 }
 
 /// Jacobian entries at a held end node of a cable (`Workspace::end_jac`): `diag` ∂r_end/∂x_end,
@@ -204,6 +215,15 @@ enum Var {
 impl Workspace {
     pub fn new(rod: &Rod) -> Self {
         let n = rod.n_edges();
+        // The nodes and edges whose gradients give reactions (`clip_reaction`, the joined
+        // ends' residuals at their ghosts' nodes).
+        let mut node_clip = vec![false; n + 1];
+        let mut edge_clip = vec![false; n];
+        for c in 0..rod.spec.clips.len() {
+            rod.clip_nodes[c].iter().for_each(|&k| node_clip[k] = true);
+            rod.clip_edges[c].iter().for_each(|&e| edge_clip[e] = true);
+        }
+        rod.ghosts.iter().for_each(|g| node_clip[g.node] = true);
         Workspace {
             jac: BlockTridiag::new(n + 1),
             rhs: vec![Vector6::zeros(); n + 1],
@@ -222,6 +242,23 @@ impl Workspace {
             held_reaction: vec![None; rod.spec.clips.len()],
             end_jac: [EndNodeJacobian::default(); 2],
             section_outputs: true,
+            outputs_only: false,
+            reaction_edge: (0..n)
+                .map(|e| node_clip[e] || node_clip[e + 1] || edge_clip[e])
+                .collect(),
+            reaction_bend: rod
+                .bend_terms
+                .iter()
+                .map(|t| {
+                    [t.a, t.b].iter().any(|r| match *r {
+                        RotRef::Edge(e) => edge_clip[e],
+                        RotRef::Ghost(_) => true,
+                    })
+                })
+                .collect(),
+            reaction_block: (0..=n)
+                .map(|b| [node_clip[b], b < n && edge_clip[b]])
+                .collect(),
         }
     }
 
@@ -439,10 +476,12 @@ impl Workspace {
             self.edge_force[e] = f;
             self.edge_force_viscous[e] = f - f_el;
         }
-        let rf = kin.r * f;
-        self.node_grad[e] -= rf;
-        self.node_grad[e + 1] += rf;
-        self.edge_grad[e] += ds * f.cross(&kin.u);
+        if !self.outputs_only || self.reaction_edge[e] {
+            let rf = kin.r * f;
+            self.node_grad[e] -= rf;
+            self.node_grad[e + 1] += rf;
+            self.edge_grad[e] += ds * f.cross(&kin.u);
+        }
         if want_jac {
             let jb = kin.jacobian(&f, &sec.shear_stiffness, viscous.as_ref());
             let a_free = rod.node_kind[e] == NodeKind::Free;
@@ -520,11 +559,13 @@ impl Workspace {
             self.node_moment_viscous[t.node] += m - m_el;
             self.node_moment_count[t.node] += 1;
         }
-        let g = kin.forces(&m);
-        for (r, gi) in [(t.a, g[0]), (t.b, g[1])] {
-            match r {
-                RotRef::Edge(e) => self.edge_grad[e] += gi,
-                RotRef::Ghost(k) => self.ghost_grad[k] += gi,
+        if !self.outputs_only || self.reaction_bend[i] {
+            let g = kin.forces(&m);
+            for (r, gi) in [(t.a, g[0]), (t.b, g[1])] {
+                match r {
+                    RotRef::Edge(e) => self.edge_grad[e] += gi,
+                    RotRef::Ghost(k) => self.ghost_grad[k] += gi,
+                }
             }
         }
         if want_jac {

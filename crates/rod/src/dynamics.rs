@@ -267,6 +267,9 @@ pub struct Dynamics {
     pub energies: Energies,
     /// The outputs (energies, reactions) are those of the current state.
     outputs_current: bool,
+    /// Whether `update_outputs` takes the outputs pass (`Workspace::outputs_only`); tests
+    /// switch it off to compare with the full assembly.
+    pub(crate) outputs_pass: bool,
     /// An obstacle moved in the last step (its work is not accounted: no energy check).
     obstacles_moved: bool,
     pub(crate) power_n: f64,
@@ -342,6 +345,7 @@ impl Dynamics {
             clip_still: Vec::with_capacity(clips.len()),
             energies: Energies::default(),
             outputs_current: false,
+            outputs_pass: true,
             obstacles_moved: false,
             power_n: 0.0,
             poses: Vec::with_capacity(clips.len()),
@@ -418,11 +422,19 @@ impl Dynamics {
             load_factor: 1.0,
         };
         Elastic.add_residual_jacobian(rod, st, &ev, &mut self.ws)?;
-        // Inertia: m ẍ on nodes, J ω̇ + ω × Jω on edges (prescribed ones enter the reactions).
+        // Inertia: m ẍ on nodes, J ω̇ + ω × Jω on edges (prescribed ones enter the reactions;
+        // in the outputs pass only they: `Workspace::outputs_only`).
         let n_edges = rod.n_edges();
+        let only = self.ws.outputs_only;
         for b in blocks {
+            let [at_node, at_edge] = self.ws.reaction_block[b];
+            if only && !at_node && !at_edge {
+                continue;
+            }
             let acc: Vector3<f64> = self.vdot[b].fixed_rows::<3>(0).into();
-            self.ws.node_grad[b] += rod.node_mass[b] * acc;
+            if !only || at_node {
+                self.ws.node_grad[b] += rod.node_mass[b] * acc;
+            }
             let [node, edge] = self.inertial_half[b];
             if want_jac && node {
                 let m = c_mass * rod.node_mass[b];
@@ -431,7 +443,7 @@ impl Dynamics {
                     d[(k, k)] += m;
                 }
             }
-            if b >= n_edges {
+            if b >= n_edges || (only && !at_edge) {
                 continue;
             }
             let j = self.edge_inertia[b];
@@ -453,7 +465,9 @@ impl Dynamics {
             .add_residual_jacobian(rod, st, &ev, &mut self.ws)?;
         self.sliding
             .add_residual_jacobian(rod, st, &ev, &mut self.ws)?;
-        self.ws.finalize_part(rod, want_jac, part);
+        if !only {
+            self.ws.finalize_part(rod, want_jac, part);
+        }
         Ok(())
     }
 
@@ -1146,7 +1160,9 @@ impl Dynamics {
     /// the power at the last Newton iterate).
     pub fn update_outputs(&mut self, rod: &Rod, st: &State) -> Result<(), SolveError> {
         let keep = std::mem::replace(&mut self.ws.section_outputs, true);
+        self.ws.outputs_only = self.outputs_pass;
         let assembled = self.assemble(rod, st, 0.0, 0.0, false, Part::All);
+        self.ws.outputs_only = false;
         self.ws.section_outputs = keep;
         assembled.map_err(|k| SolveError::Kink {
             node: k.node,
@@ -1158,6 +1174,15 @@ impl Dynamics {
         self.energies.kinetic = self.kinetic_energy(rod);
         self.outputs_current = true;
         Ok(())
+    }
+
+    /// `update_outputs` with the full assembly: also the residual of the step's equations at
+    /// `st` (`ws.rhs`, e.g. `ws.residual_norms`), which the outputs pass leaves out.
+    pub fn assemble_residual(&mut self, rod: &Rod, st: &State) -> Result<(), SolveError> {
+        let pass = std::mem::replace(&mut self.outputs_pass, false);
+        let assembled = self.update_outputs(rod, st);
+        self.outputs_pass = pass;
+        assembled
     }
 
     pub fn kinetic_energy(&self, rod: &Rod) -> f64 {

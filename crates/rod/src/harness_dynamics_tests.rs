@@ -301,3 +301,41 @@ fn damped_harness_iteration_matrix_matches_finite_differences() {
     assert!(fdev < 1e-6 * fscale, "forces {fdev:e} of {fscale:e}");
     assert!(mdev < 1e-6 * mscale, "moments {mdev:e} of {mscale:e}");
 }
+
+/// The outputs pass of the saved steps gives the full assembly's harness outputs to the last
+/// bit: each branch's load on the junction, the section loads and the energies, with a clip
+/// moving and the junction carrying a mass and rotary inertia (`Workspace::outputs_only`).
+#[test]
+fn harness_outputs_pass_equals_the_full_assembly() {
+    let h = y_harness(8, 0.02, 1e-6);
+    let mut st = initial(&h);
+    let mut hd = HarnessDynamics::new(&h, &st, &motions(&st.cables, lift(0.0)), tight());
+    hd.start(&h, &mut st).unwrap();
+    let outputs = |hd: &HarnessDynamics, st: &HarnessState| -> Vec<f64> {
+        let mut v: Vec<f64> = hd
+            .branch_loads(&h, st)
+            .iter()
+            .flat_map(|(f, m)| f.iter().chain(m.iter()).copied().collect::<Vec<_>>())
+            .collect();
+        for dy in &hd.cables {
+            let ws = &dy.ws;
+            for a in [&ws.edge_force, &ws.node_moment, &ws.edge_force_viscous] {
+                v.extend(a.iter().flat_map(|x| x.iter().copied()));
+            }
+        }
+        let e = &hd.energies;
+        v.extend([e.kinetic, e.elastic, e.load_potential, e.dissipated]);
+        v
+    };
+    for k in 1..=20 {
+        let t = k as f64 * 1e-3;
+        let m = motions(&st.cables, lift(t));
+        hd.step(&h, &mut st, 1e-3, &m).unwrap();
+        hd.update_outputs(&h, &st).unwrap();
+        let pass = outputs(&hd, &st);
+        hd.cables.iter_mut().for_each(|dy| dy.outputs_pass = false);
+        hd.update_outputs(&h, &st).unwrap();
+        hd.cables.iter_mut().for_each(|dy| dy.outputs_pass = true);
+        assert_eq!(pass, outputs(&hd, &st), "step {k}");
+    }
+}

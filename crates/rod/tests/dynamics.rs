@@ -4,6 +4,7 @@
 mod common;
 use common::*;
 use nalgebra::Vector3;
+use rod::contact::{Contact, ContactOptions, Obstacle, Plane};
 use rod::rotation::exp_half;
 use rod::routing::route;
 use rod::{
@@ -330,12 +331,9 @@ fn shaken(rod: &Rod, t: f64) -> Vec<ClipMotion> {
     clips
 }
 
-#[test]
-fn iteration_matrix_is_the_derivative_of_the_dynamic_residual() {
-    // Every clip type, gravity, dead loads, natural curvature and Kelvin–Voigt damping, with
-    // a clip moving and rotating: the assembled iteration matrix (stiffness, damping and its
-    // configuration derivative, inertia, tangent of the rotation steps) against central
-    // differences of the residual along the Newton update.
+/// A cable in every clip type (fixed, swivel, ball, hinge, sliding), gravity, dead loads,
+/// natural curvature, Kelvin–Voigt damping; in static equilibrium.
+fn every_clip_type() -> (Rod, State, DynamicOptions) {
     let mut spec = cantilever(1.0, 24, circle(0.005, 5e7, 0.45, 1500.0));
     spec.gravity = Vector3::new(0.0, 0.0, -9.81);
     spec.natural_curvature = Vector3::new(0.5, -0.2, 0.3);
@@ -412,6 +410,16 @@ fn iteration_matrix_is_the_derivative_of_the_dynamic_residual() {
         tolerance: 1e-9,
         ..Default::default()
     };
+    (rod, st, opts)
+}
+
+#[test]
+fn iteration_matrix_is_the_derivative_of_the_dynamic_residual() {
+    // Every clip type, gravity, dead loads, natural curvature and Kelvin–Voigt damping, with
+    // a clip moving and rotating: the assembled iteration matrix (stiffness, damping and its
+    // configuration derivative, inertia, tangent of the rotation steps) against central
+    // differences of the residual along the Newton update.
+    let (rod, mut st, opts) = every_clip_type();
     let h = 1e-3;
     let mut dy = Dynamics::new(&rod, &st, &shaken(&rod, 0.0), opts);
     dy.start(&rod, &st).unwrap();
@@ -460,6 +468,72 @@ fn iteration_matrix_is_the_derivative_of_the_dynamic_residual() {
                 assert_eq!(m.amax(), 0.0, "coupling of blocks {b} and {}", b + 1);
             }
         }
+    }
+}
+
+/// The outputs pass of a saved step (`Dynamics::update_outputs`: the gradients only where the
+/// reactions read them, no residual vector) gives the full assembly's outputs to the last bit:
+/// section loads and their viscous parts, energies, the reaction of every clip type — with a
+/// clip moving and rotating, and again with the cable on a frictional floor.
+#[test]
+fn outputs_pass_equals_the_full_assembly() {
+    let outputs = |dy: &Dynamics, rod: &Rod, st: &State| -> Vec<f64> {
+        let ws = &dy.ws;
+        let mut v: Vec<f64> = [
+            &ws.edge_force,
+            &ws.edge_force_viscous,
+            &ws.node_moment,
+            &ws.node_moment_viscous,
+        ]
+        .iter()
+        .flat_map(|a| a.iter().flat_map(|x| x.iter().copied()))
+        .collect();
+        let e = &dy.energies;
+        v.extend([
+            e.kinetic,
+            e.elastic,
+            e.load_potential,
+            e.contact,
+            ws.dissipation,
+        ]);
+        for c in 0..rod.spec.clips.len() {
+            let (f, m) = ws.clip_reaction(rod, st, c);
+            v.extend(f.iter().chain(m.iter()));
+        }
+        v
+    };
+    for floor in [false, true] {
+        let (rod, mut st, opts) = every_clip_type();
+        let mut dy = Dynamics::new(&rod, &st, &shaken(&rod, 0.0), opts);
+        if floor {
+            // A frictional floor within the barrier's reach (half of it) below the lowest
+            // point of the cable's surface.
+            let r = 0.005;
+            let options = ContactOptions::for_radius(r);
+            let lowest = st.x.iter().map(|x| x.z).fold(f64::INFINITY, f64::min);
+            let z = lowest - r - 0.5 * options.distance;
+            let pose = rod::Pose {
+                position: Vector3::new(0.0, 0.0, z),
+                orientation: rod::rotation::Quat::identity(),
+            };
+            let plane = Obstacle::new("floor", 0, Box::new(Plane), 0.5, &pose);
+            dy.contact = Some(Contact::new(&rod, vec![plane], options, 1).unwrap());
+        }
+        dy.start(&rod, &st).unwrap();
+        let mut touched = false;
+        for k in 1..=20 {
+            dy.step(&rod, &mut st, 1e-3, &shaken(&rod, k as f64 * 1e-3))
+                .unwrap();
+            dy.update_outputs(&rod, &st).unwrap();
+            let pass = outputs(&dy, &rod, &st);
+            touched |= dy.energies.contact > 0.0;
+            dy.assemble_residual(&rod, &st).unwrap();
+            assert_eq!(pass, outputs(&dy, &rod, &st), "floor {floor}, step {k}");
+        }
+        assert_eq!(
+            touched, floor,
+            "the cable touches the floor (when there is one)"
+        );
     }
 }
 
@@ -543,6 +617,7 @@ fn spans_at_rest_stay_in_equilibrium_and_are_skipped() {
         dy.step(&rod, &mut st, h, &moving(k as f64 * h)).unwrap();
     }
     let first = rod.segments[0].blocks.clone();
+    dy.assemble_residual(&rod, &st).unwrap();
     let residual = dy.ws.residual_norms_range(first.clone(), rod.mean_ds()).1;
     let weight = rod.spec.section.mass_per_length * 9.81 * rod.mean_ds();
     assert!(residual < 1e-9 * weight, "residual {residual:e} N");
