@@ -198,14 +198,18 @@ def test_a_dynamic_run_starts_from_the_stable_buckled_state():
     assert np.abs(res.positions[-1] - res.positions[0]).max() < 1e-6
 
 
-def test_strain_extremes_scan_equals_the_rotation_matrix_formula():
-    """The blocked scan of the strains (no rotation matrices formed) finds the same extremes,
-    values and places as Γ = Rᵀ(x_{n+1} − x_n)/Δs − e₃ with R from the normalised quaternion,
-    also when the extreme lies in a later block and the quaternions are not unit."""
+def test_strain_extremes_scan_equals_the_rotation_matrix_formula(monkeypatch):
+    """The blocked scan of the strains (the Rust kernel, no rotation matrices formed) finds the
+    same extremes, values and places as Γ = Rᵀ(x_{n+1} − x_n)/Δs − e₃ with R from the
+    normalised quaternion, also when the extreme lies in a later block and the quaternions are
+    not unit."""
     from types import SimpleNamespace
 
+    from cablelife import validity
     from cablelife.export.frames import rotation_matrices
     from cablelife.validity import strain_extremes
+
+    monkeypatch.setattr(validity, "_STRAIN_BLOCK", 64)
 
     rng = np.random.default_rng(3)
     t, n = 150, 30  # three blocks of the scan

@@ -309,6 +309,11 @@ def fatigue_turning_points(series, hysteresis=0.0) -> Any:
     """Turning points of a 1-D series: (indices int64, values float64)."""
     ...
 
+def section_strains(positions, quaternions, arc_length) -> Any:
+    """Axial strain Γ₃ and shear strain |(Γ₁, Γ₂)| per step and edge (T, N) of saved positions
+    (T, N + 1, 3), edge quaternions (T, N, 4, scalar first) and node arc lengths (N + 1)."""
+    ...
+
 def weld_vertices(vertices, faces) -> Any:
     """Merges the vertices (N, 3) of a triangle soup that agree to 8 decimals (first appearance's
     order and coordinates kept) and re-indexes the faces (F, 3): (vertices (M, 3), faces (F, 3)).

@@ -13,6 +13,7 @@ import warnings
 
 import numpy as np
 
+from cablelife import _core
 from cablelife.results import CableResult
 
 #: Largest axial strain Γ₃ (= F3/EA at rest) inside the validity range.
@@ -65,24 +66,18 @@ def strains(c: CableResult, steps: slice = slice(None)) -> tuple[np.ndarray, np.
     t, n = c.quaternions[steps].shape[:2]
     if t == 0 or n == 0:
         return np.zeros((t, n)), np.zeros((t, n))
-    x = np.asarray(c.positions[steps], dtype=float)
-    inv_ds = 1.0 / np.diff(c.arc_length)[None, :]
-    # Rᵀ v = v + (2/|p|²)(u × (u × v) − w u × v) for p = (w, u): the rotation matrices of
-    # every step and edge are never formed (a dynamic run saves 1000s of steps: this was 20 %
-    # of simulate() on bench_harness.py).
-    p = np.asarray(c.quaternions[steps], dtype=float)
-    w, ux, uy, uz = (p[..., k] for k in range(4))
-    k = 2.0 / (w * w + ux * ux + uy * uy + uz * uz)
-    vx, vy, vz = ((x[:, 1:, i] - x[:, :-1, i]) * inv_ds for i in range(3))
-    cx, cy, cz = uy * vz - uz * vy, uz * vx - ux * vz, ux * vy - uy * vx  # u × v
-    gx = vx + k * (uy * cz - uz * cy - w * cx)
-    gy = vy + k * (uz * cx - ux * cz - w * cy)
-    gz = vz + k * (ux * cy - uy * cx - w * cz)
-    return gz - 1.0, np.sqrt(gx * gx + gy * gy)  # (np.hypot: 3× slower, guards overflow)
+    # Rust kernel (rod::shear::saved_strain): the rotation matrices of every step and edge are
+    # never formed; a dynamic run saves 1000s of steps (numpy took 9 ms per simulated second of
+    # bench_harness.py's harness, 5 % of its simulate()).
+    return _core.section_strains(
+        np.asarray(c.positions[steps], dtype=float),
+        np.asarray(c.quaternions[steps], dtype=float),
+        np.asarray(c.arc_length, dtype=float),
+    )
 
 
-#: Saved steps per block of the strain scan (its temporaries stay in the cache).
-_STRAIN_BLOCK = 64
+#: Saved steps per block of the strain scan (bounded temporaries on long runs).
+_STRAIN_BLOCK = 1024
 
 
 def strain_extremes(c: CableResult) -> dict:

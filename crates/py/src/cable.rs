@@ -2,7 +2,9 @@
 //! GIL, poll Ctrl-C and report progress through an optional Python callable.
 use crate::stop::{Poller, StopFlag};
 use nalgebra::{Quaternion, Vector3};
-use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray2, PyReadonlyArray3};
+use numpy::{
+    PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3,
+};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -10,6 +12,7 @@ use rod::assembly::Workspace;
 use rod::contact::{Contact, ContactOptions, Cuboid, Cylinder, Obstacle, Plane, Shape, Sphere};
 use rod::contact_mesh::MeshShape;
 use rod::routing::route;
+use rod::shear::saved_strain as shear_strain_of_saved;
 use rod::sliding::SlidingClips;
 use rod::{
     CableSpec, ClipKind, ClipMotion, ClipSpec, DynamicOptions, Dynamics, NewtonOptions, PointLoad,
@@ -1097,8 +1100,53 @@ impl Cable {
     }
 }
 
+type StrainArrays<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>);
+
+/// Axial strain Γ₃ and shear strain |(Γ₁, Γ₂)| per step and edge (T, N) of saved positions
+/// (T, N + 1, 3), edge quaternions (T, N, 4, scalar first) and node arc lengths (N + 1).
+#[pyfunction]
+fn section_strains<'py>(
+    py: Python<'py>,
+    positions: PyReadonlyArray3<'py, f64>,
+    quaternions: PyReadonlyArray3<'py, f64>,
+    arc_length: PyReadonlyArray1<'py, f64>,
+) -> PyResult<StrainArrays<'py>> {
+    let (x, p, s) = (
+        positions.as_array(),
+        quaternions.as_array(),
+        arc_length.as_array(),
+    );
+    let (t, n) = (p.shape()[0], p.shape()[1]);
+    if x.shape() != [t, n + 1, 3] || p.shape()[2] != 4 || s.len() != n + 1 {
+        return Err(PyValueError::new_err(format!(
+            "section_strains: positions {:?}, quaternions {:?} and arc lengths ({}) do not \
+             match: (T, N + 1, 3), (T, N, 4), N + 1",
+            x.shape(),
+            p.shape(),
+            s.len()
+        )));
+    }
+    let inv_ds: Vec<f64> = (0..n).map(|e| 1.0 / (s[e + 1] - s[e])).collect();
+    let (mut axial, mut shear) = (vec![0.0; t * n], vec![0.0; t * n]);
+    for k in 0..t {
+        for e in 0..n {
+            let at = |i: usize| Vector3::new(x[[k, i, 0]], x[[k, i, 1]], x[[k, i, 2]]);
+            let u = Vector3::new(p[[k, e, 1]], p[[k, e, 2]], p[[k, e, 3]]);
+            let g = shear_strain_of_saved(&at(e), &at(e + 1), p[[k, e, 0]], &u, inv_ds[e]);
+            axial[k * n + e] = g.z;
+            shear[k * n + e] = (g.x * g.x + g.y * g.y).sqrt();
+        }
+    }
+    let shape = [t, n];
+    Ok((
+        PyArray1::from_vec(py, axial).reshape(shape)?,
+        PyArray1::from_vec(py, shear).reshape(shape)?,
+    ))
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Cable>()?;
+    m.add_function(wrap_pyfunction!(section_strains, m)?)?;
     m.add(
         "DEFAULT_NEWTON_TOLERANCE",
         DynamicOptions::default().tolerance,

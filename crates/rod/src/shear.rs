@@ -33,6 +33,23 @@ pub fn shear_strain(
     r.transpose() * ((xb - xa) / ds) - Vector3::z() - strain0
 }
 
+/// Γ = Rᵀ (x_b − x_a)/Δs − e3 of a saved state: the edge's rotation given by a quaternion
+/// (w, u) of any length, Rᵀ v = v + k (u × (u × v) − w u × v) with k = 2/|p|² (the rotation
+/// matrix is never formed). The validity scan of results (axial and shear strains).
+#[inline]
+pub fn saved_strain(
+    xa: &Vector3<f64>,
+    xb: &Vector3<f64>,
+    w: f64,
+    u: &Vector3<f64>,
+    inv_ds: f64,
+) -> Vector3<f64> {
+    let k = 2.0 / (w * w + u.norm_squared());
+    let v = (xb - xa) * inv_ds;
+    let c = u.cross(&v);
+    v + k * (u.cross(&c) - w * c) - Vector3::z()
+}
+
 /// Strain Γ − Γ⁰ of an edge and its derivatives: the pieces from which forces, stiffness
 /// and viscous damping are assembled (static and dynamic alike).
 #[derive(Clone, Copy, Debug)]
@@ -228,6 +245,23 @@ pub fn shear_element(
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn saved_strain_is_the_element_strain_for_any_quaternion_length() {
+        let p = crate::rotation::exp_half(&Vector3::new(0.3, -0.7, 1.1));
+        let (xa, xb) = (
+            Vector3::new(0.1, 0.2, -0.3),
+            Vector3::new(0.12, 0.25, -0.28),
+        );
+        let ds = 0.05;
+        let exact = shear_strain(&xa, &xb, &p, ds, &Vector3::zeros());
+        for scale in [1.0, 3.0, 0.01] {
+            let q = p.coords * scale; // (i, j, k, w)
+            let u = Vector3::new(q[0], q[1], q[2]);
+            let got = saved_strain(&xa, &xb, q[3], &u, 1.0 / ds);
+            assert!((got - exact).amax() < 1e-14, "{scale}: {got} vs {exact}");
+        }
+    }
+
     use super::*;
     use crate::rotation::{exp_half, rotate_body};
 
