@@ -1185,6 +1185,22 @@ impl Contact {
         let half = 0.5 * (b - a).norm();
         let far = o.shape.bounding_radius();
         let slot = k * rod.n_edges() + e;
+        // An edge known to be beyond the barrier's reach by more than it moved since (every
+        // point of it moved at most as far as one of its ends): still beyond, no query; the
+        // bound is kept for the new positions, less the motion.
+        let cached = &self.cache_edges[slot];
+        if cached.far_gap > self.opts.distance
+            && !self.deep[slot]
+            && cached.position == o.position
+            && cached.rotation == o.rotation
+        {
+            let lower = cached.far_gap - (a - cached.a).norm().max((b - cached.b).norm());
+            if lower > self.opts.distance {
+                let c = &mut self.cache_edges[slot];
+                (c.a, c.b, c.far_gap) = (a, b, lower);
+                return;
+            }
+        }
         // Beyond the barrier's reach: kept with a lower bound of the edge's gap (every point of
         // the edge is within |b − a|/2 of its midpoint).
         let mut far_edge = |far_gap: f64| {
@@ -1204,17 +1220,16 @@ impl Contact {
                 return;
             }
         }
-        let mut d_mid = o.distance_within(&mid, half + reach);
-        if self.deep[slot] && d_mid >= half + reach {
+        // The bound reaches a cable radius beyond the barrier: a mesh then gives a far edge's
+        // exact distance up to there, a bound that lasts while the edge moves less.
+        let bound = half + reach + self.opts.radius;
+        let mut d_mid = o.distance_within(&mid, bound);
+        if self.deep[slot] && d_mid >= bound {
             d_mid = o.distance(&mid); // deeper inside than the bound, or far
         }
         if d_mid - half >= reach {
             // d_mid exact, or ∞ beyond the bound (a mesh)
-            let d = if d_mid.is_finite() {
-                d_mid
-            } else {
-                half + reach
-            };
+            let d = if d_mid.is_finite() { d_mid } else { bound };
             far_edge(d - half - self.opts.radius);
             return;
         }
