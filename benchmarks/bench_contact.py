@@ -29,6 +29,7 @@ sys.path.insert(0, os.path.dirname(__file__))
 from bench_dynamic import scene as dynamic_scene  # noqa: E402
 from cablelife.scene import scene_from_dict  # noqa: E402
 from cablelife.simulate import simulate  # noqa: E402
+from validity_report import run_reporting_warnings  # noqa: E402
 
 TABLE = {"shape": "plane", "name": "table", "point": [0.0, 0.0, -0.30], "normal": [0, 0, 1]}
 PIPE = {
@@ -183,4 +184,4 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    run_reporting_warnings(main)

@@ -24,6 +24,7 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 import numpy as np  # noqa: E402
 from cablelife.scene import scene_from_dict  # noqa: E402
 from cablelife.simulate import simulate  # noqa: E402
+from validity_report import run_reporting_warnings  # noqa: E402
 
 RMS = 2e-3
 BAND = (10.0, 200.0)
@@ -177,4 +178,4 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    run_reporting_warnings(main)

@@ -10,8 +10,11 @@ the engine shaken by the ISO 16750-3 engine PSD (as the demo), 1 ms steps. Print
 - a dynamic run (generalized-α, default damping and Newton tolerance) of 1 s at 1 ms steps
   through the PSD motion: real-time factor (simulated time / solver wall time; target ≥ 10×)
   and of the whole simulate() call, harness and single cable alternated.
-With --contact, also the dynamic run with a tray (a plane 6 mm below the lowest clip) under
-the harness and contact on: the harness rests on it and touches it while shaken.
+With --contact, also the dynamic run with a tray (a plane 10 mm below the lowest clip) under
+the harness and contact on: the trunk rests on it while shaken. (At 6 mm, before session 13,
+the engine's clip of branch d, which the PSD moves 3.6 mm down, pressed the branch into the
+tray: 34 % shear strain, outside the model's validity range.) The validity warnings of the
+runs (strains, impacts) are printed at the end: the figures are for valid scenes.
 One core: OpenBLAS held to one thread.
 Run: python benchmarks/bench_harness.py [--repeat K] [--contact]
 """
@@ -27,6 +30,7 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 from cablelife.scene import scene_from_dict  # noqa: E402
 from cablelife.simulate import simulate  # noqa: E402
+from validity_report import run_reporting_warnings  # noqa: E402
 
 SECTION = {"shape": "circle", "radius": 0.005}
 MATERIAL = {"youngs_modulus": 5.0e7, "poisson_ratio": 0.4, "density": 2000.0}
@@ -174,7 +178,7 @@ def main() -> None:
     if "--contact" in sys.argv:
         # The harness only: the single cable's span sags 38 cm below the tray's height (a
         # push-out that deep fails; docs/contact.md), it would need a tray of its own.
-        tray = {"shape": "plane", "name": "tray", "point": [0, 0, -0.106], "normal": [0, 0, 1]}
+        tray = {"shape": "plane", "name": "tray", "point": [0, 0, -0.110], "normal": [0, 0, 1]}
         d = scene("dynamic", 1.0)
         d["bodies"].append({"name": "tray", "geometry": [tray]})
         d["contact"] = {"enabled": True}
@@ -186,4 +190,4 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    run_reporting_warnings(main)
