@@ -526,7 +526,7 @@ impl HarnessStatics {
             if self.tail_factored && self.tail_end[e.cable][s] == Some(k) {
                 // x = A⁻¹(r + B d): B d enters the in-sweep at the tail alone, then the way back.
                 let rev = e.topo.at_start;
-                let (last, _) = BlockTridiag::tail_blocks(&range, rev);
+                let (last, prev) = BlockTridiag::tail_blocks(&range, rev);
                 let eb = &self.held[e.cable].ends[e.local];
                 let (mut u_last, mut u_prev) = (Vector6::zeros(), Vector6::zeros());
                 for (i, &b) in e.topo.blocks().iter().enumerate() {
@@ -540,7 +540,6 @@ impl HarnessStatics {
                 let jac = &self.ws[e.cable].jac;
                 let x = &mut out[e.cable];
                 let (w_last, w_prev) = jac.sweep_in_tail(&range, rev, &u_last, &u_prev);
-                let prev = BlockTridiag::tail_blocks(&range, rev).1;
                 // `out` holds −y here.
                 x[last] -= w_last;
                 x[prev] -= w_prev;
@@ -1104,7 +1103,6 @@ impl HarnessStatics {
     }
 }
 
-/// `e` of cable `c` of `h`, naming the cable.
 /// Per cable segment: its junction end if it is the segment's only one and couples to the
 /// two blocks that the segment's elimination towards it takes last (`tail_end`).
 fn tail_ends(h: &Harness) -> Vec<Vec<Option<usize>>> {
@@ -1135,6 +1133,7 @@ fn tail_ends(h: &Harness) -> Vec<Vec<Option<usize>>> {
         .collect()
 }
 
+/// `e` of cable `c` of `h`, naming the cable.
 pub(crate) fn cable_error(h: &Harness, c: usize, e: SolveError) -> HarnessError {
     HarnessError(format!("cable '{}': {e}", h.names[c]))
 }
