@@ -129,15 +129,16 @@ def obstacles(scene) -> tuple[list, list, list[tuple[np.ndarray, np.ndarray]]]:
     return tuples, frames, meshes
 
 
-def obstacle_poses(scene, times: np.ndarray, frames: list, bodies: list[int]):
+def obstacle_poses(scene, times: np.ndarray, frames: list, bodies: list[int], motions=None):
     """Global positions (T, O, 3) and orientations (T, O, 4, scalar first) of the obstacles on
-    ``times``: each frame at rest moved with its body (simulate.body_motions, as the clips and
-    the clearance): x = o + u + R (X − o)."""
+    ``times``: each frame at rest moved with its body (simulate.body_motions on ``times``, as
+    the clips and the clearance, or ``motions`` computed so already): x = o + u + R (X − o)."""
     from scipy.spatial.transform import Rotation
 
     from cablelife.simulate import body_motions
 
-    motions = body_motions(scene, times)
+    if motions is None:
+        motions = body_motions(scene, times)
     n_t = times.size
     pos = np.zeros((n_t, len(frames), 3))
     axes = np.zeros((n_t, len(frames), 3, 3))
@@ -155,14 +156,15 @@ def obstacle_poses(scene, times: np.ndarray, frames: list, bodies: list[int]):
     return pos, quats.reshape(n_t, len(frames), 4)
 
 
-def set_contact(core, scene, cable, times: np.ndarray) -> None:
-    """Adds the contact term to the Rust cable ``core`` if ``[contact]`` is enabled."""
+def set_contact(core, scene, cable, times: np.ndarray, motions=None) -> None:
+    """Adds the contact term to the Rust cable ``core`` if ``[contact]`` is enabled (the
+    bodies' ``motions`` on ``times`` if already computed: simulate.body_motions)."""
     c = scene.contact
     if c is None or not c.enabled:
         return
     check_geometry(scene)
     tuples, frames, meshes = obstacles(scene)
-    pos, quat = obstacle_poses(scene, times, frames, [t[1] for t in tuples])
+    pos, quat = obstacle_poses(scene, times, frames, [t[1] for t in tuples], motions)
     core.set_contact(
         tuples,
         len(scene.bodies) + 1,

@@ -234,9 +234,10 @@ def run_harness(scene: Scene, times: np.ndarray, mode: str, progress, stop):
         )
     cables, specs = harness_cables(scene)
     cores = [build_cable(scene, c) for c in cables]
+    motions = body_motions(scene, times)  # once for all cables (clips and obstacles)
     for c, co in zip(cables, cores, strict=True):  # each cable's contact: a harness term
         try:
-            set_contact(co, scene, c, times)
+            set_contact(co, scene, c, times, motions)
         except ValueError as err:
             raise SceneError(f"cable '{c.name}': {err}") from None
     try:
@@ -249,7 +250,6 @@ def run_harness(scene: Scene, times: np.ndarray, mode: str, progress, stop):
         )
     except ValueError as err:
         raise SceneError(f"harness: {err}") from None
-    motions = body_motions(scene, times)  # once for all cables
     kin = [clip_kinematics(scene, c, times, motions=motions) for c in cables]
     poses = [(k["positions"], k["quaternions"]) for k in kin]
     callback = (lambda k, n: progress("harness", k, n)) if progress else None
