@@ -339,7 +339,32 @@ fn coupled_jacobian_matches_finite_differences() {
 /// at its end) and with the A⁻¹ B columns of every end; the two agree to round-off.
 #[test]
 fn tree_elimination_solves_the_coupled_system() {
-    let h = two_junctions(7);
+    // As built, and with a fixed clip in the middle of the link between the junctions: its two
+    // segments are then branches too (one joined at its start, one at its end).
+    tree_elimination_both_ways(&two_junctions(7), (4, 2));
+    let mut h = two_junctions(7);
+    let mut spec = h.cables[1].spec.clone();
+    let (a, b) = (&spec.clips[0].pose, &spec.clips[1].pose);
+    let middle = ClipSpec {
+        name: "m".into(),
+        s: 0.5 * spec.length,
+        length: 0.0,
+        kind: ClipKind::Fixed,
+        pose: Pose {
+            position: 0.5 * (a.position + b.position),
+            orientation: a.orientation,
+        },
+    };
+    spec.clips.push(middle); // after the ends: the junctions name the ends by index
+    h.cables[1] = Rod::new(spec).unwrap();
+    let h = Harness::new(names(5), h.cables.clone(), h.junctions.clone()).unwrap();
+    tree_elimination_both_ways(&h, (6, 3));
+}
+
+/// The tree solve with and without the tail path for branches; `tails`: (ends on it, of
+/// them at a cable's start).
+fn tree_elimination_both_ways(h: &Harness, tails: (usize, usize)) {
+    let h = h.clone();
     let (st, _, _) = perturbed(&h);
     let mut corrections = Vec::new();
     for tail in [true, false] {
@@ -359,7 +384,7 @@ fn tree_elimination_solves_the_coupled_system() {
         let starts = (0..h.ends.len()).filter(|&k| on_tail[k] && h.ends[k].topo.at_start);
         assert_eq!(
             (on_tail.iter().filter(|&&t| t).count(), starts.count()),
-            if tail { (4, 2) } else { (0, 0) }
+            if tail { tails } else { (0, 0) }
         );
         s.newton_correction(&h);
         let (d, dj) = s.correction();
