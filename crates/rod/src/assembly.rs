@@ -752,23 +752,19 @@ impl Workspace {
     }
 
     /// `factor_segment` eliminating towards the segment's first block with `rev`
-    /// (`BlockTridiag::factor_range_rev`).
+    /// (`BlockTridiag::factor_range_dir`).
     pub fn factor_segment_dir(
         &mut self,
         rod: &Rod,
         seg: &Segment,
         rev: bool,
     ) -> Result<(), SolveError> {
-        let blocks = seg.blocks.clone();
-        if rev {
-            self.jac.factor_range_rev(blocks)
-        } else {
-            self.jac.factor_range(blocks)
-        }
-        .map_err(|Singular { block }| SolveError::Singular {
-            node: block,
-            s: rod.arc[block.min(rod.arc.len() - 1)],
-        })
+        self.jac
+            .factor_range_dir(seg.blocks.clone(), rev)
+            .map_err(|Singular { block }| SolveError::Singular {
+                node: block,
+                s: rod.arc[block.min(rod.arc.len() - 1)],
+            })
     }
 
     /// The Newton correction Δ = −J⁻¹ r with the current factorisation, and its largest

@@ -116,41 +116,37 @@ impl BlockTridiag {
     /// Factors the diagonal part of blocks `r` (an independent system: the coupling blocks to
     /// the blocks outside are zero).
     pub fn factor_range(&mut self, r: Range<usize>) -> Result<(), Singular> {
-        for b in r.clone() {
-            let mut d = self.diag[b];
-            if b > r.start {
-                d -= mul6(&self.lower[b], &self.elim[b - 1]);
-            }
-            let inv = self.pivot_inverse(b, d)?;
-            self.inv[b] = inv;
-            if b > r.start {
-                self.inv_lower[b] = mul6(&inv, &self.lower[b]);
-            }
-            if b + 1 < r.end {
-                self.elim[b] = mul6(&inv, &self.upper[b]);
-            }
-        }
-        Ok(())
+        self.factor_range_dir(r, false)
     }
 
-    /// `factor_range` in the other direction (block UL): the blocks eliminated from the last
-    /// to the first, so that the first block's pivot carries the whole range. Then `inv_lower`
-    /// holds D'⁻¹U (the in-sweep, from the last block) and `elim` D'⁻¹L (the out-sweep). A
-    /// coupling at the range's start then reaches a Schur complement through the first two
-    /// blocks alone (`solve_tail`).
-    pub fn factor_range_rev(&mut self, r: Range<usize>) -> Result<(), Singular> {
-        for b in r.clone().rev() {
+    /// `factor_range` eliminating from the first block to the last (`rev` false: block LU) or
+    /// from the last to the first (`rev` true: block UL, so that the first block's pivot
+    /// carries the whole range and a coupling at the range's start reaches a Schur complement
+    /// through the first two blocks alone, `solve_tail`). `inv_lower` holds D'⁻¹ times the
+    /// coupling to the block eliminated before (the in-sweep), `elim` D'⁻¹ times the coupling
+    /// to the one eliminated after (the out-sweep).
+    pub fn factor_range_dir(&mut self, r: Range<usize>, rev: bool) -> Result<(), Singular> {
+        let n = r.len();
+        for k in 0..n {
+            let b = if rev { r.end - 1 - k } else { r.start + k };
+            // Couplings to the blocks eliminated before and after b.
+            let (before, after) = if rev {
+                (&self.upper[b], &self.lower[b])
+            } else {
+                (&self.lower[b], &self.upper[b])
+            };
             let mut d = self.diag[b];
-            if b + 1 < r.end {
-                d -= mul6(&self.upper[b], &self.elim[b + 1]);
+            if k > 0 {
+                let prev = if rev { b + 1 } else { b - 1 };
+                d -= mul6(before, &self.elim[prev]);
             }
             let inv = self.pivot_inverse(b, d)?;
             self.inv[b] = inv;
-            if b + 1 < r.end {
-                self.inv_lower[b] = mul6(&inv, &self.upper[b]);
+            if k > 0 {
+                self.inv_lower[b] = mul6(&inv, before);
             }
-            if b > r.start {
-                self.elim[b] = mul6(&inv, &self.lower[b]);
+            if k + 1 < n {
+                self.elim[b] = mul6(&inv, after);
             }
         }
         Ok(())
@@ -287,14 +283,14 @@ impl BlockTridiag {
         self.solve_range_dir(r, false, rhs);
     }
 
-    /// `solve_range` with the factors of `factor_range` (`rev` false) or `factor_range_rev`.
+    /// `solve_range` with the factors of `factor_range_dir`.
     pub fn solve_range_dir(&self, r: Range<usize>, rev: bool, rhs: &mut [Vector6<f64>]) {
         self.sweep_in(r.clone(), rev, rhs);
         self.sweep_out(r, rev, rhs);
     }
 
-    /// The first half of a solve with the factors of `factor_range` (`rev` false) or
-    /// `factor_range_rev` (true), towards the block eliminated last:
+    /// The first half of a solve with the factors of `factor_range_dir`, towards the block
+    /// eliminated last:
     /// y_b = D'_b⁻¹ r_b − (D'_b⁻¹ L_b) y_{b−1} (reversed: U_b and y_{b+1}).
     pub fn sweep_in(&self, r: Range<usize>, rev: bool, rhs: &mut [Vector6<f64>]) {
         if r.is_empty() {
@@ -720,11 +716,7 @@ mod tests {
         let mut b = vec![Vector6::zeros(); n];
         sub.mul(&x, &mut b);
         for rev in [false, true] {
-            if rev {
-                j.factor_range_rev(r.clone()).unwrap();
-            } else {
-                j.factor_range(r.clone()).unwrap();
-            }
+            j.factor_range_dir(r.clone(), rev).unwrap();
             let mut y = b.clone();
             j.sweep_in(r.clone(), rev, &mut y);
             let (t_last, t_prev) = j.tail_of(&r, rev, &y);

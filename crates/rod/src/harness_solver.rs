@@ -361,15 +361,9 @@ impl HarnessStatics {
                 let range = &h.cables[e.cable].segments[s].blocks;
                 let rev = e.topo.at_start;
                 let (last, _) = BlockTridiag::tail_blocks(range, rev);
-                let (mut b_last, mut b_prev) = (Matrix6::zeros(), Matrix6::zeros());
-                for (i, &b) in blocks.iter().enumerate() {
-                    let bk = cols_to_junction(&eb.ce[i], &e.rel);
-                    if b == last {
-                        b_last += bk;
-                    } else {
-                        b_prev += bk;
-                    }
-                }
+                let (b_last, b_prev) = onto_tail(blocks, last, Matrix6::zeros(), |i| {
+                    cols_to_junction(&eb.ce[i], &e.rel)
+                });
                 let (x_last, x_prev) = self.ws[e.cable]
                     .jac
                     .solve_tail(range, rev, &b_last, &b_prev);
@@ -528,15 +522,9 @@ impl HarnessStatics {
                 let rev = e.topo.at_start;
                 let (last, prev) = BlockTridiag::tail_blocks(&range, rev);
                 let eb = &self.held[e.cable].ends[e.local];
-                let (mut u_last, mut u_prev) = (Vector6::zeros(), Vector6::zeros());
-                for (i, &b) in e.topo.blocks().iter().enumerate() {
-                    let u = cols_to_junction(&eb.ce[i], &e.rel) * d;
-                    if b == last {
-                        u_last += u;
-                    } else {
-                        u_prev += u;
-                    }
-                }
+                let (u_last, u_prev) = onto_tail(e.topo.blocks(), last, Vector6::zeros(), |i| {
+                    cols_to_junction(&eb.ce[i], &e.rel) * d
+                });
                 let jac = &self.ws[e.cable].jac;
                 let x = &mut out[e.cable];
                 let (w_last, w_prev) = jac.sweep_in_tail(&range, rev, &u_last, &u_prev);
@@ -1101,6 +1089,25 @@ impl HarnessStatics {
             })
             .collect()
     }
+}
+
+/// An end's two coupling parts `part(i)` (at its blocks `topo.blocks()`, within the tail of
+/// its segment) summed onto the tail: (at the block eliminated last, at the one before).
+fn onto_tail<T: Copy + std::ops::AddAssign>(
+    blocks: [usize; 2],
+    last: usize,
+    zero: T,
+    part: impl Fn(usize) -> T,
+) -> (T, T) {
+    let (mut at_last, mut at_prev) = (zero, zero);
+    for (i, &b) in blocks.iter().enumerate() {
+        if b == last {
+            at_last += part(i);
+        } else {
+            at_prev += part(i);
+        }
+    }
+    (at_last, at_prev)
 }
 
 /// Per cable segment: its junction end if it is the segment's only one and couples to the
