@@ -307,10 +307,11 @@ def test_modes_and_damping_calibration_rest_on_the_table(scene_dict):
 
 
 def test_an_unresolved_impact_is_a_warning_and_is_saved(scene_dict, tmp_path, monkeypatch):
-    """The path of the step guard's report of impacts it had to accept unresolved (its physics:
-    the report equals the step's energy balance, crates/rod/src/harness_dynamics_contact_tests.rs)
-    to the user: a run whose solver reports a gain gives an ImpactWarning naming the cable, the
-    largest gain and when, and keeps the gains in the result file; a run without gives none.
+    """The path of the step guard's report of impacts it gave back or had to accept unresolved
+    (its physics: the reports equal the step's energy balance,
+    crates/rod/src/harness_dynamics_contact_tests.rs) to the user: a run whose solver reports
+    a gain gives an ImpactWarning per kind naming the cable, the largest gain and when, and
+    keeps the gains in the result file; a run without gives none.
     The solver's output is given a reported gain here, so that the test does not hang on an
     impact that one solver version happens not to resolve."""
     import importlib
@@ -321,7 +322,8 @@ def test_an_unresolved_impact_is_a_warning_and_is_saved(scene_dict, tmp_path, mo
     sim = importlib.import_module("cablelife.simulate")  # the module, not the function
 
     class Reporting:
-        """A cable whose dynamic run reports an unresolved gain of 0.88 % at its 5th step."""
+        """A cable whose dynamic run reports an unresolved gain of 0.88 % at its 5th step and a
+        given-back gain of 0.42 % at its 3rd."""
 
         def __init__(self, core):
             self._core = core
@@ -332,6 +334,7 @@ def test_an_unresolved_impact_is_a_warning_and_is_saved(scene_dict, tmp_path, mo
         def run_dynamic(self, *args, **kwargs):
             out = self._core.run_dynamic(*args, **kwargs)
             out["unresolved_gain"][5] = 0.0088
+            out["impact_dissipation"][3] = 0.0042
             return out
 
     d = with_table(scene_dict, friction=0.3)
@@ -341,16 +344,20 @@ def test_an_unresolved_impact_is_a_warning_and_is_saved(scene_dict, tmp_path, mo
         calm = simulate(scene_from_dict(d)).cable
     assert calm.solver["unresolved_gain"].shape == (calm.n_steps,)
     assert np.all(calm.solver["unresolved_gain"] == 0.0)
+    assert calm.solver["impact_dissipation"].shape == (calm.n_steps,)
+    assert np.all(calm.solver["impact_dissipation"] == 0.0)
     build = sim.build_cable
     monkeypatch.setattr(sim, "build_cable", lambda scene, cable: Reporting(build(scene, cable)))
     with pytest.warns(ImpactWarning, match=r"cable 'hose': an impact .* in 1 saved step") as rec:
         result = simulate(scene_from_dict(d))
-    (message,) = [str(w.message) for w in rec if w.category is ImpactWarning]
-    assert "0.88 %" in message and "t = 0.005 s" in message
+    given, accepted = [str(w.message) for w in rec if w.category is ImpactWarning]
+    assert "0.42 %" in given and "t = 0.003 s" in given and "given back" in given
+    assert "0.88 %" in accepted and "t = 0.005 s" in accepted and "not reliable" in accepted
     back = load_result(result.save(tmp_path / "r.h5")).cable
-    gains = result.cable.solver["unresolved_gain"]
-    np.testing.assert_array_equal(back.solver["unresolved_gain"], gains)
-    assert back.solver["unresolved_gain"][5] == 0.0088
+    for key, k, value in (("unresolved_gain", 5, 0.0088), ("impact_dissipation", 3, 0.0042)):
+        np.testing.assert_array_equal(back.solver[key], result.cable.solver[key])
+        assert back.solver[key][k] == value
+        assert np.count_nonzero(back.solver[key]) == 1
 
 
 def test_impact_message_names_the_worst_step():
@@ -360,3 +367,11 @@ def test_impact_message_names_the_worst_step():
     assert impact_messages("cable 'x'", np.zeros(4), times) == []
     (m,) = impact_messages("cable 'x'", np.array([0.0, 2e-3, 0.0, 5e-2]), times)
     assert "in 2 saved step(s)" in m and "5 %" in m and "t = 0.3 s" in m
+    assert "accepted" in m and "given back" not in m
+    given, accepted = impact_messages(
+        "cable 'x'", np.array([0.0, 0.0, 3e-3, 0.0]), times, np.array([1e-2, 0.0, 0.0, 2e-3])
+    )
+    assert "in 2 saved step(s)" in given and "1 %" in given and "t = 0 s" in given
+    assert "given back" in given and "accepted" not in given
+    assert "in 1 saved step(s)" in accepted and "0.3 %" in accepted and "t = 0.2 s" in accepted
+    assert impact_messages("cable 'x'", np.zeros(4), times, np.zeros(4)) == []

@@ -377,6 +377,12 @@ def test_an_unresolved_impact_is_in_the_report_as_on_the_terminal(dynamic_files)
     c = res.cable
     c.solver["unresolved_gain"] = np.zeros(c.n_steps)
     c.solver["unresolved_gain"][7] = 0.0123
+    c.solver["impact_dissipation"] = np.zeros(c.n_steps)
+    c.solver["impact_dissipation"][2] = 0.0031
     page = build_report([ReportRun("D", res)], voxel=None, frames=2)
-    (message,) = impact_messages("cable 'hose'", c.solver["unresolved_gain"], c.time)
-    assert html.escape(message) in page
+    messages = impact_messages(
+        "cable 'hose'", c.solver["unresolved_gain"], c.time, c.solver["impact_dissipation"]
+    )
+    assert len(messages) == 2
+    for message in messages:
+        assert html.escape(message) in page

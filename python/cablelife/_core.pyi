@@ -81,9 +81,10 @@ class Cable:
         angular velocities, accelerations, angular accelerations (global). Every
         `output_every`-th step is recorded (and step 0). τ: retardation times (GA₁, GA₂, EA),
         (EI₁, EI₂, GJ). Returns the recorded arrays, energies and `error` as `run_sequence`,
-        and `unresolved_gain` (T,): the largest energy gain, relative to the energies at play,
-        of an impact sub-step the step guard accepted at its deepest split since the last
-        recorded step (0: none); `stop` as there.
+        and `unresolved_gain`, `impact_dissipation` (T,): the largest energy gain, relative to
+        the energies at play, of an impact sub-step at the step guard's deepest split since the
+        last recorded step that it accepted (the motion held less) and that it gave back from
+        the motion near the contact (0: none); `stop` as there.
         """
         ...
     def run_sequence(
@@ -201,7 +202,8 @@ class Harness:
         `tau_bend[c]` (3 each). Returns what `run_sequence` returns, the cables' dicts with the
         energies of `Cable.run_dynamic`, and `junction_velocities` (T, J, 6: ẋ global, ω body),
         `kinetic_energy`, `elastic_energy`, `load_potential`, `dissipated_energy` (T,) of the
-        whole harness (junctions included), `unresolved_gain` (T,) as `Cable.run_dynamic`.
+        whole harness (junctions included), `unresolved_gain`, `impact_dissipation` (T,) as
+        `Cable.run_dynamic`.
         Junctions held by a clip follow its motion (given for their first end); sliding clips
         slide (a cable running out of one stops the run).
         """

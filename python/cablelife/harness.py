@@ -368,9 +368,14 @@ def run_harness(scene: Scene, times: np.ndarray, mode: str, progress, stop):
         from cablelife import validity
 
         gains = np.asarray(out["unresolved_gain"])
+        given_back = np.asarray(out["impact_dissipation"])
         for res in results.values():
             res.solver["unresolved_gain"] = gains
-        validity.report(validity.impact_messages("harness", gains, saved), validity.ImpactWarning)
+            res.solver["impact_dissipation"] = given_back
+        validity.report(
+            validity.impact_messages("harness", gains, saved, given_back),
+            validity.ImpactWarning,
+        )
     junctions: dict[str, JunctionResult] = {}
     ends = core.ends
     for jj, j in enumerate(scene.junctions):

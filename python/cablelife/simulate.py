@@ -419,8 +419,14 @@ def _run_cable(
 
         solver["viscous_peak"] = np.asarray(out["viscous_peak"])
         solver["unresolved_gain"] = np.asarray(out["unresolved_gain"])
+        solver["impact_dissipation"] = np.asarray(out["impact_dissipation"])
         validity.report(
-            validity.impact_messages(f"cable '{cable.name}'", solver["unresolved_gain"], saved[:n]),
+            validity.impact_messages(
+                f"cable '{cable.name}'",
+                solver["unresolved_gain"],
+                saved[:n],
+                solver["impact_dissipation"],
+            ),
             validity.ImpactWarning,
         )
         energies.update(

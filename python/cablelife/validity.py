@@ -160,23 +160,43 @@ def snap_events(
     }
 
 
-def impact_messages(name: str, gains: np.ndarray, times: np.ndarray) -> list[str]:
-    """The warning for impacts the dynamic step guard accepted unresolved: ``gains`` (T,) per
-    saved step, the largest energy gain of a sub-step split down to the deepest level (1/64
-    of the time step) since the saved step before, relative to the energies at play; 0 where
-    none gained more than the guard's tolerance (docs/contact.md)."""
-    gains = np.asarray(gains, dtype=float)
-    bad = np.flatnonzero(gains > 0.0)
-    if bad.size == 0:
-        return []
-    k = int(bad[np.argmax(gains[bad])])
-    return [
-        f"{name}: an impact on the geometry is not resolved by the time step in {bad.size} "
-        f"saved step(s): split down to 1/64 of the step, a sub-step still gained up to "
-        f"{100 * gains[k]:.3g} % of the energies at play (by t = {times[k]:.4g} s) and was "
-        "accepted; the contact forces and the motion right after these impacts are not "
-        "reliable (compare a run with another time_step or contact damping; docs/contact.md)"
-    ]
+def impact_messages(
+    name: str, gains: np.ndarray, times: np.ndarray, given_back: np.ndarray | None = None
+) -> list[str]:
+    """The warnings for impacts the dynamic time step does not resolve (docs/contact.md): per
+    saved step (T,), the largest energy gain, relative to the energies at play, of a sub-step
+    split down to the deepest level (1/64 of the time step) since the saved step before, 0
+    where none gained more than the guard's tolerance — ``given_back`` the gains the guard gave
+    back from the motion near the contact (counted as dissipated), ``gains`` those it had to
+    accept unresolved (the motion held less)."""
+    out = []
+    for values, what in (
+        (
+            given_back,
+            "and was given back from the cable's motion near the contact (counted as dissipated "
+            "energy: no step gains energy); the motion right after these impacts carries that "
+            "correction (compare a run with a smaller time_step; docs/contact.md)",
+        ),
+        (
+            gains,
+            "and was accepted: the cable's motion held less energy than the gain; the contact "
+            "forces and the motion right after these impacts are not reliable (compare a run "
+            "with another time_step or contact damping; docs/contact.md)",
+        ),
+    ):
+        if values is None:
+            continue
+        values = np.asarray(values, dtype=float)
+        bad = np.flatnonzero(values > 0.0)
+        if bad.size == 0:
+            continue
+        k = int(bad[np.argmax(values[bad])])
+        out.append(
+            f"{name}: an impact on the geometry is not resolved by the time step in {bad.size} "
+            f"saved step(s): split down to 1/64 of the step, a sub-step still gained up to "
+            f"{100 * values[k]:.3g} % of the energies at play (by t = {times[k]:.4g} s) {what}"
+        )
+    return out
 
 
 def report(messages: list[str], category: type[Warning]) -> None:

@@ -46,6 +46,30 @@ fn quat(v: &[f64], what: &str) -> PyResult<Quaternion<f64>> {
 /// (name, s, length, kind, position[3], quaternion[4] scalar first).
 type ClipTuple = (String, f64, f64, String, Vec<f64>, Vec<f64>);
 
+/// The largest unresolved and given-back impact gains (`StepStats::unresolved_gain`,
+/// `impact_dissipation`) of the steps since the last saved step.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct Impacts {
+    unresolved: f64,
+    dissipation: f64,
+}
+
+impl Impacts {
+    pub(crate) fn add(&mut self, s: &rod::StepStats) {
+        self.unresolved = self.unresolved.max(s.unresolved_gain);
+        self.dissipation = self.dissipation.max(s.impact_dissipation);
+    }
+
+    /// The gains so far (unresolved, given back), starting afresh.
+    pub(crate) fn take(&mut self) -> (f64, f64) {
+        let Impacts {
+            unresolved,
+            dissipation,
+        } = std::mem::take(self);
+        (unresolved, dissipation)
+    }
+}
+
 /// Per-step outputs collected during a run (flat, row-major).
 #[derive(Default)]
 pub(crate) struct Record {
@@ -62,6 +86,10 @@ pub(crate) struct Record {
     /// Dynamic runs: per saved step, the largest energy gain of an impact sub-step the step
     /// guard accepted at its deepest split since the last saved step (`StepStats::unresolved_gain`).
     unresolved_gain: Vec<f64>,
+    /// Dynamic runs: per saved step, the largest energy gain of such a sub-step that the guard
+    /// gave back from the motion near the contact since the last saved step
+    /// (`StepStats::impact_dissipation`).
+    impact_dissipation: Vec<f64>,
     /// Negative eigenvalues of the tangent stiffness (−1: not checked: dynamic steps, dead
     /// moments).
     unstable: Vec<i64>,
@@ -105,6 +133,7 @@ impl Record {
             substeps: Vec::with_capacity(n),
             residual: Vec::with_capacity(n),
             unresolved_gain: Vec::with_capacity(n),
+            impact_dissipation: Vec::with_capacity(n),
             unstable: Vec::with_capacity(n),
             snap_fraction: Vec::with_capacity(n),
             snap_jump: Vec::with_capacity(n),
@@ -159,9 +188,11 @@ impl Record {
         self.contact_energy.push(ws.contact_energy);
     }
 
-    /// The unresolved impact gain of the saved step just pushed (dynamic runs).
-    pub(crate) fn push_unresolved(&mut self, gain: f64) {
-        self.unresolved_gain.push(gain);
+    /// The impact gains of the saved step just pushed (dynamic runs): the largest unresolved
+    /// and given-back gains since the saved step before (`Impacts::take`).
+    pub(crate) fn push_impacts(&mut self, (unresolved, dissipation): (f64, f64)) {
+        self.unresolved_gain.push(unresolved);
+        self.impact_dissipation.push(dissipation);
     }
 
     /// The slid length of every clip at the step just pushed.
@@ -250,6 +281,10 @@ impl Record {
             d.set_item(
                 "unresolved_gain",
                 PyArray1::from_vec(py, self.unresolved_gain),
+            )?;
+            d.set_item(
+                "impact_dissipation",
+                PyArray1::from_vec(py, self.impact_dissipation),
             )?;
         }
         d.set_item("unstable", PyArray1::from_vec(py, self.unstable))?;
@@ -773,9 +808,10 @@ impl Cable {
     /// angular velocities, accelerations, angular accelerations (global). Every
     /// `output_every`-th step is recorded (and step 0). τ: retardation times (GA₁, GA₂, EA),
     /// (EI₁, EI₂, GJ). Returns the recorded arrays, energies and `error` as `run_sequence`,
-    /// and `unresolved_gain` (T,): the largest energy gain, relative to the energies at play,
-    /// of an impact sub-step the step guard accepted at its deepest split since the last
-    /// recorded step (0: none); `stop` as there.
+    /// and `unresolved_gain`, `impact_dissipation` (T,): the largest energy gain, relative to
+    /// the energies at play, of an impact sub-step at the step guard's deepest split since the
+    /// last recorded step that it accepted (the motion held less) and that it gave back from
+    /// the motion near the contact (0: none); `stop` as there.
     #[pyo3(signature = (time_step, positions, quaternions, velocities, angular_velocities,
         accelerations, angular_accelerations, output_every, tau_shear, tau_bend,
         spectral_radius=0.9, newton_tolerance=DynamicOptions::default().tolerance, progress=None,
@@ -890,18 +926,18 @@ impl Cable {
             rec.push(rod, &st, &dy.ws, &stats);
             rec.push_sliding(rod, dy.sliding.as_ref());
             rec.push_energies(&dy.energies);
-            rec.push_unresolved(0.0);
+            rec.push_impacts((0.0, 0.0));
             if let Some(c) = &dy.contact {
                 rec.push_contact(c);
             }
-            let mut gain = 0.0f64; // the largest unresolved impact gain since the last saved step
+            let mut impacts = Impacts::default();
             for k in 1..t {
                 if let (Some(c), Some(p)) = (&mut dy.contact, obstacle_at(obstacle_poses, k)) {
                     c.set_obstacle_poses(p);
                 }
                 match dy.advance(rod, &mut st, time_step, &motions[k - 1], &motions[k], 6) {
                     Ok(s) => {
-                        gain = gain.max(s.unresolved_gain);
+                        impacts.add(&s);
                         if k % every == 0 {
                             if let Err(e) = dy.update_outputs(rod, &st) {
                                 *state_slot = Some(st);
@@ -917,7 +953,7 @@ impl Cable {
                             rec.push_sliding(rod, dy.sliding.as_ref());
                             rec.push_viscous(&dy.ws);
                             rec.push_energies(&dy.energies);
-                            rec.push_unresolved(std::mem::take(&mut gain));
+                            rec.push_impacts(impacts.take());
                             if let Some(c) = &dy.contact {
                                 rec.push_contact(c);
                             }

@@ -1,6 +1,8 @@
 //! Bindings of the harness solver (docs/harness.md): cables joined at junctions, static and
 //! quasistatic sequences. Runs release the GIL, poll Ctrl-C and report progress like `Cable`.
-use crate::cable::{obstacle_at, read_poses, retardation_times, vec3, Cable, Record, BOTH_TAUS};
+use crate::cable::{
+    obstacle_at, read_poses, retardation_times, vec3, Cable, Impacts, Record, BOTH_TAUS,
+};
 use crate::stop::{Poller, StopFlag};
 use nalgebra::Vector3;
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray3};
@@ -454,7 +456,8 @@ impl Harness {
     /// `tau_bend[c]` (3 each). Returns what `run_sequence` returns, the cables' dicts with the
     /// energies of `Cable.run_dynamic`, and `junction_velocities` (T, J, 6: ẋ global, ω body),
     /// `kinetic_energy`, `elastic_energy`, `load_potential`, `dissipated_energy` (T,) of the
-    /// whole harness (junctions included), `unresolved_gain` (T,) as `Cable.run_dynamic`.
+    /// whole harness (junctions included), `unresolved_gain`, `impact_dissipation` (T,) as
+    /// `Cable.run_dynamic`.
     /// Junctions held by a clip follow its motion (given for their first end); sliding clips
     /// slide (a cable running out of one stops the run).
     #[pyo3(signature = (time_step, kinematics, output_every, tau_shear, tau_bend,
@@ -611,6 +614,7 @@ impl Harness {
             substeps: Vec<i64>,
             residual: Vec<f64>,
             unresolved_gain: Vec<f64>,
+            impact_dissipation: Vec<f64>,
             steps: usize,
         }
         let (out, error) = py.detach(move || {
@@ -632,6 +636,7 @@ impl Harness {
                 substeps: Vec::with_capacity(saved),
                 residual: Vec::with_capacity(saved),
                 unresolved_gain: Vec::with_capacity(saved),
+                impact_dissipation: Vec::with_capacity(saved),
                 steps: 0,
             };
             if t == 0 {
@@ -676,7 +681,7 @@ impl Harness {
                           hd: &HarnessDynamics,
                           st: &HarnessState,
                           s: &rod::SolveStats,
-                          gain: f64| {
+                          (unresolved, dissipation): (f64, f64)| {
                 for (c, rod) in tree.cables.iter().enumerate() {
                     let dy = &hd.cables[c];
                     let rec = &mut out.records[c];
@@ -714,11 +719,12 @@ impl Harness {
                 out.iterations.push(s.iterations as i64);
                 out.substeps.push(s.substeps as i64);
                 out.residual.push(s.residual);
-                out.unresolved_gain.push(gain);
+                out.unresolved_gain.push(unresolved);
+                out.impact_dissipation.push(dissipation);
                 out.steps += 1;
             };
-            record(&mut out, &hd, &st, &stats, 0.0);
-            let mut gain = 0.0f64; // the largest unresolved impact gain since the last saved step
+            record(&mut out, &hd, &st, &stats, (0.0, 0.0));
+            let mut impacts = Impacts::default();
             for k in 1..t {
                 for (c, dy) in hd.cables.iter_mut().enumerate() {
                     if let (Some(c), Some(p)) =
@@ -729,7 +735,7 @@ impl Harness {
                 }
                 match hd.advance(tree, &mut st, time_step, &motions[k - 1], &motions[k], 6) {
                     Ok(s) => {
-                        gain = gain.max(s.unresolved_gain);
+                        impacts.add(&s);
                         if k % every == 0 {
                             if let Err(e) = hd.update_outputs(tree, &st) {
                                 return (out, Some(format!("step {k}: {e}")));
@@ -740,7 +746,7 @@ impl Harness {
                                 substeps: s.substeps - 1,
                                 ..Default::default()
                             };
-                            record(&mut out, &hd, &st, &stats, std::mem::take(&mut gain));
+                            record(&mut out, &hd, &st, &stats, impacts.take());
                         }
                     }
                     Err(e) => {
@@ -777,6 +783,10 @@ impl Harness {
         d.set_item(
             "unresolved_gain",
             PyArray1::from_vec(py, out.unresolved_gain),
+        )?;
+        d.set_item(
+            "impact_dissipation",
+            PyArray1::from_vec(py, out.impact_dissipation),
         )?;
         d.set_item("steps", n)?;
         d.set_item("error", error)?;

@@ -18,6 +18,7 @@
 use crate::assembly::{Elastic, Eval, External, KinkAt, Part, Rates, Term, Workspace};
 use crate::block_tridiag::BlockTridiag;
 use crate::contact::Contact;
+use crate::impact::take_gain;
 use crate::model::{EdgeKind, NodeKind, Pose, Rod, Segment};
 use crate::rotation::{log_vec, right_jacobian, rotate_body, rotation_matrix, skew, slerp, Quat};
 use crate::sliding::{SlidingClips, STICK_TOLERANCE};
@@ -165,8 +166,12 @@ pub struct StepStats {
     pub substeps: usize,
     /// The largest energy gain, relative to the energies at play, of a sub-step near the
     /// geometry that the step guard had to accept at its deepest split (an impact the time
-    /// step does not resolve); 0 if none gained more than `energy_tolerance`.
+    /// step does not resolve) and could not give back (`impact::take_gain`: the motion held
+    /// less than the gain); 0 if none.
     pub unresolved_gain: f64,
+    /// The largest energy gain, relative to the energies at play, of such a sub-step that was
+    /// given back from the motion near the contact (counted as dissipated); 0 if none.
+    pub impact_dissipation: f64,
 }
 
 impl StepStats {
@@ -178,6 +183,7 @@ impl StepStats {
             residual: next.residual,
             substeps: self.substeps + next.substeps,
             unresolved_gain: self.unresolved_gain.max(next.unresolved_gain),
+            impact_dissipation: self.impact_dissipation.max(next.impact_dissipation),
         }
     }
 }
@@ -249,7 +255,7 @@ pub struct Dynamics {
     pub(crate) k_a: f64,
     /// The step size of the current step.
     h: f64,
-    edge_inertia: Vec<Vector3<f64>>,
+    pub(crate) edge_inertia: Vec<Vector3<f64>>,
     factors: Vec<SegmentFactor>,
     /// h|Δq| of each segment in the current step (scaled as the Newton corrections).
     increments: Vec<f64>,
@@ -955,10 +961,23 @@ impl Dynamics {
                 let scale = e0.kinetic + e1.kinetic + e0.elastic.abs() + e0.contact + work.abs();
                 let gain = (total(&e1) - total(&e0) - work) / scale;
                 match guard_verdict(gain, self.opts.energy_tolerance, max_depth) {
-                    Some(unresolved_gain) => Ok(StepStats {
-                        unresolved_gain,
-                        ..s
-                    }),
+                    Some(0.0) => Ok(s),
+                    Some(unresolved_gain) => {
+                        // The deepest split gained: give the gain back from the motion.
+                        if take_gain(&mut [&mut *self], &[rod], gain * scale) > 0.0 {
+                            self.update_outputs(rod, st)?;
+                            self.power_n = self.ws.dissipation;
+                            Ok(StepStats {
+                                impact_dissipation: gain,
+                                ..s
+                            })
+                        } else {
+                            Ok(StepStats {
+                                unresolved_gain,
+                                ..s
+                            })
+                        }
+                    }
                     None => {
                         (self.energies.dissipated, self.power_n) = dissipated;
                         Err(SolveError::NotConverged {

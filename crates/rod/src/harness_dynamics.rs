@@ -40,6 +40,7 @@ fn bottom(v: &Vector6<f64>) -> Vector3<f64> {
 type HeldKinematics = (Pose, Vector6<f64>, Vector6<f64>);
 
 /// The generalized-α integrator of a harness.
+#[derive(Clone)]
 pub struct HarnessDynamics {
     /// One single-cable integrator per cable (its workspace, rates and kinematics).
     pub cables: Vec<Dynamics>,
@@ -793,12 +794,10 @@ impl HarnessDynamics {
         let start = self.energy_start(h, st, dt)?;
         let result = match (self.step(h, st, dt, to), start) {
             (Ok(s), Some(e0)) => {
-                let gain = self.energy_gain(h, st, &e0)?;
+                let (gain, scale) = self.energy_gain(h, st, &e0)?;
                 match guard_verdict(gain, self.opts.energy_tolerance, max_depth) {
-                    Some(unresolved_gain) => Ok(StepStats {
-                        unresolved_gain,
-                        ..s
-                    }),
+                    Some(0.0) => Ok(s),
+                    Some(g) => self.give_back(h, st, (g, scale), s),
                     None => {
                         self.restore_dissipated(&e0);
                         Err(HarnessError(format!(

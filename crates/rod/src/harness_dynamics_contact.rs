@@ -6,11 +6,14 @@
 //! its junction; and the energy guard of `Dynamics::advance` on the whole harness: near the
 //! geometry a step whose energy (kinetic, elastic, loads, barrier; cables and junctions) grows
 //! by more than `energy_tolerance` of the energies at play, beyond the work of the clips, is
-//! split.
+//! split; at the deepest split a gain is given back from the cables' motion near the contact
+//! (`impact::take_gain`).
 use super::{top, HarnessDynamics};
-use crate::dynamics::Energies;
+use crate::dynamics::{Dynamics, Energies, StepStats};
 use crate::harness::{Harness, HarnessError, HarnessState};
+use crate::impact::take_gain;
 use crate::model::Pose;
+use crate::model::Rod;
 use crate::rotation::log_vec;
 use crate::sliding::SlidingClips;
 use nalgebra::Vector3;
@@ -168,15 +171,16 @@ impl HarnessDynamics {
     }
 
     /// The energy the step just taken from `start` gained beyond the clips' work, relative to
-    /// the energies at play (0 where moving geometry did work that is not counted).
+    /// the energies at play, and that scale (J); a gain of 0 where moving geometry did work
+    /// that is not counted.
     pub(crate) fn energy_gain(
         &mut self,
         h: &Harness,
         st: &HarnessState,
         start: &EnergyStart,
-    ) -> Result<f64, HarnessError> {
+    ) -> Result<(f64, f64), HarnessError> {
         if self.cables.iter().any(|d| d.obstacles_moved()) {
-            return Ok(0.0); // moving geometry does work that is not counted
+            return Ok((0.0, 0.0)); // moving geometry does work that is not counted
         }
         self.update_outputs(h, st)?;
         let work_of = |r0: &Reaction, r1: &Reaction| {
@@ -198,7 +202,35 @@ impl HarnessDynamics {
         let (e0, e1) = (&start.energies, &self.energies);
         let total = |e: &Energies| e.kinetic + e.elastic + e.load_potential + e.contact;
         let scale = e0.kinetic + e1.kinetic + e0.elastic.abs() + e0.contact + work.abs();
-        Ok((total(e1) - total(e0) - work) / scale)
+        Ok(((total(e1) - total(e0) - work) / scale, scale))
+    }
+
+    /// A sub-step at the deepest split that gained `gain` (relative to `scale`, J): the
+    /// cables' motion near the contact gives it back (`impact::take_gain`) and the step reports
+    /// it as impact dissipation, or, where the motion holds less, as unresolved.
+    pub(crate) fn give_back(
+        &mut self,
+        h: &Harness,
+        st: &HarnessState,
+        (gain, scale): (f64, f64),
+        s: StepStats,
+    ) -> Result<StepStats, HarnessError> {
+        let rods: Vec<&Rod> = h.cables.iter().collect();
+        let mut cables: Vec<&mut Dynamics> = self.cables.iter_mut().collect();
+        if take_gain(&mut cables, &rods, gain * scale) == 0.0 {
+            return Ok(StepStats {
+                unresolved_gain: gain,
+                ..s
+            });
+        }
+        self.update_outputs(h, st)?;
+        for dy in &mut self.cables {
+            dy.power_n = dy.ws.dissipation;
+        }
+        Ok(StepStats {
+            impact_dissipation: gain,
+            ..s
+        })
     }
 
     /// Puts back the dissipated energies of `start` (a step that will be redone).

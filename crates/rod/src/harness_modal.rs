@@ -41,6 +41,7 @@ pub struct HarnessMode {
 /// The buffers of a harness's pencil, allocated once (`HarnessStability` keeps them across the
 /// steps of a sequence): `k` the assembled symmetric stiffness (kept for products), `work` its
 /// shifted copy factored by the tree elimination.
+#[derive(Clone)]
 pub struct ModalSystem {
     k: HarnessStatics,
     work: HarnessStatics,

@@ -51,6 +51,7 @@ fn invert(m: &Matrix6<f64>) -> Option<Matrix6<f64>> {
 
 /// Static and quasistatic solver of a harness: the cables' workspaces, the coupling terms and
 /// the buffers of the tree elimination (allocated once).
+#[derive(Clone)]
 pub struct HarnessStatics {
     pub ws: Vec<Workspace>,
     pub held: Vec<HeldEnds>,

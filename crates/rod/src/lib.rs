@@ -18,6 +18,7 @@ pub mod harness_dynamics;
 mod harness_escape;
 pub mod harness_modal;
 pub mod harness_solver;
+mod impact;
 pub mod junction;
 pub mod modal;
 pub mod model;

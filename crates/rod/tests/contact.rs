@@ -457,8 +457,7 @@ fn friction_holds_on_an_incline_below_the_friction_angle_and_slides_above() {
 /// the horizontal momentum of a tilted impact stays; with friction it is stopped too). A
 /// solver error fails with its step (the energy bounds are asserted on every step before it).
 fn drop(r: f64, mu: f64, line_search: bool, tilt: f64) {
-    let (rod, st, dy) =
-        drop_run(r, mu, line_search, tilt, 3000, true).unwrap_or_else(|e| panic!("{e}"));
+    let (rod, st, dy) = drop_run(r, mu, line_search, tilt, 3000).unwrap_or_else(|e| panic!("{e}"));
     let drop_energy = rod.node_mass.iter().sum::<f64>() * 9.81 * 0.02;
     // At rest on the floor after 3 s: vertical motion below 1e-4 of the drop energy (frictionless, the horizontal momentum
     // the tilted impact gave it stays), lying on the floor within 1 % of r.
@@ -500,7 +499,6 @@ fn drop_run(
     line_search: bool,
     tilt: f64,
     steps: usize,
-    strict: bool,
 ) -> Result<(Rod, State, Dynamics), String> {
     let l = 0.4;
     let n = 40;
@@ -559,10 +557,10 @@ fn drop_run(
         // With friction too (before the contact's normal damping, session 8, the μ = 0.3 drop
         // gained 0.67 % of the energy in motion at step 248 and was exempt).
         let scale = last_kinetic + en.kinetic + last_elastic.abs() + last_contact;
-        if e > last + 2e-3 * scale && (strict || stats.unresolved_gain == 0.0) {
+        if e > last + 2e-3 * scale || stats.unresolved_gain > 0.0 {
             return Err(format!(
                 "{case}: energy grew at step {k}: {last} → {e} (scale {scale}, {en:?}; \
-                 reported unresolved gain {})",
+                 unresolved gain {})",
                 stats.unresolved_gain
             ));
         }
@@ -578,10 +576,13 @@ fn drop_run(
 
 /// Thin cables dropped flat or tilted, with and without the line search (r = 0.9–2 mm, tilt
 /// 0–0.02; 50 drops of 0.3 s through the impact and the first bounces): every run completes,
-/// never rises above its start, never goes through the plane, and every step whose energy
-/// grew beyond the guard's bound is one the guard reported as an unresolved impact. Before
-/// session 10's smooth damping saturation 5 of these runs stopped with Newton not converging
-/// (a period-4 cycle at h/64) and 4 gained energy unreported; the named drop tests above had
+/// never rises above its start, never goes through the plane, and no step's energy grows
+/// beyond the guard's bound: the gains of sub-steps at the guard's deepest split are given back
+/// from the motion near the contact (`impact::take_gain`; 169 such sub-steps in 46 of the 50
+/// runs, up to 19 % of the energies at play, none left unresolved). Without that 5 runs gain
+/// beyond the bound (they were reported as unresolved impacts, session 10). Before session
+/// 10's smooth damping saturation 5 of these runs stopped with Newton not converging (a
+/// period-4 cycle at h/64) and 4 gained energy unreported; the named drop tests above had
 /// passed by their parameters.
 #[test]
 fn thin_cables_dropped_any_way_complete_and_report_what_they_gain() {
@@ -589,7 +590,7 @@ fn thin_cables_dropped_any_way_complete_and_report_what_they_gain() {
     for r in [0.0009, 0.001, 0.0011, 0.0015, 0.002] {
         for tilt in [0.0, 0.005, 0.01, 0.015, 0.02] {
             for line_search in [false, true] {
-                if let Err(e) = drop_run(r, 0.0, line_search, tilt, 300, false) {
+                if let Err(e) = drop_run(r, 0.0, line_search, tilt, 300) {
                     failures.push(e);
                 }
             }

@@ -455,8 +455,9 @@ def _frequencies(page: Page, res: Result, name: str, cache: dict, run_label: str
 
 
 def _impact_notes(res) -> list[str]:
-    """The warnings of impacts the dynamic step guard accepted unresolved (saved per step in
-    ``solver["unresolved_gain"]``; one for a harness, whose cables share it)."""
+    """The warnings of impacts the dynamic time step does not resolve (saved per step in
+    ``solver["unresolved_gain"]`` and ``solver["impact_dissipation"]``; one for a harness,
+    whose cables share them)."""
     from cablelife.validity import impact_messages
 
     named = [(f"cable '{n}'", c) for n, c in res.cables.items()]
@@ -466,7 +467,9 @@ def _impact_notes(res) -> list[str]:
         m
         for name, c in named
         if c.solver.get("unresolved_gain") is not None
-        for m in impact_messages(name, c.solver["unresolved_gain"], c.time)
+        for m in impact_messages(
+            name, c.solver["unresolved_gain"], c.time, c.solver.get("impact_dissipation")
+        )
     ]
 
 
