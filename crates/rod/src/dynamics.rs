@@ -964,7 +964,7 @@ impl Dynamics {
                     Some(0.0) => Ok(s),
                     Some(unresolved_gain) => {
                         // The deepest split gained: give the gain back from the motion.
-                        if take_gain(&mut [&mut *self], &[rod], gain * scale) > 0.0 {
+                        if take_gain(&mut [&mut *self], &[rod], &[&*st], gain * scale) > 0.0 {
                             self.update_outputs(rod, st)?;
                             self.power_n = self.ws.dissipation;
                             Ok(StepStats {

@@ -12,10 +12,10 @@ use super::{top, HarnessDynamics};
 use crate::dynamics::{Dynamics, Energies, StepStats};
 use crate::harness::{Harness, HarnessError, HarnessState};
 use crate::impact::take_gain;
-use crate::model::Pose;
-use crate::model::Rod;
+use crate::model::{Pose, Rod};
 use crate::rotation::log_vec;
 use crate::sliding::SlidingClips;
+use crate::state::State;
 use nalgebra::Vector3;
 
 /// A clip's (or held junction's) reaction force and moment on the harness and its pose.
@@ -217,7 +217,8 @@ impl HarnessDynamics {
     ) -> Result<StepStats, HarnessError> {
         let rods: Vec<&Rod> = h.cables.iter().collect();
         let mut cables: Vec<&mut Dynamics> = self.cables.iter_mut().collect();
-        if take_gain(&mut cables, &rods, gain * scale) == 0.0 {
+        let states: Vec<&State> = st.cables.iter().collect();
+        if take_gain(&mut cables, &rods, &states, gain * scale) == 0.0 {
             return Ok(StepStats {
                 unresolved_gain: gain,
                 ..s
