@@ -962,22 +962,7 @@ impl Dynamics {
                 let gain = (total(&e1) - total(&e0) - work) / scale;
                 match guard_verdict(gain, self.opts.energy_tolerance, max_depth) {
                     Some(0.0) => Ok(s),
-                    Some(unresolved_gain) => {
-                        // The deepest split gained: give the gain back from the motion.
-                        if take_gain(&mut [&mut *self], &[rod], &[&*st], gain * scale) > 0.0 {
-                            self.update_outputs(rod, st)?;
-                            self.power_n = self.ws.dissipation;
-                            Ok(StepStats {
-                                impact_dissipation: gain,
-                                ..s
-                            })
-                        } else {
-                            Ok(StepStats {
-                                unresolved_gain,
-                                ..s
-                            })
-                        }
-                    }
+                    Some(g) => self.give_back(rod, st, (g, scale), s),
                     None => {
                         (self.energies.dissipated, self.power_n) = dissipated;
                         Err(SolveError::NotConverged {
@@ -1002,6 +987,30 @@ impl Dynamics {
                 Ok(s1.then(s2))
             }
         }
+    }
+
+    /// A sub-step at the deepest split that gained `gain` (relative to `scale`, J): the motion
+    /// near the contact gives it back (`impact::take_gain`) and the step reports it as impact
+    /// dissipation, or, where the motion holds less, as unresolved.
+    fn give_back(
+        &mut self,
+        rod: &Rod,
+        st: &State,
+        (gain, scale): (f64, f64),
+        s: StepStats,
+    ) -> Result<StepStats, SolveError> {
+        if take_gain(&mut [&mut *self], &[rod], &[st], gain * scale) == 0.0 {
+            return Ok(StepStats {
+                unresolved_gain: gain,
+                ..s
+            });
+        }
+        self.update_outputs(rod, st)?;
+        self.power_n = self.ws.dissipation;
+        Ok(StepStats {
+            impact_dissipation: gain,
+            ..s
+        })
     }
 
     /// The parts of Δq, v_{n+1} and a_{n+1} fixed during a step (from the values at t_n): all
