@@ -21,7 +21,7 @@ use crate::contact::Contact;
 use crate::impact::take_gain;
 use crate::model::{EdgeKind, NodeKind, Pose, Rod, Segment};
 use crate::rotation::{log_vec, right_jacobian, rotate_body, rotation_matrix, skew, slerp, Quat};
-use crate::sliding::{SlidingClips, STICK_TOLERANCE};
+use crate::sliding::SlidingClips;
 use crate::state::State;
 use crate::statics::SolveError;
 use nalgebra::{Matrix3, Vector3, Vector6};
@@ -803,7 +803,7 @@ impl Dynamics {
             }
             // Frictional guides: a correction small against the stick width.
             if let Some(s) = SlidingClips::frictional(&self.sliding) {
-                tolerance = tolerance.min(STICK_TOLERANCE * s.stick_width() / l);
+                tolerance = tolerance.min(s.newton_tolerance(l));
             }
             if alpha == 1.0 && norm < tolerance {
                 stats.residual = self

@@ -22,7 +22,7 @@ use crate::harness::{Harness, HarnessError, HarnessState, HarnessStatics};
 use crate::harness_solver::vec_to_junction;
 use crate::model::Pose;
 use crate::rotation::{log_vec, right_jacobian, rotate_body, rotation_matrix, skew};
-use crate::sliding::{SlidingClips, STICK_TOLERANCE};
+use crate::sliding::SlidingClips;
 use crate::statics::{NewtonOptions, SolveError};
 use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 
@@ -703,7 +703,7 @@ impl HarnessDynamics {
             // Frictional guides: a correction small against the stick width (`Dynamics`).
             for (rod, dy) in h.cables.iter().zip(&self.cables) {
                 if let Some(s) = SlidingClips::frictional(&dy.sliding) {
-                    tolerance = tolerance.min(STICK_TOLERANCE * s.stick_width() / rod.spec.length);
+                    tolerance = tolerance.min(s.newton_tolerance(rod.spec.length));
                 }
             }
             if alpha == 1.0 && norm < tolerance {

@@ -365,11 +365,11 @@ impl HarnessStatics {
                 let (b_last, b_prev) = onto_tail(blocks, last, Matrix6::zeros(), |i| {
                     cols_to_junction(&eb.ce[i], &e.rel)
                 });
-                let (x_last, x_prev) = self.ws[e.cable]
+                let x = self.ws[e.cable]
                     .jac
                     .solve_tail(range, rev, &b_last, &b_prev);
-                let at = |b: usize| if b == last { x_last } else { x_prev };
-                self.pivot[e.junction] -= ck[0] * at(blocks[0]) + ck[1] * at(blocks[1]);
+                let [x0, x1] = from_tail(blocks, last, x);
+                self.pivot[e.junction] -= ck[0] * x0 + ck[1] * x1;
                 continue;
             }
             for &l in &h.cable_ends[e.cable] {
@@ -445,11 +445,9 @@ impl HarnessStatics {
                         // Towards the end only; the way back once its junction has moved.
                         let topo = &h.ends[k].topo;
                         jac.sweep_in(seg.blocks.clone(), topo.at_start, y);
-                        let (x_last, x_prev) = jac.tail_of(&seg.blocks, topo.at_start, y);
+                        let x = jac.tail_of(&seg.blocks, topo.at_start, y);
                         let (last, _) = BlockTridiag::tail_blocks(&seg.blocks, topo.at_start);
-                        self.tail_x[k] = topo
-                            .blocks()
-                            .map(|b| if b == last { x_last } else { x_prev });
+                        self.tail_x[k] = from_tail(topo.blocks(), last, x);
                     }
                     None => jac.solve_range(seg.blocks.clone(), y),
                 }
@@ -518,6 +516,7 @@ impl HarnessStatics {
             let Some(s) = e.segment else { continue };
             let range = h.cables[e.cable].segments[s].blocks.clone();
             let d = dj[e.junction];
+            // (`on_tail`, with `dj` borrowed from self)
             if self.tail_factored && self.tail_end[e.cable][s] == Some(k) {
                 // x = A⁻¹(r + B d): B d enters the in-sweep at the tail alone, then the way back.
                 let rev = e.topo.at_start;
@@ -1109,6 +1108,12 @@ fn onto_tail<T: Copy + std::ops::AddAssign>(
         }
     }
     (at_last, at_prev)
+}
+
+/// The values at an end's two blocks `blocks` from those at the tail (at the block eliminated
+/// last, at the one before): the inverse of `onto_tail`'s placement.
+fn from_tail<T: Copy>(blocks: [usize; 2], last: usize, (at_last, at_prev): (T, T)) -> [T; 2] {
+    blocks.map(|b| if b == last { at_last } else { at_prev })
 }
 
 /// Per cable segment: its junction end if it is the segment's only one and couples to the

@@ -245,6 +245,9 @@ pub fn shear_element(
 
 #[cfg(test)]
 mod tests {
+    use super::*;
+    use crate::rotation::{exp_half, rotate_body};
+
     #[test]
     fn saved_strain_is_the_element_strain_for_any_quaternion_length() {
         let p = crate::rotation::exp_half(&Vector3::new(0.3, -0.7, 1.1));
@@ -261,9 +264,6 @@ mod tests {
             assert!((got - exact).amax() < 1e-14, "{scale}: {got} vs {exact}");
         }
     }
-
-    use super::*;
-    use crate::rotation::{exp_half, rotate_body};
 
     /// The element about a fixed base state, moved by z = (x_a, x_b, θ).
     fn eval_at(z: &[f64; 9], want_hess: bool) -> ShearEval {

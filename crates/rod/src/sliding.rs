@@ -24,7 +24,7 @@
 use crate::assembly::{Eval, KinkAt, Part, Rates, Term, Workspace};
 use crate::dynamics::ClipMotion;
 use crate::friction::{f1_over, stick_cut};
-use crate::model::{ClipKind, NodeKind, Rod};
+use crate::model::{ClipKind, NodeKind, Pose, Rod};
 use crate::rotation::rotation_matrix;
 use crate::state::State;
 use nalgebra::{Matrix3, Vector3};
@@ -137,9 +137,11 @@ impl SlidingClips {
         })
     }
 
-    /// The stick width ε of the current step (m; dynamics: stick velocity × h).
-    pub fn stick_width(&self) -> f64 {
-        self.eps
+    /// The Newton tolerance of a step with these frictional guides, for the corrections
+    /// relative to a cable of `length` (`STICK_TOLERANCE` of the stick width ε of the step:
+    /// dynamics, stick velocity × h).
+    pub fn newton_tolerance(&self, length: f64) -> f64 {
+        STICK_TOLERANCE * self.eps / length
     }
 
     /// Whether a sliding clip has friction.
@@ -158,9 +160,7 @@ impl SlidingClips {
     pub fn begin_step(&mut self, rod: &Rod, st: &State, dynamic: Option<(f64, &[ClipMotion])>) {
         let n = self.n_nodes;
         for (k, &c) in self.clips.iter().enumerate() {
-            let pose = &st.clip_pose[c];
-            let t = rotation_matrix(&pose.orientation) * Vector3::z();
-            let half = 0.5 * rod.spec.clips[c].length;
+            let (pose, t, half) = guide_line(rod, st, c);
             let taper = 0.5 * rod.mean_ds();
             for (j, x) in st.x.iter().enumerate() {
                 let d = x - pose.position;
@@ -237,9 +237,7 @@ impl SlidingClips {
             if self.mu[k] <= 0.0 {
                 continue;
             }
-            let pose = &st.clip_pose[c];
-            let t = rotation_matrix(&pose.orientation) * Vector3::z();
-            let half = 0.5 * rod.spec.clips[c].length;
+            let (pose, t, half) = guide_line(rod, st, c);
             for n in nodes.clone() {
                 if rod.node_kind[n] != NodeKind::Free {
                     continue;
@@ -262,11 +260,9 @@ impl SlidingClips {
     /// beyond a cable end (or that the cable no longer passes through) is the error.
     pub fn check(&mut self, rod: &Rod, st: &State) -> Result<(), usize> {
         for (k, &c) in self.clips.iter().enumerate() {
-            let pose = &st.clip_pose[c];
-            let t = rotation_matrix(&pose.orientation) * Vector3::z();
+            let (pose, t, half) = guide_line(rod, st, c);
             let sigma = SlidingClips::crossing(rod, st, &pose.position, &t);
             self.sigma[k] = sigma.unwrap_or(f64::NAN);
-            let half = 0.5 * rod.spec.clips[c].length;
             if sigma.is_none_or(|s| s - half < 0.0 || s + half > rod.spec.length) {
                 return Err(c);
             }
@@ -290,6 +286,15 @@ impl SlidingClips {
         }
         best.map(|(_, s)| s)
     }
+}
+
+/// Clip c's guide at the state `st`: its pose (the centre P), the line's direction t (the
+/// clip's d3) and the half length of its window along it.
+#[inline]
+fn guide_line<'a>(rod: &Rod, st: &'a State, c: usize) -> (&'a Pose, Vector3<f64>, f64) {
+    let pose = &st.clip_pose[c];
+    let t = rotation_matrix(&pose.orientation) * Vector3::z();
+    (pose, t, 0.5 * rod.spec.clips[c].length)
 }
 
 /// The guide's window along the line and its derivative in z.
@@ -326,10 +331,8 @@ impl Term for SlidingClips {
         }
         let taper = 0.5 * rod.mean_ds();
         for (k, &c) in self.clips.iter().enumerate() {
-            let pose = &st.clip_pose[c];
+            let (pose, t, half) = guide_line(rod, st, c);
             let p = pose.position;
-            let t = rotation_matrix(&pose.orientation) * Vector3::z();
-            let half = 0.5 * rod.spec.clips[c].length;
             let sigma = SlidingClips::crossing(rod, st, &p, &t);
             if all {
                 self.sigma[k] = sigma.unwrap_or(f64::NAN);

@@ -10,7 +10,7 @@ from pydantic import BaseModel, ConfigDict, Field, Strict, ValidationError
 from cablelife.lda.pipeline import DEFAULT_POINTS
 from cablelife.lda.planes import DEFAULT_PLANE_STEP_DEG
 from cablelife.lda.wohler import PSEUDO_K, WohlerCurve, pseudo_damage_curve
-from cablelife.scene_types import PositiveFloat, PositiveInt
+from cablelife.scene_types import NonNegativeFloat, PositiveFloat, PositiveInt
 
 
 class LdaSettings(BaseModel):
@@ -26,7 +26,7 @@ class LdaSettings(BaseModel):
     plane_step: Annotated[float, Strict(), Field(gt=0.0, le=90.0)] = DEFAULT_PLANE_STEP_DEG
     section_step: PositiveInt = 1
     residue: Literal["half", "discard", "full", "repeated"] = "half"
-    hysteresis: Annotated[float, Strict(), Field(ge=0.0)] = 0.0  # Pa
+    hysteresis: NonNegativeFloat = 0.0  # Pa
 
     @classmethod
     def from_options(cls, **options) -> LdaSettings:

@@ -13,7 +13,7 @@ from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, Strict, model_validator
 
-from cablelife.scene_types import NonNegativeFloat, PositiveFloat, Real
+from cablelife.scene_types import NonNegativeFloat, PositiveFloat, Real, Time
 from cablelife.signals.profiles import get_profile
 from cablelife.signals.psd import PowerLawPsd
 from cablelife.signals.units import (
@@ -30,7 +30,7 @@ TRANSLATIONS = ("x", "y", "z")
 ROTATIONS = ("rx", "ry", "rz")
 
 # Fades and sweep durations: at most 1e6 s (11 days; longer overflows the ramp polynomials).
-Seconds = Annotated[float, Strict(), Field(ge=0, le=1e6)]
+Seconds = Time
 
 
 class _Spec(BaseModel):

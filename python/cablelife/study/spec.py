@@ -6,11 +6,11 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Annotated, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, Strict, ValidationError, model_validator
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
 from cablelife.lda.settings import LdaSettings
 from cablelife.scene import format_validation_errors
-from cablelife.scene_types import Flag, PositiveFloat, Real, Vec3
+from cablelife.scene_types import Flag, NonNegativeFloat, PositiveFloat, PositiveInt, Real, Vec3
 from cablelife.tomlfile import read_toml
 
 ParameterName = Annotated[str, Field(min_length=1, pattern=r"^[A-Za-z_][A-Za-z0-9_\-]*$")]
@@ -86,8 +86,8 @@ class VolumeSettings(_Model):
     """Motion volume per variant (its size goes into the summary); voxel 0 switches it off.
     At most ``max_steps`` saved steps are swept (every k-th step of longer runs)."""
 
-    voxel: Annotated[float, Strict(), Field(ge=0.0)] = 0.004  # m
-    max_steps: Annotated[int, Strict(), Field(ge=1)] = 1000
+    voxel: NonNegativeFloat = 0.004  # m
+    max_steps: PositiveInt = 1000
 
 
 class StudySettings(_Model):
@@ -96,7 +96,7 @@ class StudySettings(_Model):
     mode: Literal["static", "quasistatic", "dynamic"] | None = None  # default: the scene's
     duration: PositiveFloat | None = None  # s, overrides simulation.duration
     combine: Literal["grid", "list"] = "grid"
-    threads: Annotated[int, Strict(), Field(ge=1)] = 1  # threads per variant (LDA kernels)
+    threads: PositiveInt = 1  # threads per variant (LDA kernels)
 
 
 class StudyFile(_Model):
