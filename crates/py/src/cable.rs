@@ -1183,10 +1183,7 @@ fn section_strains<'py>(
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Cable>()?;
     m.add_function(wrap_pyfunction!(section_strains, m)?)?;
-    m.add(
-        "DEFAULT_NEWTON_TOLERANCE",
-        DynamicOptions::default().tolerance,
-    )?;
+    m.add("DEFAULT_NEWTON_TOLERANCE", rod::dynamics::DEFAULT_TOLERANCE)?;
     Ok(())
 }
 

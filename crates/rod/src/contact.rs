@@ -955,6 +955,8 @@ impl Contact {
     /// when it decreases ψ sufficiently (Armijo, 1e-4) and keeps every gap above a tenth of its
     /// value (the feasible bound, `step_bound`'s); otherwise the minimiser of ψ within that
     /// bound. With R ≤ 0 (a reused matrix giving no descent): the feasible bound alone.
+    /// With `stick_cut`, the feasible bound also keeps frictional samples from being carried
+    /// across their stick zone (`stick_cut`, as `step_bound`): for an iteration that cycles.
     pub fn line_search(
         &mut self,
         x: &[Vector3<f64>],
@@ -962,6 +964,7 @@ impl Contact {
         edges: impl Iterator<Item = usize> + Clone,
         ds: &[f64],
         decrement: f64,
+        stick_cut: bool,
     ) -> f64 {
         let mut feasible = 1.0f64;
         let dhat = self.opts.distance;
@@ -973,10 +976,19 @@ impl Contact {
                 let (da, db) = (dx(e), dx(e + 1));
                 let motion = da.norm().max(db.norm());
                 let w_end = 0.5 * ds[e] / kk as f64;
+                let slip = if stick_cut {
+                    self.slip_ends(x, k, e)
+                } else {
+                    None
+                };
                 self.edge_samples(x, k, e, motion + dhat, |t, g, normal| {
-                    let approach = -normal.dot(&(da + t * (db - da)));
+                    let d = da + t * (db - da);
+                    let approach = -normal.dot(&d);
                     if g > 0.0 && approach * feasible > 0.9 * g {
                         feasible = 0.9 * g / approach;
+                    }
+                    if let Some((ua, ub)) = slip.filter(|_| g < dhat) {
+                        feasible = self.stick_cut(ua + t * (ub - ua), d, normal, feasible);
                     }
                     if g - approach.max(0.0) < dhat {
                         let w = if t == 0.0 || t == 1.0 {

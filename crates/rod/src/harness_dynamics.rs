@@ -16,7 +16,7 @@
 use crate::assembly::{KinkAt, Part};
 use crate::dynamics::{
     guard_verdict, ClipMotion, DynamicOptions, Dynamics, Energies, GenAlpha, StepStats,
-    STALL_TOLERANCE, TOLERANCE_FLOOR,
+    STALL_TOLERANCE,
 };
 use crate::harness::{Harness, HarnessError, HarnessState, HarnessStatics};
 use crate::harness_solver::vec_to_junction;
@@ -688,18 +688,7 @@ impl HarnessDynamics {
             last_applied = norm;
             stats.iterations = it + 1;
             let active = contact && self.contact_active();
-            let mut tolerance = if contact {
-                STALL_TOLERANCE * scale // the rule contact was verified with (`Dynamics`)
-            } else {
-                (self.opts.tolerance * error)
-                    .min(STALL_TOLERANCE * scale)
-                    .max(TOLERANCE_FLOOR * scale)
-            }
-            .max(self.opts.abs_tolerance);
-            if active {
-                let tight = self.opts.contact_tolerance * scale;
-                tolerance = tolerance.min(tight.max(self.opts.abs_tolerance));
-            }
+            let mut tolerance = self.opts.step_tolerance(error, scale, active);
             // Frictional guides: a correction small against the stick width (`Dynamics`).
             for (rod, dy) in h.cables.iter().zip(&self.cables) {
                 if let Some(s) = SlidingClips::frictional(&dy.sliding) {

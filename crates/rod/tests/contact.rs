@@ -954,7 +954,7 @@ fn line_search_stops_where_the_barrier_balances_the_decrement() {
     let (kds, a) = (c.kappa * rod.ds_edge[0], g0);
     let s = kds * b2 * a * a;
     let decrement = 0.5 * s;
-    let alpha = c.line_search(&x, down, 0..1, &rod.ds_edge, decrement);
+    let alpha = c.line_search(&x, down, 0..1, &rod.ds_edge, decrement, false);
     assert!(alpha > 0.0 && alpha < 0.85, "{alpha}");
     // −b'(g₀(1 − α)) = −b'(g₀) + R/(κ ds a), to the search's resolution (1e-3 of the bound).
     let target = -b1 + decrement / (kds * a);
@@ -966,7 +966,10 @@ fn line_search_stops_where_the_barrier_balances_the_decrement() {
         force(alpha + 1e-3)
     );
     let up = |_: usize| Vector3::new(0.0, 0.0, g0);
-    assert_eq!(c.line_search(&x, up, 0..1, &rod.ds_edge, decrement), 1.0);
+    assert_eq!(
+        c.line_search(&x, up, 0..1, &rod.ds_edge, decrement, false),
+        1.0
+    );
 }
 
 /// A route through a table: the hose's sag without contact reaches 9 cm below the table top,
