@@ -512,7 +512,8 @@ class Simulation(_Model):
     max_iterations: PositiveInt = 40
     spectral_radius: Annotated[float, Strict(), Field(ge=0.0, le=1.0)] = 0.9  # ρ∞ of generalized-α
     # Dynamic Newton iteration: converged when the correction is below this fraction of the
-    # step's increment (docs/dynamics.md: the error it leaves vs the time-step error).
+    # estimated local time error, at most 5e-3 of the step's increment (1e-4 while touching a
+    # contact barrier); docs/dynamics.md: the error it leaves vs the time-step error.
     newton_tolerance: Annotated[float, Strict(), Field(gt=0.0, lt=1.0)] = (
         _core.DEFAULT_NEWTON_TOLERANCE
     )
