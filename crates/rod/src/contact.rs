@@ -186,6 +186,8 @@ pub struct Obstacle {
     position: Vector3<f64>,
     rotation: Matrix3<f64>,
     moved: bool,
+    /// Counts the pose changes (the contact's cached queries are of one pose).
+    pose_version: u64,
     /// Added to every signed distance: the solid shrunk by this much (0: as given). The
     /// push-out continuation of a start inside the geometry (`Contact::set_shrink`).
     shrink: f64,
@@ -201,6 +203,7 @@ impl Obstacle {
             position: pose.position,
             rotation: rotation_matrix(&pose.orientation),
             moved: true,
+            pose_version: 0,
             shrink: 0.0,
         }
     }
@@ -210,6 +213,7 @@ impl Obstacle {
         let rotation = rotation_matrix(&pose.orientation);
         if pose.position != self.position || rotation != self.rotation {
             self.moved = true;
+            self.pose_version += 1;
         }
         self.position = pose.position;
         self.rotation = rotation;
@@ -542,15 +546,30 @@ pub struct Contact {
 /// An edge's queries of the last assembly against one obstacle (`Contact::edge_samples`).
 #[derive(Clone, Debug)]
 struct CachedEdge {
+    /// The edge's end points when queried.
     a: Vector3<f64>,
     b: Vector3<f64>,
     /// Exact distance at the midpoint; ∞: not queried.
     d_mid: f64,
     /// An edge the assembly found beyond the barrier's reach: a lower bound of the gap of every
-    /// point of it (−∞: none known), so that a correction moving it less is not queried again.
+    /// point of it at `a`, `b` (−∞: none known). Every point of the edge moves at most as far as
+    /// one of its ends, so at other end points the bound less that motion still holds: an edge
+    /// moved less than `far_gap` − d̂ since is not queried again.
     far_gap: f64,
-    position: Vector3<f64>,
-    rotation: Matrix3<f64>,
+    /// The obstacle's `pose_version` when queried.
+    pose: u64,
+}
+
+impl CachedEdge {
+    /// Whether the bound `far_gap` shows every point of the edge at the end points `a`, `b`
+    /// farther than `gap` from the obstacle (of pose `pose`).
+    #[inline]
+    fn beyond(&self, a: &Vector3<f64>, b: &Vector3<f64>, pose: u64, gap: f64) -> bool {
+        let room = self.far_gap - gap;
+        self.pose == pose
+            && room > 0.0
+            && (a - self.a).norm_squared().max((b - self.b).norm_squared()) < room * room
+    }
 }
 
 impl Default for CachedEdge {
@@ -560,8 +579,7 @@ impl Default for CachedEdge {
             b: Vector3::zeros(),
             d_mid: f64::INFINITY,
             far_gap: f64::NEG_INFINITY,
-            position: Vector3::zeros(),
-            rotation: Matrix3::zeros(),
+            pose: u64::MAX,
         }
     }
 }
@@ -810,7 +828,9 @@ impl Contact {
             o.shrink = by;
         }
         for c in &mut self.cache_edges {
-            c.d_mid = f64::INFINITY; // the cached distances are of the former surface
+            // the cached distances and bounds are of the former surface
+            c.d_mid = f64::INFINITY;
+            c.far_gap = f64::NEG_INFINITY;
         }
     }
 
@@ -915,10 +935,10 @@ impl Contact {
         let half = 0.5 * (b - a).norm();
         let slot = k * (x.len() - 1) + e;
         let c = &self.cache_edges[slot];
-        let same = c.a == a && c.b == b && c.position == o.position && c.rotation == o.rotation;
-        if same && c.far_gap > margin {
+        if c.beyond(&a, &b, o.pose_version, margin) {
             return; // every point of the edge farther than the margin (from the assembly)
         }
+        let same = c.a == a && c.b == b && c.pose == o.pose_version;
         if same && c.d_mid.is_finite() {
             if c.d_mid - half - r > margin {
                 return;
@@ -1198,20 +1218,11 @@ impl Contact {
         let far = o.shape.bounding_radius();
         let slot = k * rod.n_edges() + e;
         // An edge known to be beyond the barrier's reach by more than it moved since (every
-        // point of it moved at most as far as one of its ends): still beyond, no query; the
-        // bound is kept for the new positions, less the motion.
-        let cached = &self.cache_edges[slot];
-        if cached.far_gap > self.opts.distance
-            && !self.deep[slot]
-            && cached.position == o.position
-            && cached.rotation == o.rotation
+        // point of it moved at most as far as one of its ends): still beyond, no query.
+        if !self.deep[slot]
+            && self.cache_edges[slot].beyond(&a, &b, o.pose_version, self.opts.distance)
         {
-            let lower = cached.far_gap - (a - cached.a).norm().max((b - cached.b).norm());
-            if lower > self.opts.distance {
-                let c = &mut self.cache_edges[slot];
-                (c.a, c.b, c.far_gap) = (a, b, lower);
-                return;
-            }
+            return;
         }
         // Beyond the barrier's reach: kept with a lower bound of the edge's gap (every point of
         // the edge is within |b − a|/2 of its midpoint).
@@ -1221,8 +1232,7 @@ impl Contact {
                 b,
                 d_mid: f64::INFINITY,
                 far_gap,
-                position: o.position,
-                rotation: o.rotation,
+                pose: o.pose_version,
             };
         };
         if far.is_finite() {
@@ -1251,8 +1261,7 @@ impl Contact {
             b,
             d_mid,
             far_gap: f64::NEG_INFINITY,
-            position: o.position,
-            rotation: o.rotation,
+            pose: o.pose_version,
         };
         let stride = self.opts.max_samples.max(1) + 1;
         let kk = self.samples[k];

@@ -1294,3 +1294,37 @@ fn a_clip_driven_into_the_geometry_keeps_newton_converging() {
         }
     }
 }
+
+/// The broad phase's bounds are of one surface: an edge found beyond the barrier's reach while
+/// the obstacles are shrunk (the push-out continuation, `Contact::set_shrink`) is queried
+/// again once they are restored. A cable lying 0.5 d̂ above a plane: shrunk by two edge
+/// lengths no sample is within reach (and the edges' bounds show it); restored, every sample
+/// (both ends of every edge) is in the barrier again.
+#[test]
+fn restoring_shrunk_obstacles_forgets_the_far_bounds() {
+    let r = 0.003;
+    let n = 10;
+    let rod = free_cable(0.2, n);
+    let dhat = ContactOptions::for_radius(r).distance;
+    let x = rod
+        .arc
+        .iter()
+        .map(|&s| Vector3::new(s, 0.0, r + 0.5 * dhat))
+        .collect();
+    let st = state_through(&rod, x, Vector3::z());
+    let table = Obstacle::new("table", 0, Box::new(Plane), 0.0, &origin());
+    let mut ct = contact(&rod, vec![table], r);
+    ct.begin_step(&st.x, None);
+    let mut ws = rod::assembly::Workspace::new(&rod);
+    let mut touching = |ct: &mut Contact| {
+        ws.assemble_terms(&rod, &st, 1.0, false, &mut [&mut *ct])
+            .unwrap();
+        ct.active
+    };
+    assert_eq!(touching(&mut ct), 2 * n);
+    ct.set_shrink(2.0 * rod.ds_edge[0]);
+    assert_eq!(touching(&mut ct), 0);
+    assert_eq!(touching(&mut ct), 0);
+    ct.set_shrink(0.0);
+    assert_eq!(touching(&mut ct), 2 * n);
+}
