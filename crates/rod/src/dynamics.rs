@@ -840,7 +840,10 @@ impl Dynamics {
             if alpha < 1.0 && self.opts.contact_line_search {
                 self.factors[k].valid = false;
             }
-            if norm > rate * last_norm && !refactor {
+            // Slow contraction (`rate`), unless the reused matrix is expected to finish at the
+            // next iterate (the contraction so far carrying this correction below the
+            // tolerance): a fresh matrix costs more than that iteration.
+            if norm > rate * last_norm && !refactor && norm * (norm / last_norm) >= tolerance {
                 self.factors[k].valid = false;
             }
             last_norm = norm;

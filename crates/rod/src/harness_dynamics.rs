@@ -704,7 +704,8 @@ impl HarnessDynamics {
             } else {
                 self.opts.refactor_rate
             };
-            if norm > rate * last_norm && !refactor {
+            // … unless expected to finish at the next iterate (`Dynamics`).
+            if norm > rate * last_norm && !refactor && norm * (norm / last_norm) >= tolerance {
                 self.factor_valid = false;
             }
             last_norm = norm;
