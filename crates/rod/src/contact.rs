@@ -188,6 +188,11 @@ pub struct Obstacle {
     moved: bool,
     /// Counts the pose changes (the contact's cached queries are of one pose).
     pose_version: u64,
+    /// The rotation is the identity (most parts: global at the reference, on a fixed body):
+    /// queries skip the transforms.
+    unrotated: bool,
+    /// The shape's `bounding_radius` (∞: unbounded).
+    bounding_radius: f64,
     /// Added to every signed distance: the solid shrunk by this much (0: as given). The
     /// push-out continuation of a start inside the geometry (`Contact::set_shrink`).
     shrink: f64,
@@ -195,15 +200,18 @@ pub struct Obstacle {
 
 impl Obstacle {
     pub fn new(name: &str, body: usize, shape: Box<dyn Shape>, friction: f64, pose: &Pose) -> Self {
+        let rotation = rotation_matrix(&pose.orientation);
         Obstacle {
             name: name.into(),
             body,
+            bounding_radius: shape.bounding_radius(),
             shape,
             friction,
             position: pose.position,
-            rotation: rotation_matrix(&pose.orientation),
+            rotation,
             moved: true,
             pose_version: 0,
+            unrotated: rotation == Matrix3::identity(),
             shrink: 0.0,
         }
     }
@@ -217,13 +225,19 @@ impl Obstacle {
         }
         self.position = pose.position;
         self.rotation = rotation;
+        self.unrotated = rotation == Matrix3::identity();
     }
 
     /// Signed distance, outward normal and its gradient at a global point.
     #[inline]
     pub fn query(&self, p: &Vector3<f64>) -> PointQuery {
-        let local = self.rotation.transpose() * (p - self.position);
-        let q = self.shape.query(&local);
+        let q = self.shape.query(&self.local(p));
+        if self.unrotated {
+            return PointQuery {
+                distance: q.distance + self.shrink,
+                ..q
+            };
+        }
         PointQuery {
             distance: q.distance + self.shrink,
             normal: self.rotation * q.normal,
@@ -238,17 +252,26 @@ impl Obstacle {
     /// Signed distance at a global point (broad phase).
     #[inline]
     pub fn distance(&self, p: &Vector3<f64>) -> f64 {
-        self.shape
-            .distance(&(self.rotation.transpose() * (p - self.position)))
-            + self.shrink
+        self.shape.distance(&self.local(p)) + self.shrink
+    }
+
+    /// A global point in the obstacle's frame.
+    #[inline]
+    fn local(&self, p: &Vector3<f64>) -> Vector3<f64> {
+        if self.unrotated {
+            p - self.position
+        } else {
+            self.rotation.transpose() * (p - self.position)
+        }
     }
 
     /// Signed distance at a global point if within `bound` of the surface, else the exact
     /// distance or ∞ (broad phase; [`Shape::distance_within`]).
     #[inline]
     pub fn distance_within(&self, p: &Vector3<f64>, bound: f64) -> f64 {
-        let local = self.rotation.transpose() * (p - self.position);
-        self.shape.distance_within(&local, bound - self.shrink) + self.shrink
+        self.shape
+            .distance_within(&self.local(p), bound - self.shrink)
+            + self.shrink
     }
 
     /// Closest points between the segment [a, b] and the obstacle: the least signed distance
@@ -314,6 +337,11 @@ impl ContactOptions {
 /// it is κ w φ(g) τ_c/h times the harmonic mean of b''(g) and b''(d̂ · this), ≈ b''(g) well
 /// above it.
 pub const DAMPING_SATURATION: f64 = 1e-2;
+
+/// b''(g) at the damping's saturation gap `DAMPING_SATURATION` · d̂ (`sample_terms`' `floor`).
+pub fn damping_floor(dhat: f64) -> f64 {
+    barrier(DAMPING_SATURATION * dhat, dhat).2
+}
 
 /// The fade φ(g) of the contact's normal damping and φ'(g): 1 up to 3/4 of d̂, then
 /// 1 − ((g − ¾d̂)/(¼d̂))² down to 0 at d̂ (C¹ at both ends, so the damping coefficient
@@ -397,8 +425,8 @@ pub struct SampleTerms {
 
 /// The contact term at a point x with weight w (arc length, m), reference x_ref (the point at
 /// the step's start, carried with the geometry), obstacle query q: barrier, normal damping
-/// (`damping_rate` = τ_c/h, 0 in statics; `gap_ref` the gap of x_ref) and friction (μ, stick
-/// width ε).
+/// (`damping_rate` = τ_c/h, 0 in statics; `gap_ref` the gap of x_ref; `floor` =
+/// [`damping_floor`] of d̂) and friction (μ, stick width ε).
 #[allow(clippy::too_many_arguments)]
 #[inline]
 pub fn sample_terms(
@@ -413,6 +441,7 @@ pub fn sample_terms(
     eps: f64,
     damping_rate: f64,
     gap_ref: f64,
+    floor: f64,
     want_jac: bool,
 ) -> Option<SampleTerms> {
     let g = q.distance - radius;
@@ -442,7 +471,6 @@ pub fn sample_terms(
         // no free node can balance (bench_harness --contact: Newton stalled at 100 N). Smoothly:
         // the harmonic mean of b''(g) and b''(d̂/100), below both, with a continuous slope (the
         // former hard cap's kink at d̂/100 made Newton cycle at impacts; docs/contact.md).
-        let floor = barrier(DAMPING_SATURATION * dhat, dhat).2;
         let b2c = 1.0 / (1.0 / b2 + 1.0 / floor);
         let b3c = barrier_third(g, dhat) * (b2c / b2) * (b2c / b2);
         let c = damping_rate * kw * b2c * phi;
@@ -515,6 +543,8 @@ pub struct Contact {
     /// Per sample (as `cache_samples`): the gap of its reference point, queried once per step
     /// when the sample first needs it (NaN: not yet).
     reference_gap: Vec<f64>,
+    /// `damping_floor` of the barrier's reach d̂.
+    damping_floor: f64,
     /// Stick width of the current step (m) and the step duration (dynamics).
     eps: f64,
     step: Option<f64>,
@@ -697,6 +727,7 @@ impl Contact {
             obstacle_gap: vec![f64::INFINITY; n_obstacles],
             lowest_gap: vec![f64::INFINITY; n_obstacles],
             eps: opts.stick_distance,
+            damping_floor: damping_floor(opts.distance),
             opts,
             reference: vec![Vector3::zeros(); n],
             step: None,
@@ -1215,7 +1246,7 @@ impl Contact {
         // Broad phase: every point of the edge is within |b − a|/2 of its midpoint.
         let mid = 0.5 * (a + b);
         let half = 0.5 * (b - a).norm();
-        let far = o.shape.bounding_radius();
+        let far = o.bounding_radius;
         let slot = k * rod.n_edges() + e;
         // An edge known to be beyond the barrier's reach by more than it moved since (every
         // point of it moved at most as far as one of its ends): still beyond, no query.
@@ -1303,6 +1334,7 @@ impl Contact {
                 self.eps,
                 damping_rate,
                 gap_ref,
+                self.damping_floor,
                 want_jac,
             ) else {
                 continue;
@@ -1558,7 +1590,19 @@ mod tests {
                             let w = 0.002;
                             let gr = o.query(&xr).distance - radius;
                             if let Some(s) = sample_terms(
-                                &q, &x, &xr, w, radius, dhat, 50.0, mu, 1e-3, damping, gr, jac,
+                                &q,
+                                &x,
+                                &xr,
+                                w,
+                                radius,
+                                dhat,
+                                50.0,
+                                mu,
+                                1e-3,
+                                damping,
+                                gr,
+                                damping_floor(dhat),
+                                jac,
                             ) {
                                 e += s.energy;
                                 let gr = s.normal_grad + s.friction_grad;
