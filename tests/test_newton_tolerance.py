@@ -14,27 +14,22 @@ from cablelife.scene import scene_from_dict
 from cablelife.simulate import simulate
 
 
-def hose(channel: str, amplitude: float, damping: dict | None = None) -> dict:
+def two_clips(
+    end: list[float], directions: tuple[list, list], youngs: float, channel: str, signal: dict
+) -> dict:
+    """A hose (1 m, 50 segments, r = 5 mm) clamped at the origin and at `end` on a body
+    'engine' that `signal` moves along `channel`; 0.3 s at 1 ms, every step saved."""
     cable = {
         "name": "hose",
         "length": 1.0,
         "segments": 50,
         "section": {"shape": "circle", "radius": 0.005},
-        "material": {"youngs_modulus": 5.0e7, "poisson_ratio": 0.45, "density": 1500.0},
+        "material": {"youngs_modulus": youngs, "poisson_ratio": 0.45, "density": 1500.0},
         "clips": [
-            {"name": "a", "s": 0.0, "position": [0, 0, 0], "direction": [1, 0, 0]},
-            {
-                "name": "b",
-                "s": 1.0,
-                "body": "engine",
-                "position": [0.8, 0.2, 0.0],
-                "direction": [1, 0, 0],
-            },
+            {"name": "a", "s": 0.0, "position": [0, 0, 0], "direction": directions[0]},
+            {"name": "b", "s": 1.0, "body": "engine", "position": end, "direction": directions[1]},
         ],
     }
-    if damping:
-        cable["damping"] = damping
-    signal = {"type": "sine", "amplitude": amplitude, "frequency": 10.0, "fade_in": 0.1}
     return {
         "simulation": {
             "mode": "dynamic",
@@ -44,24 +39,30 @@ def hose(channel: str, amplitude: float, damping: dict | None = None) -> dict:
             "output_step": 0.001,
         },
         "bodies": [
-            {
-                "name": "engine",
-                "origin": [0.8, 0.2, 0.0],
-                "motion": [{"channel": channel, "signal": signal}],
-            }
+            {"name": "engine", "origin": end, "motion": [{"channel": channel, "signal": signal}]}
         ],
         "cables": [cable],
     }
 
 
-def moments(d: dict, tolerance: float | None, dt: float) -> np.ndarray:
+def hose(channel: str, amplitude: float, damping: dict | None = None) -> dict:
+    signal = {"type": "sine", "amplitude": amplitude, "frequency": 10.0, "fade_in": 0.1}
+    d = two_clips([0.8, 0.2, 0.0], ([1, 0, 0], [1, 0, 0]), 5.0e7, channel, signal)
+    if damping:
+        d["cables"][0]["damping"] = damping
+    return d
+
+
+def run(d: dict, tolerance: float | None, dt: float = 0.001):
+    """The cable's result of scene `d` at time step `dt` with `newton_tolerance` (None: the
+    default)."""
     d = copy.deepcopy(d)
     d["simulation"]["time_step"] = dt
     if tolerance is not None:
         d["simulation"]["newton_tolerance"] = tolerance
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        return simulate(scene_from_dict(d)).cable.moments
+        return simulate(scene_from_dict(d)).cable
 
 
 def rel(a: np.ndarray, b: np.ndarray) -> float:
@@ -79,9 +80,9 @@ def rel(a: np.ndarray, b: np.ndarray) -> float:
     ids=["overdamped-10Hz", "default-damping-10Hz"],
 )
 def test_iteration_error_is_below_the_time_discretisation_error(scene):
-    default = moments(scene, None, 0.001)
-    tight = moments(scene, 1e-9, 0.001)
-    fine = moments(scene, 1e-9, 0.00025)
+    default = run(scene, None).moments
+    tight = run(scene, 1e-9).moments
+    fine = run(scene, 1e-9, 0.00025).moments
     iteration, time = rel(default, tight), rel(tight, fine)
     assert iteration < 0.5 * time, (iteration, time)
 
@@ -89,42 +90,12 @@ def test_iteration_error_is_below_the_time_discretisation_error(scene):
 def draped(signal: dict, friction: float = 0.3, duration: float = 0.3) -> dict:
     """A soft hose (1 m) between clips 0.7 m apart, its sag lying on a table 0.2 m below them
     (24–25 nodes touching, Coulomb friction μ); the right clip's body moved along z."""
-    cable = {
-        "name": "hose",
-        "length": 1.0,
-        "segments": 50,
-        "section": {"shape": "circle", "radius": 0.005},
-        "material": {"youngs_modulus": 2.0e7, "poisson_ratio": 0.45, "density": 1500.0},
-        "clips": [
-            {"name": "a", "s": 0.0, "position": [0, 0, 0], "direction": [1, 0, -0.5]},
-            {
-                "name": "b",
-                "s": 1.0,
-                "body": "bracket",
-                "position": [0.7, 0, 0],
-                "direction": [1, 0, 0.5],
-            },
-        ],
-    }
+    d = two_clips([0.7, 0.0, 0.0], ([1, 0, -0.5], [1, 0, 0.5]), 2.0e7, "z", signal)
     table = {"shape": "plane", "name": "table", "point": [0, 0, -0.2], "normal": [0, 0, 1]}
-    return {
-        "simulation": {
-            "mode": "dynamic",
-            "duration": duration,
-            "time_step": 0.001,
-            "output_step": 0.001,
-        },
-        "bodies": [
-            {
-                "name": "bracket",
-                "origin": [0.7, 0, 0],
-                "motion": [{"channel": "z", "signal": signal}],
-            },
-            {"name": "floor", "geometry": [table]},
-        ],
-        "contact": {"enabled": True, "friction": friction},
-        "cables": [cable],
-    }
+    d["simulation"]["duration"] = duration
+    d["bodies"].append({"name": "floor", "geometry": [table]})
+    d["contact"] = {"enabled": True, "friction": friction}
+    return d
 
 
 def random_motion(rms: float) -> dict:
@@ -142,24 +113,14 @@ def random_motion(rms: float) -> dict:
 SINE_20HZ = {"type": "sine", "amplitude": 0.003, "frequency": 20.0, "fade_in": 0.05}
 
 
-def contact_run(d: dict, tolerance: float | None, dt: float = 0.001):
-    d = copy.deepcopy(d)
-    d["simulation"]["time_step"] = dt
-    if tolerance is not None:
-        d["simulation"]["newton_tolerance"] = tolerance
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        return simulate(scene_from_dict(d)).cable
-
-
 @pytest.mark.parametrize(
     "signal", [SINE_20HZ, random_motion(0.001)], ids=["sine-20Hz", "random-1mm"]
 )
 def test_iteration_error_with_contact_is_below_the_time_discretisation_error(signal):
     # Measured (moments, rms relative): sine 0.015 of the time error, random 0.12.
     d = draped(signal)
-    default, tight = contact_run(d, None), contact_run(d, 1e-9)
-    fine = contact_run(d, 1e-9, 0.00025)
+    default, tight = run(d, None), run(d, 1e-9)
+    fine = run(d, 1e-9, 0.00025)
     assert (default.contact["contact_state"] > 0).sum(axis=1).min() >= 20  # it lies on the table
     iteration, time = rel(default.moments, tight.moments), rel(tight.moments, fine.moments)
     assert iteration < 0.5 * time, (iteration, time)
@@ -169,7 +130,7 @@ def test_the_scene_tolerance_governs_runs_with_contact():
     # Before session 15 a run with contact held fixed fractions of the step's increment alone:
     # `newton_tolerance` changed nothing, so a converged reference could not be computed.
     d = draped(SINE_20HZ, duration=0.15)
-    default, tighter, tight = (contact_run(d, t) for t in (None, 1e-4, 1e-9))
+    default, tighter, tight = (run(d, t) for t in (None, 1e-4, 1e-9))
     assert tighter.solver["iterations"].mean() > default.solver["iterations"].mean()
     assert rel(tighter.moments, tight.moments) < 0.1 * rel(default.moments, tight.moments)
 
@@ -179,9 +140,8 @@ def test_a_hose_held_by_high_friction_on_a_table_completes():
     # zone at step 36 (20 iterations, 3 N left; every split of the step too) until the line
     # search of a cycling iteration kept frictional samples from jumping across it
     # (`Contact::line_search`'s stick cut, as the step bound and the sliding clips' guides).
-    res = contact_run(draped(random_motion(0.001), friction=1.0, duration=0.06), None)
+    res = run(draped(random_motion(0.001), friction=1.0, duration=0.06), None)
     assert len(res.time) == 61
     state = res.contact["contact_state"]
     assert (state > 0).sum(axis=1).min() >= 20
     assert (state[:50] == 1).sum(axis=1).min() >= 20  # held by friction up to there
-
