@@ -160,7 +160,7 @@ pub fn clearance(
                 }
                 for (j, frames) in local.chunks(width).enumerate() {
                     let row = j * n_nodes..(j + 1) * n_nodes;
-                    step(
+                    node_clearance(
                         parts,
                         frames,
                         n_nodes,
@@ -201,7 +201,7 @@ pub fn clearance(
 /// its half-edges, which start at the node: their distance is at most the node's, so the
 /// minimum is the same (to round-off). This needs half-edges (two nodes or more).
 #[allow(clippy::too_many_arguments)]
-fn step(
+fn node_clearance(
     parts: &[Part],
     local: &[V3],
     n: usize,
