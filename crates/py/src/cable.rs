@@ -814,7 +814,7 @@ impl Cable {
     /// the motion near the contact (0: none); `stop` as there.
     #[pyo3(signature = (time_step, positions, quaternions, velocities, angular_velocities,
         accelerations, angular_accelerations, output_every, tau_shear, tau_bend,
-        spectral_radius=0.9, newton_tolerance=DynamicOptions::default().tolerance, progress=None,
+        spectral_radius=0.9, newton_tolerance=rod::dynamics::DEFAULT_TOLERANCE, progress=None,
         progress_every=100, stop=None))]
     #[allow(clippy::too_many_arguments)]
     fn run_dynamic<'py>(

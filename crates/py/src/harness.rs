@@ -461,7 +461,7 @@ impl Harness {
     /// Junctions held by a clip follow its motion (given for their first end); sliding clips
     /// slide (a cable running out of one stops the run).
     #[pyo3(signature = (time_step, kinematics, output_every, tau_shear, tau_bend,
-        spectral_radius=0.9, newton_tolerance=DynamicOptions::default().tolerance, progress=None,
+        spectral_radius=0.9, newton_tolerance=rod::dynamics::DEFAULT_TOLERANCE, progress=None,
         progress_every=100, stop=None))]
     #[allow(clippy::too_many_arguments, clippy::type_complexity)]
     fn run_dynamic<'py>(

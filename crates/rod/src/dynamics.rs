@@ -202,6 +202,23 @@ pub struct StepStats {
 }
 
 impl StepStats {
+    /// These stats with an impact sub-step's energy `gain` recorded: given back from the
+    /// motion near the contact (`impact_dissipation`) or, where that motion held less,
+    /// unresolved.
+    pub(crate) fn with_impact(self, gain: f64, given_back: bool) -> StepStats {
+        if given_back {
+            StepStats {
+                impact_dissipation: gain,
+                ..self
+            }
+        } else {
+            StepStats {
+                unresolved_gain: gain,
+                ..self
+            }
+        }
+    }
+
     /// The stats of this step followed by `next` (sub-steps of one step).
     pub fn then(self, next: StepStats) -> StepStats {
         StepStats {
@@ -237,6 +254,29 @@ pub struct Energies {
     pub dissipated: f64,
     /// Energy of the contact barrier.
     pub contact: f64,
+}
+
+impl Energies {
+    /// The step guard's measure from these energies to `after`: the gain of the energy in
+    /// motion (kinetic, elastic, gravity, barrier) beyond the clips' `work`, relative to the
+    /// energies at play, and that scale (J).
+    pub(crate) fn gain_to(&self, after: &Energies, work: f64) -> (f64, f64) {
+        let total = |e: &Energies| e.kinetic + e.elastic + e.load_potential + e.contact;
+        let scale = self.kinetic + after.kinetic + self.elastic.abs() + self.contact + work.abs();
+        ((total(after) - total(self) - work) / scale, scale)
+    }
+}
+
+/// The work of a clip's reaction (force, moment) over a step from pose `p0` (reaction `r0`)
+/// to pose `p1` (reaction `r1`), by the trapezoidal rule.
+pub(crate) fn reaction_work(
+    (f0, m0): (&Vector3<f64>, &Vector3<f64>),
+    (f1, m1): (&Vector3<f64>, &Vector3<f64>),
+    p0: &Pose,
+    p1: &Pose,
+) -> f64 {
+    let turn = log_vec(&(p1.orientation * p0.orientation.conjugate()));
+    0.5 * (f0 + f1).dot(&(p1.position - p0.position)) + 0.5 * (m0 + m1).dot(&turn)
 }
 
 /// The factorisation state of one segment's iteration matrix.
@@ -964,18 +1004,12 @@ impl Dynamics {
         let result = match (result, before) {
             (Ok(s), Some((e0, r0, poses0))) if !self.obstacles_moved => {
                 self.update_outputs(rod, st)?;
-                let e1 = self.energies;
                 let mut work = 0.0;
                 for (c, (f0, m0)) in r0.iter().enumerate() {
                     let (f1, m1) = self.ws.clip_reaction(rod, st, c);
-                    let (p0, p1) = (&poses0[c], &st.clip_pose[c]);
-                    let turn = log_vec(&(p1.orientation * p0.orientation.conjugate()));
-                    work += 0.5 * (f0 + f1).dot(&(p1.position - p0.position))
-                        + 0.5 * (m0 + m1).dot(&turn);
+                    work += reaction_work((f0, m0), (&f1, &m1), &poses0[c], &st.clip_pose[c]);
                 }
-                let total = |e: &Energies| e.kinetic + e.elastic + e.load_potential + e.contact;
-                let scale = e0.kinetic + e1.kinetic + e0.elastic.abs() + e0.contact + work.abs();
-                let gain = (total(&e1) - total(&e0) - work) / scale;
+                let (gain, scale) = e0.gain_to(&self.energies, work);
                 match guard_verdict(gain, self.opts.energy_tolerance, max_depth) {
                     Some(0.0) => Ok(s),
                     Some(g) => self.give_back(rod, st, (g, scale), s),
@@ -1015,18 +1049,12 @@ impl Dynamics {
         (gain, scale): (f64, f64),
         s: StepStats,
     ) -> Result<StepStats, SolveError> {
-        if take_gain(&mut [&mut *self], &[rod], &[st], gain * scale) == 0.0 {
-            return Ok(StepStats {
-                unresolved_gain: gain,
-                ..s
-            });
+        let given_back = take_gain(&mut [&mut *self], &[rod], &[st], gain * scale) != 0.0;
+        if given_back {
+            self.update_outputs(rod, st)?;
+            self.power_n = self.ws.dissipation;
         }
-        self.update_outputs(rod, st)?;
-        self.power_n = self.ws.dissipation;
-        Ok(StepStats {
-            impact_dissipation: gain,
-            ..s
-        })
+        Ok(s.with_impact(gain, given_back))
     }
 
     /// The parts of Δq, v_{n+1} and a_{n+1} fixed during a step (from the values at t_n): all

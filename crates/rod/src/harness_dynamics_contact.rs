@@ -9,11 +9,10 @@
 //! split; at the deepest split a gain is given back from the cables' motion near the contact
 //! (`impact::take_gain`).
 use super::{top, HarnessDynamics};
-use crate::dynamics::{Dynamics, Energies, StepStats};
+use crate::dynamics::{reaction_work, Dynamics, Energies, StepStats};
 use crate::harness::{Harness, HarnessError, HarnessState};
 use crate::impact::take_gain;
 use crate::model::{Pose, Rod};
-use crate::rotation::log_vec;
 use crate::sliding::SlidingClips;
 use crate::state::State;
 use nalgebra::Vector3;
@@ -184,9 +183,7 @@ impl HarnessDynamics {
         }
         self.update_outputs(h, st)?;
         let work_of = |r0: &Reaction, r1: &Reaction| {
-            let turn = log_vec(&(r1.2.orientation * r0.2.orientation.conjugate()));
-            0.5 * (r0.0 + r1.0).dot(&(r1.2.position - r0.2.position))
-                + 0.5 * (r0.1 + r1.1).dot(&turn)
+            reaction_work((&r0.0, &r0.1), (&r1.0, &r1.1), &r0.2, &r1.2)
         };
         let mut work = 0.0;
         for (c0, c1) in start.clips.iter().zip(self.own_clip_reactions(h, st)) {
@@ -199,10 +196,7 @@ impl HarnessDynamics {
                 work += work_of(r0, &r1);
             }
         }
-        let (e0, e1) = (&start.energies, &self.energies);
-        let total = |e: &Energies| e.kinetic + e.elastic + e.load_potential + e.contact;
-        let scale = e0.kinetic + e1.kinetic + e0.elastic.abs() + e0.contact + work.abs();
-        Ok(((total(e1) - total(e0) - work) / scale, scale))
+        Ok(start.energies.gain_to(&self.energies, work))
     }
 
     /// A sub-step at the deepest split that gained `gain` (relative to `scale`, J): the
@@ -218,20 +212,14 @@ impl HarnessDynamics {
         let rods: Vec<&Rod> = h.cables.iter().collect();
         let mut cables: Vec<&mut Dynamics> = self.cables.iter_mut().collect();
         let states: Vec<&State> = st.cables.iter().collect();
-        if take_gain(&mut cables, &rods, &states, gain * scale) == 0.0 {
-            return Ok(StepStats {
-                unresolved_gain: gain,
-                ..s
-            });
+        let given_back = take_gain(&mut cables, &rods, &states, gain * scale) != 0.0;
+        if given_back {
+            self.update_outputs(h, st)?;
+            for dy in &mut self.cables {
+                dy.power_n = dy.ws.dissipation;
+            }
         }
-        self.update_outputs(h, st)?;
-        for dy in &mut self.cables {
-            dy.power_n = dy.ws.dissipation;
-        }
-        Ok(StepStats {
-            impact_dissipation: gain,
-            ..s
-        })
+        Ok(s.with_impact(gain, given_back))
     }
 
     /// Puts back the dissipated energies of `start` (a step that will be redone).
