@@ -20,6 +20,7 @@ use crate::block_tridiag::BlockTridiag;
 use crate::contact::Contact;
 use crate::impact::take_gain;
 use crate::model::{EdgeKind, NodeKind, Pose, Rod, Segment};
+use crate::predictor::Extrapolation;
 use crate::rotation::{log_vec, right_jacobian, rotate_body, rotation_matrix, skew, slerp, Quat};
 use crate::sliding::SlidingClips;
 use crate::state::State;
@@ -307,6 +308,8 @@ pub struct Dynamics {
     pose_n: Vec<Pose>,
     v_n: Vec<Vector6<f64>>,
     vdot_n: Vec<Vector6<f64>>,
+    /// The predictor's extrapolation of v̇ (learns λ from the accepted steps).
+    extrapolation: Extrapolation,
     a_n: Vec<Vector6<f64>>,
     pub(crate) delta: Vec<Vector6<f64>>,
     /// Slots with inertia (free nodes, free edges).
@@ -391,6 +394,7 @@ impl Dynamics {
             pose_n: st.clip_pose.clone(),
             v_n: vec![Vector6::zeros(); n + 1],
             vdot_n: vec![Vector6::zeros(); n + 1],
+            extrapolation: Extrapolation::new(n + 1),
             a_n: vec![Vector6::zeros(); n + 1],
             delta: vec![Vector6::zeros(); n + 1],
             inertial_half: inertial.iter().map(|m| [m[0], m[3]]).collect(),
@@ -554,7 +558,17 @@ impl Dynamics {
         self.ghost_n.clone_from(&st.ghost);
         self.pose_n.clone_from(&st.clip_pose);
         self.v_n.clone_from(&self.rates.v);
-        self.vdot_n.clone_from(&self.vdot);
+        // v̇_n into vdot_n, and the predictor (below): v̇_{n+1} = v̇_n + λ (v̇_n − v̇_{n−1})
+        // on the inertial slots, λ ∈ [0, 1] learnt from the accepted steps (crate::predictor)
+        let restarted = self.restarted;
+        self.extrapolation.begin_step(
+            &mut self.vdot,
+            &mut self.vdot_n,
+            Some(&self.inertial),
+            (!restarted).then_some(self.h),
+            h,
+            !restarted && self.contact.is_none(),
+        );
         self.a_n.clone_from(&self.a);
         self.outputs_current = false;
         self.obstacles_moved = false;
@@ -583,10 +597,12 @@ impl Dynamics {
         self.poses.extend(clips.iter().map(|m| m.pose));
         st.set_clip_poses(rod, &self.poses);
         self.prescribe_rates(rod, st, clips);
-        // Predictor: constant acceleration, v̇_{n+1} = v̇_n — v̇ already holds v̇_n on the
-        // inertial slots (docs/dynamics.md, "Predictor": 2.70 → 2.04 iterations per step on
+        // Predictor: v̇_{n+1} = v̇_n + λ (v̇_n − v̇_{n−1}), λ ∈ [0, 1] learnt from the run
+        // (crate::predictor, above; λ = 0 is constant acceleration). docs/dynamics.md,
+        // "Predictor": constant acceleration took 2.70 → 2.04 iterations per step on
         // bench_harness.py's cable, 4.45 → 4.32 on bench_dynamic.py, against the former
-        // constant-velocity predictor Δq = v_n). The first step after a (re)start takes
+        // constant-velocity predictor Δq = v_n; the learnt extrapolation 2.36 → 2.08 on
+        // bench_harness.py's harness. The first step after a (re)start takes
         // constant velocity: v̇ may hold the response to a jump of the clip velocities (a
         // shock), which constant acceleration would carry through the whole step; so does
         // every step with contact (an impact is a shock; the contact term's energy behaviour
@@ -612,8 +628,8 @@ impl Dynamics {
     }
 
     /// Advances from t_n to t_n + h with the clips at their kinematics at t_{n+1}. A step
-    /// whose Newton iteration fails from the constant-acceleration predictor is done again
-    /// from the constant-velocity one (a shock: v̇_n far from v̇_{n+1}).
+    /// whose Newton iteration fails from the accelerations' predictor (constant or
+    /// extrapolated) is done again from constant velocity (a shock: v̇_n far from v̇_{n+1}).
     pub fn step(
         &mut self,
         rod: &Rod,

@@ -21,6 +21,7 @@ use crate::dynamics::{
 use crate::harness::{Harness, HarnessError, HarnessState, HarnessStatics};
 use crate::harness_solver::vec_to_junction;
 use crate::model::Pose;
+use crate::predictor::Extrapolation;
 use crate::rotation::{log_vec, right_jacobian, rotate_body, rotation_matrix, skew};
 use crate::sliding::SlidingClips;
 use crate::statics::{NewtonOptions, SolveError};
@@ -54,6 +55,9 @@ pub struct HarnessDynamics {
     ja: Vec<Vector6<f64>>,
     jv_n: Vec<Vector6<f64>>,
     jvdot_n: Vec<Vector6<f64>>,
+    /// The junctions' predictor (as the cables': crate::predictor) and the last step size.
+    jextrapolation: Extrapolation,
+    last_dt: f64,
     ja_n: Vec<Vector6<f64>>,
     jpose_n: Vec<Pose>,
     jdq0: Vec<Vector6<f64>>,
@@ -98,6 +102,8 @@ impl HarnessDynamics {
             ja: vec![Vector6::zeros(); nj],
             jv_n: vec![Vector6::zeros(); nj],
             jvdot_n: vec![Vector6::zeros(); nj],
+            jextrapolation: Extrapolation::new(nj),
+            last_dt: 0.0,
             ja_n: vec![Vector6::zeros(); nj],
             jpose_n: st.junctions.clone(),
             jdq0: vec![Vector6::zeros(); nj],
@@ -501,18 +507,29 @@ impl HarnessDynamics {
         clips: &[Vec<ClipMotion>],
     ) -> (f64, f64) {
         let ga = self.ga;
+        let restarted = self.cables.iter().any(|d| d.restarted);
         self.jpose_n.clone_from(&st.junctions);
         self.jv_n.clone_from(&self.jv);
-        self.jvdot_n.clone_from(&self.jvdot);
+        // v̇_n into jvdot_n and the predictor (as the cables'; held junctions get their
+        // prescribed kinematics after it)
+        let predict = !restarted && !self.has_contact();
+        self.jextrapolation.begin_step(
+            &mut self.jvdot,
+            &mut self.jvdot_n,
+            None,
+            (!restarted).then_some(self.last_dt),
+            dt,
+            predict,
+        );
+        self.last_dt = dt;
         self.ja_n.clone_from(&self.ja);
         self.prescribe_held(h, clips);
         self.end_motions(h, st, clips);
-        let restarted = self.cables.iter().any(|d| d.restarted);
         for (c, rod) in h.cables.iter().enumerate() {
             self.cables[c].begin_step(rod, &mut st.cables[c], dt, &self.motions[c]);
         }
-        // The junctions: the cables' predictor (v̇_{n+1} = v̇_n: jvdot holds it; constant
-        // velocity after a restart and with contact, as the cables') and kinematics.
+        // The junctions' predictor after a restart and with contact: constant velocity (as
+        // the cables'); their kinematics.
         if restarted || self.has_contact() {
             let c_a = ((1.0 - ga.alpha_m) * (-(0.5 - ga.beta) / ga.beta) + ga.alpha_m)
                 / (1.0 - ga.alpha_f);

@@ -22,6 +22,7 @@ mod impact;
 pub mod junction;
 pub mod modal;
 pub mod model;
+mod predictor;
 mod projection;
 pub mod rotation;
 pub mod routing;
