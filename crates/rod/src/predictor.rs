@@ -92,22 +92,29 @@ impl Extrapolation {
         let extrapolate = lambda != [0.0; 2];
         let observe = self.observed > 0;
         let (mut cross, mut square) = ([0.0; 2], [0.0; 2]);
+        let all = [true; 6];
         for (b, ((v, l), p)) in vdot
             .iter_mut()
             .zip(vdot_n.iter_mut())
             .zip(&mut self.prev)
             .enumerate()
         {
+            let m = inertial.map_or(&all, |m| &m[b]);
             let now = *v;
-            let (d, d_old) = (now - *l, *l - *p);
-            for k in 0..6 {
-                if inertial.is_none_or(|m| m[b][k]) {
-                    if observe {
+            let d = now - *l;
+            if observe {
+                let d_old = *l - *p;
+                for k in 0..6 {
+                    if m[k] {
                         cross[k / 3] += d[k] * d_old[k];
                         square[k / 3] += d_old[k] * d_old[k];
                     }
-                    if extrapolate {
-                        v[k] += lambda[k / 3] * d[k];
+                }
+            }
+            if extrapolate {
+                for k in 0..6 {
+                    if m[k] {
+                        v[k] = now[k] + lambda[k / 3] * d[k];
                     }
                 }
             }
