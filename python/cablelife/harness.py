@@ -177,7 +177,7 @@ def default_normals(scene: Scene, cable: Cable, n_own: int, given: set, ends: li
     sources = [k for k, clip in enumerate(cable.clips) if k < n_own or clip.name in given]
     if not sources:
         return cable
-    core = build_cable(scene, cable)
+    core = build_cable(scene, cable, check=False)  # built and checked again for the run
     clips = list(cable.clips)
     for e in ends:
         src = min(sources, key=lambda k: abs(cable.clips[k].s - cable.clips[e].s))

@@ -237,8 +237,10 @@ def clip_poses(
     return k["positions"], k["quaternions"]
 
 
-def build_cable(scene: Scene, cable: Cable) -> _core.Cable:
-    """The Rust solver object of one cable at its reference clip poses."""
+def build_cable(scene: Scene, cable: Cable, check: bool = True) -> _core.Cable:
+    """The Rust solver object of one cable at its reference clip poses; ``check``: warn when
+    its tangent stiffness there is ill-conditioned (off for helper builds whose cable is
+    built and checked again for the run)."""
     props = cable.properties()
     pos, quat = clip_poses(scene, cable, np.array([0.0]), with_motion=False)
     clips = [
@@ -271,7 +273,8 @@ def build_cable(scene: Scene, cable: Cable) -> _core.Cable:
             f"the cable into {used} intervals that need one segment each; allowed: segments "
             f">= {used} (or max_segment_length)"
         )
-    _check_conditioning(cable, props, core)
+    if check:
+        _check_conditioning(cable, props, core)
     return core
 
 
