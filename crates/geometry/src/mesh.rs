@@ -299,38 +299,10 @@ impl TriMesh {
                 vertex_normals[f[k] as usize] += n * angle;
             }
         }
-        // edge pseudo-normals: sum of the normals of the faces sharing the edge (edges grouped
-        // by sorting their vertex pairs)
-        let mut keys: Vec<(u64, u32)> = Vec::with_capacity(faces.len() * 3);
-        for (i, f) in faces.iter().enumerate() {
-            for k in 0..3 {
-                keys.push((edge_key(f[k], f[(k + 1) % 3]), (3 * i + k) as u32));
-            }
-        }
-        keys.par_sort_unstable();
-        let mut edge_of = vec![V3::zeros(); faces.len() * 3];
-        // closed and consistently oriented: every edge in two faces, once in each direction
-        let forward = |side: u32| {
-            let f = &faces[side as usize / 3];
-            let k = side as usize % 3;
-            f[k] < f[(k + 1) % 3]
-        };
-        let mut closed = true;
-        let mut g = 0;
-        while g < keys.len() {
-            let mut h = g;
-            let mut sum = V3::zeros();
-            while h < keys.len() && keys[h].0 == keys[g].0 {
-                sum += normals[keys[h].1 as usize / 3];
-                h += 1;
-            }
-            closed &= h - g == 2 && forward(keys[g].1) != forward(keys[g + 1].1);
-            for key in &keys[g..h] {
-                edge_of[key.1 as usize] = sum;
-            }
-            g = h;
-        }
-        drop(keys);
+        // edge pseudo-normals: sum of the normals of the faces sharing the edge, and whether the
+        // mesh is closed and consistently oriented: every edge in two faces, once in each
+        // direction
+        let (edge_of, closed) = edge_normals(vertices.len(), faces, &normals);
         // hierarchy over the triangle centroids
         let mut items: Vec<(V3, u32)> = faces
             .par_iter()
@@ -355,17 +327,18 @@ impl TriMesh {
         };
         let mut nodes = vec![Node::EMPTY; tree_size(items.len())];
         build(&mut items, 0, 0, &mut nodes, &ctx);
-        let order: Vec<usize> = items.iter().map(|&(_, i)| i as usize).collect();
+        // the per-triangle arrays in hierarchy order (parallel gathers)
+        let order: Vec<usize> = items.par_iter().map(|&(_, i)| i as usize).collect();
         let triangles = order
-            .iter()
+            .par_iter()
             .map(|&i| faces[i].map(|k| vertices[k as usize]))
             .collect();
-        let corners = order.iter().map(|&i| faces[i]).collect();
+        let corners = order.par_iter().map(|&i| faces[i]).collect();
         let spheres = triangles_spheres(&order, faces, vertices);
-        let face_normals: Vec<V3> = order.iter().map(|&i| normals[i]).collect();
+        let face_normals: Vec<V3> = order.par_iter().map(|&i| normals[i]).collect();
         let edge_normals = order
-            .iter()
-            .map(|&i| [0, 1, 2].map(|k| edge_of[3 * i + k]))
+            .par_iter()
+            .map(|&i| [0, 1, 2].map(|k| edge_of.of(3 * i + k)))
             .collect();
         let view = BinaryView {
             nodes: &nodes,
@@ -979,7 +952,7 @@ impl Surface for TriMesh {
 
 fn triangles_spheres(order: &[usize], faces: &[[u32; 3]], vertices: &[V3]) -> Vec<(V3, f64)> {
     order
-        .iter()
+        .par_iter()
         .map(|&i| {
             let v = faces[i].map(|k| vertices[k as usize]);
             let c = (v[0] + v[1] + v[2]) / 3.0;
@@ -989,10 +962,103 @@ fn triangles_spheres(order: &[usize], faces: &[[u32; 3]], vertices: &[V3]) -> Ve
         .collect()
 }
 
-#[inline]
-fn edge_key(a: u32, b: u32) -> u64 {
-    let (lo, hi) = if a < b { (a, b) } else { (b, a) };
-    ((lo as u64) << 32) | hi as u64
+/// Per triangle side (3 t + k: from corner k to corner k + 1) the sum of the normals of the
+/// faces sharing its edge: `sum[slot[side]]`.
+struct EdgeSums {
+    slot: Vec<u32>,
+    sum: Vec<V3>,
+}
+
+impl EdgeSums {
+    #[inline]
+    fn of(&self, side: usize) -> V3 {
+        self.sum[self.slot[side] as usize]
+    }
+}
+
+/// The edges' normal sums ([`EdgeSums`]) and whether every edge is in two faces, once in each
+/// direction. The sides are grouped by a counting sort on their lower vertex (linear in the
+/// triangles; the edges of one vertex, a handful, are matched by their other vertex), in
+/// parallel over vertex ranges; an edge's sum is taken in increasing side order.
+fn edge_normals(n_vertices: usize, faces: &[[u32; 3]], normals: &[V3]) -> (EdgeSums, bool) {
+    let ends = |side: usize| {
+        let f = &faces[side / 3];
+        let (a, b) = (f[side % 3], f[(side + 1) % 3]);
+        if a < b {
+            (a, b, true)
+        } else {
+            (b, a, false)
+        }
+    };
+    let n_sides = 3 * faces.len();
+    // bucket boundaries by lower vertex, then each side's other vertex into its bucket (in
+    // increasing side order)
+    let mut start = vec![0u32; n_vertices + 1];
+    for side in 0..n_sides {
+        start[ends(side).0 as usize + 1] += 1;
+    }
+    for v in 0..n_vertices {
+        start[v + 1] += start[v];
+    }
+    let mut other = vec![(0u32, 0u32); n_sides];
+    let mut slot = vec![0u32; n_sides];
+    let mut next = start.clone();
+    for (side, at_side) in slot.iter_mut().enumerate() {
+        let (lo, hi, _) = ends(side);
+        let at = &mut next[lo as usize];
+        other[*at as usize] = (hi, side as u32);
+        *at_side = *at;
+        *at += 1;
+    }
+    drop(next);
+    // per range of vertices (in parallel): the sides of one edge share the other vertex
+    let chunk = n_vertices
+        .div_ceil(8 * rayon::current_num_threads())
+        .max(1024);
+    let mut sum = vec![V3::zeros(); n_sides];
+    let mut parts = Vec::new();
+    let (mut rest, mut done) = (sum.as_mut_slice(), 0usize);
+    for v0 in (0..n_vertices).step_by(chunk) {
+        let v1 = (v0 + chunk).min(n_vertices);
+        let (part, tail) = std::mem::take(&mut rest).split_at_mut(start[v1] as usize - done);
+        parts.push((v0..v1, part));
+        rest = tail;
+        done = start[v1] as usize;
+    }
+    let closed = parts
+        .into_par_iter()
+        .map(|(vertices, part)| {
+            let base = start[vertices.start] as usize;
+            let mut closed = true;
+            let mut order: Vec<usize> = Vec::new();
+            for v in vertices {
+                let (a, b) = (start[v] as usize, start[v + 1] as usize);
+                // the bucket's entries by other vertex, then side (sides arrive in increasing
+                // order, so a stable sort by other vertex; buckets hold a handful)
+                order.clear();
+                order.extend(0..b - a);
+                order.sort_by_key(|&k| other[a + k].0);
+                let mut g = 0;
+                while g < order.len() {
+                    let hi = other[a + order[g]].0;
+                    let mut h = g;
+                    let mut total = V3::zeros();
+                    while h < order.len() && other[a + order[h]].0 == hi {
+                        total += normals[other[a + order[h]].1 as usize / 3];
+                        h += 1;
+                    }
+                    let side = |i: usize| other[a + order[i]].1 as usize;
+                    closed &= h - g == 2 && ends(side(g)).2 != ends(side(g + 1)).2;
+                    for &k in &order[g..h] {
+                        part[a - base + k] = total;
+                    }
+                    g = h;
+                }
+            }
+            closed
+        })
+        .reduce(|| true, |x, y| x && y);
+    (EdgeSums { slot, sum }, closed)
 }
 
 struct BuildData<'a> {
@@ -1195,6 +1261,98 @@ mod tests {
             .unwrap();
         assert!((s.distance - 0.5f64.sqrt()).abs() < 1e-14);
         assert!((s.t - 0.5).abs() < 1e-12);
+    }
+
+    #[test]
+    fn edge_sums_equal_a_sort_of_all_sides() {
+        // a fan of 100 triangles around vertex 0 (its bucket holds 200 sides), a strip, a
+        // non-manifold edge in three faces and open boundaries: every side's sum equal to the
+        // bit to the sums over a sort of all sides by (edge, side); closedness
+        let mut v = vec![V3::zeros()];
+        let mut f = vec![];
+        for k in 0..100 {
+            let a = 2.0 * std::f64::consts::PI * k as f64 / 100.0;
+            v.push(V3::new(a.cos(), a.sin(), 0.01 * k as f64));
+        }
+        for k in 0..100u32 {
+            f.push([0, 1 + k, 1 + (k + 1) % 100]);
+        }
+        let s = v.len() as u32;
+        for k in 0..20 {
+            v.push(V3::new(3.0 + k as f64 * 0.1, 0.0, 0.0));
+            v.push(V3::new(3.0 + k as f64 * 0.1, 0.2, 0.05 * (k as f64).sin()));
+        }
+        for k in 0..19u32 {
+            let a = s + 2 * k;
+            f.push([a, a + 2, a + 1]);
+            f.push([a + 1, a + 2, a + 3]);
+        }
+        let w = v.len() as u32;
+        v.push(V3::new(5.0, 0.0, 1.0));
+        f.push([s, s + 1, w]); // a third face on the strip's first edge
+        let normals: Vec<V3> = f
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|k| v[k as usize]);
+                (b - a).cross(&(c - a)).normalize()
+            })
+            .collect();
+        let (sums, closed) = edge_normals(v.len(), &f, &normals);
+        assert!(!closed);
+        let key = |t: &[u32; 3], k: usize| {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            (a.min(b), a.max(b))
+        };
+        let mut keys: Vec<((u32, u32), usize)> = (0..3 * f.len())
+            .map(|side| (key(&f[side / 3], side % 3), side))
+            .collect();
+        keys.sort();
+        for g in keys.chunk_by(|x, y| x.0 == y.0) {
+            let mut total = V3::zeros();
+            for &(_, side) in g {
+                total += normals[side / 3];
+            }
+            for &(_, side) in g {
+                assert_eq!(sums.of(side), total, "side {side}");
+            }
+        }
+        // the closed cube
+        let cube = cube();
+        assert!(cube.is_closed());
+    }
+
+    #[test]
+    fn parallel_collapse_lays_out_the_wide_tree_as_one_pass() {
+        // 80 000 triangles (a bumpy grid): the root's subtrees are collapsed in parallel
+        let n = 200;
+        let v: Vec<V3> = (0..=n)
+            .flat_map(|i| {
+                (0..=n).map(move |j| {
+                    let (x, y) = (i as f64 / n as f64, j as f64 / n as f64);
+                    V3::new(x, y, 0.05 * (9.0 * x).sin() * (7.0 * y).cos())
+                })
+            })
+            .collect();
+        let mut f = vec![];
+        for i in 0..n as u32 {
+            for j in 0..n as u32 {
+                let a = i * (n as u32 + 1) + j;
+                let (b, c, d) = (a + n as u32 + 1, a + 1, a + n as u32 + 2);
+                f.push([a, b, d]);
+                f.push([a, d, c]);
+            }
+        }
+        let m = TriMesh::new(&v, &f).unwrap();
+        let view = BinaryView {
+            nodes: &m.nodes,
+            spheres: &m.spheres,
+            normals: &m.face_normals,
+        };
+        let (wide, blocks) = wide::collapse_serial(&view, 0);
+        assert!(wide.len() > 1000 && m.wide[0].wide.iter().all(|&w| w & LEAF == 0));
+        let show = |x: &dyn std::fmt::Debug| format!("{x:?}");
+        assert_eq!(show(&m.wide), show(&wide));
+        assert_eq!(show(&m.blocks), show(&blocks));
     }
 
     #[test]

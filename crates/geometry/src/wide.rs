@@ -8,6 +8,8 @@
 //! lower bound of the exact float64 distance: it only ever skips what the float64 test would
 //! skip. The binary nodes keep their float64 data (slab and ball bounds, triangle ranges): the
 //! wide nodes point at them, and the leaves are tested exactly.
+use rayon::prelude::*;
+
 use crate::V3;
 
 /// A lane with no node: an empty box (every distance infinite).
@@ -214,6 +216,15 @@ impl Rounded {
 }
 
 impl Wide {
+    /// A node with no lanes.
+    const EMPTY: Wide = Wide {
+        min: [[f32::INFINITY; 4]; 3],
+        max: [[f32::NEG_INFINITY; 4]; 3],
+        node: [EMPTY; 4],
+        wide: [EMPTY; 4],
+        disk: Disk4::NONE,
+    };
+
     /// Lower bounds (float32, see [`F32_SAFE`]) of the squared distances between the box q
     /// and the four lanes' boxes; infinite for empty lanes.
     #[inline(always)]
@@ -252,24 +263,73 @@ pub(crate) trait Binary {
 }
 
 /// Wide nodes over the binary tree rooted at `root` (wide node 0 holds the root's children,
-/// or the root itself when it is a leaf) and the leaves' triangle disks.
-pub(crate) fn collapse<T: Binary + ?Sized>(tree: &T, root: u32) -> (Vec<Wide>, Vec<Disk4>) {
-    let mut out = (Vec::new(), Vec::new());
+/// or the root itself when it is a leaf) and the leaves' triangle disks. The subtrees under
+/// wide node 0 are counted, then collapsed in parallel into their places of arrays laid out
+/// as one depth-first pass would lay them out (the same arrays, no copies).
+pub(crate) fn collapse<T: Binary + Sync + ?Sized>(tree: &T, root: u32) -> (Vec<Wide>, Vec<Disk4>) {
     let lanes = match tree.children(root) {
         Some((l, r)) => vec![l, r],
         None => vec![root],
     };
-    push(tree, lanes, &mut out);
-    out
+    let lanes = open(tree, lanes);
+    // per lane of wide node 0: its subtree's wide nodes and blocks
+    let sizes: Vec<(usize, usize)> = lanes
+        .par_iter()
+        .map(|&n| {
+            tree.children(n)
+                .map_or((0, 1), |(a, b)| count(tree, vec![a, b]))
+        })
+        .collect();
+    let n_wide = 1 + sizes.iter().map(|s| s.0).sum::<usize>();
+    let n_blocks = sizes.iter().map(|s| s.1).sum::<usize>();
+    let mut wide: Vec<Wide> = (0..n_wide).into_par_iter().map(|_| Wide::EMPTY).collect();
+    let mut blocks: Vec<Disk4> = (0..n_blocks).into_par_iter().map(|_| Disk4::NONE).collect();
+    let (head, mut wide_rest) = wide.split_at_mut(1);
+    let mut block_rest = blocks.as_mut_slice();
+    let mut sinks = Vec::with_capacity(lanes.len());
+    let (mut w_base, mut b_base) = (1u32, 0u32);
+    for &(nw, nb) in &sizes {
+        let (w, wr) = std::mem::take(&mut wide_rest).split_at_mut(nw);
+        let (b, br) = std::mem::take(&mut block_rest).split_at_mut(nb);
+        sinks.push(Sink {
+            wide: w,
+            blocks: b,
+            n_wide: 0,
+            n_blocks: 0,
+            w_base,
+            b_base,
+        });
+        (wide_rest, block_rest) = (wr, br);
+        (w_base, b_base) = (w_base + nw as u32, b_base + nb as u32);
+    }
+    let links: Vec<u32> = lanes
+        .par_iter()
+        .zip(sinks)
+        .map(|(&n, mut sink)| match tree.children(n) {
+            Some((a, b)) => push(tree, vec![a, b], &mut sink),
+            None => leaf_block(tree, n, &mut sink),
+        })
+        .collect();
+    for (l, (&n, link)) in lanes.iter().zip(links).enumerate() {
+        set_lane(tree, &mut head[0], l, n);
+        head[0].wide[l] = link;
+    }
+    (wide, blocks)
 }
 
-/// Adds the wide node of `lanes` (opening the largest inner lanes until there are four) and,
-/// depth first, those of its inner lanes; returns its index.
-fn push<T: Binary + ?Sized>(
-    tree: &T,
-    mut lanes: Vec<u32>,
-    out: &mut (Vec<Wide>, Vec<Disk4>),
-) -> u32 {
+/// Where [`push`] writes a subtree: its part of the wide nodes and of the blocks, how many
+/// it wrote, and the index of the part's first node and block in the whole arrays.
+struct Sink<'a> {
+    wide: &'a mut [Wide],
+    blocks: &'a mut [Disk4],
+    n_wide: usize,
+    n_blocks: usize,
+    w_base: u32,
+    b_base: u32,
+}
+
+/// `lanes` with the largest inner lanes opened until there are four (or only leaves).
+fn open<T: Binary + ?Sized>(tree: &T, mut lanes: Vec<u32>) -> Vec<u32> {
     while lanes.len() < 4 {
         let open = lanes
             .iter()
@@ -281,42 +341,84 @@ fn push<T: Binary + ?Sized>(
         lanes[i] = l;
         lanes.push(r);
     }
-    let at = out.0.len();
-    out.0.push(Wide {
-        min: [[f32::INFINITY; 4]; 3],
-        max: [[f32::NEG_INFINITY; 4]; 3],
-        node: [EMPTY; 4],
-        wide: [EMPTY; 4],
-        disk: Disk4::NONE,
-    });
-    for (l, &n) in lanes.iter().enumerate() {
-        let (lo, hi) = tree.bounds(n);
-        let r = Rounded::new(&lo, &hi);
-        let w = &mut out.0[at];
-        for k in 0..3 {
-            w.min[k][l] = r.lo[k];
-            w.max[k][l] = r.hi[k];
-        }
-        w.node[l] = n;
-        if let Some((axis, slo, shi, center, radius)) = tree.slab(n) {
-            w.disk.set(l, &axis, slo, shi, &center, radius);
-        }
-        if let Some((a, b)) = tree.children(n) {
-            let c = push(tree, vec![a, b], out);
-            out.0[at].wide[l] = c;
-        } else {
-            let (first, count) = tree.triangles(n);
-            assert!(count <= 4, "a leaf holds at most 4 triangles");
-            let mut block = Disk4::NONE;
-            for i in 0..count {
-                let (axis, lo, hi, center, radius) = tree.disk(first + i);
-                block.set(i, &axis, lo, hi, &center, radius);
-            }
-            out.0[at].wide[l] = LEAF | out.1.len() as u32;
-            out.1.push(block);
-        }
+    lanes
+}
+
+/// The wide nodes and blocks [`push`] writes for `lanes`.
+fn count<T: Binary + ?Sized>(tree: &T, lanes: Vec<u32>) -> (usize, usize) {
+    let mut n = (1, 0);
+    for l in open(tree, lanes) {
+        let (w, b) = tree
+            .children(l)
+            .map_or((0, 1), |(a, b)| count(tree, vec![a, b]));
+        n = (n.0 + w, n.1 + b);
     }
-    at as u32
+    n
+}
+
+/// Lane `l` of `w` for binary node `n`: its box, index and slab (not its link).
+fn set_lane<T: Binary + ?Sized>(tree: &T, w: &mut Wide, l: usize, n: u32) {
+    let (lo, hi) = tree.bounds(n);
+    let r = Rounded::new(&lo, &hi);
+    for k in 0..3 {
+        w.min[k][l] = r.lo[k];
+        w.max[k][l] = r.hi[k];
+    }
+    w.node[l] = n;
+    if let Some((axis, slo, shi, center, radius)) = tree.slab(n) {
+        w.disk.set(l, &axis, slo, shi, &center, radius);
+    }
+}
+
+/// Writes the triangle disks of leaf `n` as the sink's next block; returns its link
+/// (`LEAF | block`).
+fn leaf_block<T: Binary + ?Sized>(tree: &T, n: u32, sink: &mut Sink) -> u32 {
+    let (first, count) = tree.triangles(n);
+    assert!(count <= 4, "a leaf holds at most 4 triangles");
+    let block = &mut sink.blocks[sink.n_blocks];
+    for i in 0..count {
+        let (axis, lo, hi, center, radius) = tree.disk(first + i);
+        block.set(i, &axis, lo, hi, &center, radius);
+    }
+    sink.n_blocks += 1;
+    LEAF | (sink.b_base + sink.n_blocks as u32 - 1)
+}
+
+/// [`collapse`] in one depth-first pass (what the parallel one must equal).
+#[cfg(test)]
+pub(crate) fn collapse_serial<T: Binary + ?Sized>(tree: &T, root: u32) -> (Vec<Wide>, Vec<Disk4>) {
+    let lanes = match tree.children(root) {
+        Some((l, r)) => vec![l, r],
+        None => vec![root],
+    };
+    let (n_wide, n_blocks) = count(tree, lanes.clone());
+    let mut out = (vec![Wide::EMPTY; n_wide], vec![Disk4::NONE; n_blocks]);
+    let mut sink = Sink {
+        wide: &mut out.0,
+        blocks: &mut out.1,
+        n_wide: 0,
+        n_blocks: 0,
+        w_base: 0,
+        b_base: 0,
+    };
+    push(tree, lanes, &mut sink);
+    out
+}
+
+/// Writes the wide node of `lanes` (opening the largest inner lanes until there are four)
+/// and, depth first, those of its inner lanes; returns its index.
+fn push<T: Binary + ?Sized>(tree: &T, lanes: Vec<u32>, sink: &mut Sink) -> u32 {
+    let lanes = open(tree, lanes);
+    let at = sink.n_wide;
+    sink.n_wide += 1;
+    for (l, &n) in lanes.iter().enumerate() {
+        set_lane(tree, &mut sink.wide[at], l, n);
+        sink.wide[at].wide[l] = match tree.children(n) {
+            Some((a, b)) => push(tree, vec![a, b], sink),
+            None => leaf_block(tree, n, sink),
+        };
+    }
+    sink.w_base + at as u32
 }
 
 #[cfg(test)]
