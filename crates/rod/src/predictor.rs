@@ -1,36 +1,58 @@
-//! The dynamic step's predictor of the accelerations: v̇_{n+1} ≈ v̇_n + λ (v̇_n − v̇_{n−1}),
-//! with λ learnt from the run itself.
+//! The dynamic step's predictor of the accelerations, learnt from the run itself:
+//! v̇_{n+1} ≈ v̇_n + μ v̇_n + λ (v̇_n − v̇_{n−1}).
 //!
 //! The Newton iteration of a step starts from predicted accelerations; its first correction
 //! is the predictor's error, and the later ones shrink with it (the iteration matrix is
-//! reused over many steps). Constant acceleration (λ = 0) is right where the increments
-//! d_n = v̇_{n+1} − v̇_n of successive steps are uncorrelated (broadband motion near the
-//! sampling limit); linear extrapolation (λ = 1) where the response is smooth at the step
-//! (a PSD of a few hundred hertz at most sampled at 1 ms). The error of the prediction,
-//! d_n − λ d_{n−1}, has the least mean square for λ = ⟨d_n, d_{n−1}⟩ / ⟨d_{n−1}, d_{n−1}⟩,
-//! the increments' lag-one correlation: estimated from the past steps with exponential
-//! forgetting (`MEMORY` steps), separately for the translational and the rotational
-//! unknowns (m/s², rad/s²), and held to [0, 1] (an oscillation from step to step is not
-//! extrapolated). Measured in docs/dynamics.md ("Predictor").
+//! reused over many steps). The increments d_n = v̇_{n+1} − v̇_n are fitted, by least squares
+//! over the accepted steps with exponential forgetting (`MEMORY` steps), as d_n ≈ μ v̇_n +
+//! λ d_{n−1}: a linear recursion of order two, v̇_{n+1} = (1 + μ + λ) v̇_n − λ v̇_{n−1}. It
+//! holds exactly for a sampled sinusoid, v̇_n = sin(ω n h): μ = 2 cos ωh − 2, λ = 1 — a
+//! response dominated by one frequency is predicted almost exactly; a constant acceleration
+//! gives μ = λ = 0 (constant acceleration, the predictor before), a ramp μ = 0, λ = 1 (linear
+//! extrapolation), uncorrelated accelerations μ = −1, λ = 0 (their mean). The fit is taken
+//! separately for the translational and the rotational unknowns (m/s², rad/s²), with a ridge
+//! of 1e-3 on the normal equations' diagonal (collinear data: alternation, constant motion)
+//! and held to μ ∈ [−4, 0.5], λ ∈ [−1, 1.5], around the sinusoids' μ ∈ [−4, 0], λ = 1 (a fit
+//! beyond is noise). Measured in docs/dynamics.md ("Predictor").
 //!
 //! The predictor changes only where Newton starts: the converged step is the same to the
 //! tolerance, which bounds the iteration error by the time error.
 use nalgebra::Vector6;
 
-/// Steps of memory of the correlation estimate (forgetting factor 1 − 1/MEMORY per step).
+/// Steps of memory of the fit (forgetting factor 1 − 1/MEMORY per step).
 const MEMORY: f64 = 20.0;
-/// Steps observed before λ is used (constant acceleration until then).
+/// Steps observed before the fit is used (constant acceleration until then).
 const WARM_UP: usize = 3;
+/// Ridge on the diagonal of the normal equations, relative.
+const RIDGE: f64 = 1e-3;
+
+/// The sums of the least-squares fit d_n ≈ μ v̇_n + λ d_{n−1} of one kind of unknown:
+/// Σ v̇², Σ v̇ d_old, Σ d_old², Σ d v̇, Σ d d_old (exponentially weighted).
+#[derive(Clone, Copy, Debug, Default)]
+struct Fit([f64; 5]);
+
+impl Fit {
+    /// (μ, λ), or constant acceleration where the data do not determine them.
+    fn solve(&self) -> (f64, f64) {
+        let [vv, vd, dd, rv, rd] = self.0;
+        let (a, c) = (vv * (1.0 + RIDGE), dd * (1.0 + RIDGE));
+        let det = a * c - vd * vd;
+        if det.is_nan() || det <= 0.0 || det.is_infinite() {
+            return (0.0, 0.0);
+        }
+        let mu = (rv * c - vd * rd) / det;
+        let lambda = (a * rd - vd * rv) / det;
+        (mu.clamp(-4.0, 0.5), lambda.clamp(-1.0, 1.5))
+    }
+}
 
 /// The extrapolation of one set of unknowns (a cable's blocks, a harness's junctions).
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Extrapolation {
     /// v̇_{n−1} at the start of a step (from the second observed step on).
     prev: Vec<Vector6<f64>>,
-    /// Exponentially weighted ⟨d_n, d_{n−1}⟩ and ⟨d_{n−1}, d_{n−1}⟩, translations and
-    /// rotations.
-    cross: [f64; 2],
-    square: [f64; 2],
+    /// Translations and rotations.
+    fits: [Fit; 2],
     /// Step size of the observed steps; steps observed since the last reset.
     h: f64,
     observed: usize,
@@ -44,28 +66,22 @@ impl Extrapolation {
         }
     }
 
-    /// λ for translations and rotations (0 until enough steps are observed).
-    pub(crate) fn lambda(&self) -> [f64; 2] {
+    /// (μ, λ) for translations and rotations (0 until enough steps are observed).
+    pub(crate) fn coefficients(&self) -> [(f64, f64); 2] {
         if self.observed < WARM_UP {
-            return [0.0; 2];
+            return [(0.0, 0.0); 2];
         }
-        [0, 1].map(|i| {
-            if self.square[i] > 0.0 {
-                (self.cross[i] / self.square[i]).clamp(0.0, 1.0)
-            } else {
-                0.0
-            }
-        })
+        self.fits.map(|f| f.solve())
     }
 
     /// The start of a step of size `h`, in one pass: `vdot` holds v̇_n (the end of the step
     /// just accepted, of size `h_last`; None after a restart, which forgets the past: the last
     /// accelerations may hold a shock) and `vdot_n` v̇_{n−1}. Adds the accepted step to the
-    /// correlation (d_n = v̇_n − v̇_{n−1}, d_{n−1} = v̇_{n−1} − v̇_{n−2}), sets `vdot_n` to v̇_n
-    /// and, with `predict` and a step of the observed size, `vdot` to the prediction
-    /// v̇_n + λ (v̇_n − v̇_{n−1}) (λ of the steps before; the unknowns with `inertial[b][k]`,
-    /// None: all). Otherwise `vdot` keeps v̇_n (constant acceleration). Steps of another size
-    /// restart the count (the increments scale with the step).
+    /// fit (d = v̇_n − v̇_{n−1} against v̇_{n−1} and d_old = v̇_{n−1} − v̇_{n−2}), sets `vdot_n`
+    /// to v̇_n and, with `predict` and a step of the observed size, `vdot` to the prediction
+    /// v̇_n + μ v̇_n + λ (v̇_n − v̇_{n−1}) (the fit of the steps before; the unknowns with
+    /// `inertial[b][k]`, None: all). Otherwise `vdot` keeps v̇_n (constant acceleration).
+    /// Steps of another size restart the count (the increments scale with the step).
     pub(crate) fn begin_step(
         &mut self,
         vdot: &mut [Vector6<f64>],
@@ -78,20 +94,20 @@ impl Extrapolation {
         match h_last {
             Some(h_last) if h_last == self.h => {}
             _ => {
-                self.cross = [0.0; 2];
-                self.square = [0.0; 2];
+                self.fits = Default::default();
                 self.observed = 0;
                 self.h = h_last.unwrap_or(0.0);
             }
         }
-        let lambda = if predict && h == self.h {
-            self.lambda()
+        let [(mu_x, la_x), (mu_r, la_r)] = if predict && h == self.h {
+            self.coefficients()
         } else {
-            [0.0; 2]
+            [(0.0, 0.0); 2]
         };
-        let extrapolate = lambda != [0.0; 2];
+        let (mu, lambda) = ([mu_x, mu_r], [la_x, la_r]);
+        let extrapolate = mu != [0.0; 2] || lambda != [0.0; 2];
         let observe = self.observed > 0;
-        let (mut cross, mut square) = ([0.0; 2], [0.0; 2]);
+        let mut sums = [[0.0; 5]; 2];
         let all = [true; 6];
         for (b, ((v, l), p)) in vdot
             .iter_mut()
@@ -106,15 +122,19 @@ impl Extrapolation {
                 let d_old = *l - *p;
                 for k in 0..6 {
                     if m[k] {
-                        cross[k / 3] += d[k] * d_old[k];
-                        square[k / 3] += d_old[k] * d_old[k];
+                        let s = &mut sums[k / 3];
+                        s[0] += l[k] * l[k];
+                        s[1] += l[k] * d_old[k];
+                        s[2] += d_old[k] * d_old[k];
+                        s[3] += d[k] * l[k];
+                        s[4] += d[k] * d_old[k];
                     }
                 }
             }
             if extrapolate {
                 for k in 0..6 {
                     if m[k] {
-                        v[k] = now[k] + lambda[k / 3] * d[k];
+                        v[k] = now[k] + mu[k / 3] * now[k] + lambda[k / 3] * d[k];
                     }
                 }
             }
@@ -123,9 +143,10 @@ impl Extrapolation {
         }
         if observe {
             let keep = 1.0 - 1.0 / MEMORY;
-            for i in 0..2 {
-                self.cross[i] = keep * self.cross[i] + cross[i];
-                self.square[i] = keep * self.square[i] + square[i];
+            for (fit, sum) in self.fits.iter_mut().zip(sums) {
+                for (f, s) in fit.0.iter_mut().zip(sum) {
+                    *f = keep * *f + s;
+                }
             }
         }
         if h_last.is_some() {
@@ -153,33 +174,56 @@ mod tests {
         (e, predicted)
     }
 
-    #[test]
-    fn smooth_motion_is_extrapolated_and_alternation_is_not() {
-        // a sine at 20 steps per period: the increments' lag-one correlation is cos w
-        // (the exponential window of MEMORY ≈ one period weighs the phases unevenly: ± 0.02)
-        let w = 2.0 * std::f64::consts::PI / 20.0;
-        let x = |t: usize| (w * t as f64).sin();
-        let (e, predicted) = run(x, 1000);
-        let l = e.lambda();
-        assert!((l[0] - w.cos()).abs() < 0.02, "{l:?}");
-        assert_eq!(l[0], l[1]);
-        // the prediction error against constant acceleration's: for the best fixed λ = cos w
-        // its mean square is 1 − cos² w of the increments', an RMS ratio of sin w (≈ 0.31);
-        // the learnt λ (one step old, varying with the phase over its window) within 5 %
+    /// RMS of the prediction errors from step `from` on, against constant acceleration's.
+    fn error_ratio(signal: impl Fn(usize) -> f64, predicted: &[f64], from: usize) -> f64 {
         let (mut err, mut err0) = (0.0, 0.0);
-        for t in 200..999 {
-            err += (predicted[t - 1] - x(t + 1)).powi(2);
-            err0 += (x(t) - x(t + 1)).powi(2);
+        for t in from..predicted.len() {
+            // predicted[t - 1] was made at step t for step t + 1
+            err += (predicted[t - 1] - signal(t + 1)).powi(2);
+            err0 += (signal(t) - signal(t + 1)).powi(2);
         }
-        let ratio = (err / err0).sqrt();
-        assert!((ratio - w.sin()).abs() < 0.05 * w.sin(), "{ratio}");
-        // alternating values (the sampling limit): λ held at 0, constant acceleration
-        let (e, predicted) = run(|t| if t % 2 == 0 { 1.0 } else { -1.0 }, 100);
-        assert_eq!(e.lambda(), [0.0; 2]);
-        assert_eq!(predicted[50], if 51 % 2 == 0 { 1.0 } else { -1.0 });
-        // too few steps: 0
-        let (e, _) = run(|t| t as f64, WARM_UP);
-        assert_eq!(e.lambda(), [0.0; 2]);
+        (err / err0).sqrt()
+    }
+
+    #[test]
+    fn a_sinusoid_is_predicted_by_its_recursion() {
+        // v̇ = sin(w n) fits d_n = μ v̇_n + λ d_{n−1} exactly with μ = 2 cos w − 2, λ = 1 (the
+        // ridge of 1e-3 moves them by a few 1e-3)
+        for steps_per_period in [8.0, 20.0, 60.0] {
+            let w = 2.0 * std::f64::consts::PI / steps_per_period;
+            let x = |t: usize| (w * t as f64).sin();
+            let (e, predicted) = run(x, 600);
+            let [(mu, la), (mu_r, la_r)] = e.coefficients();
+            assert_eq!((mu, la), (mu_r, la_r));
+            assert!((mu - (2.0 * w.cos() - 2.0)).abs() < 0.01, "{mu}");
+            assert!((la - 1.0).abs() < 0.01, "{la}");
+            // the prediction error against constant acceleration's (RMS ratio sin w for the
+            // best linear extrapolation alone): below 2 %
+            let ratio = error_ratio(x, &predicted, 100);
+            assert!(ratio < 0.02, "{steps_per_period}: {ratio}");
+        }
+    }
+
+    #[test]
+    fn ramps_constants_and_alternation() {
+        // a ramp: linear extrapolation (μ = 0, λ = 1), up to the ridge: over the 20 steps of
+        // memory v̇ and its increments are nearly collinear there, and the ridge on Σ v̇²
+        // (≈ 100 × Σ d²) pulls λ by a few per cent
+        let (e, predicted) = run(|t| 0.5 * t as f64, 100);
+        let [(mu, la), _] = e.coefficients();
+        assert!(mu.abs() < 1e-3 && (la - 1.0).abs() < 0.03, "{mu} {la}");
+        assert!(error_ratio(|t| 0.5 * t as f64, &predicted, 50) < 0.03);
+        // a constant: nothing to fit, constant acceleration (exact)
+        let (e, predicted) = run(|_| 3.0, 50);
+        assert_eq!(e.coefficients(), [(0.0, 0.0); 2]);
+        assert!(predicted.iter().all(|&p| p == 3.0));
+        // alternation (the sampling limit): −v̇_n, to the ridge
+        let alt = |t: usize| if t.is_multiple_of(2) { 1.0 } else { -1.0 };
+        let (_, predicted) = run(alt, 100);
+        assert!(error_ratio(alt, &predicted, 50) < 1e-2);
+        // too few steps: constant acceleration
+        let (e, _) = run(|t| (t * t) as f64, WARM_UP);
+        assert_eq!(e.coefficients(), [(0.0, 0.0); 2]);
     }
 
     #[test]
@@ -196,23 +240,24 @@ mod tests {
         for t in 1..50 {
             step(&mut e, t, Some(1e-3), 1e-3);
         }
-        // a ramp: λ = 1 for translations; no rotational unknowns: 0
-        assert_eq!(e.lambda(), [1.0, 0.0]);
+        // a ramp: λ ≈ 1 for translations (up to the ridge, above); no rotational unknowns: 0
+        let [(mu, la), rot] = e.coefficients();
+        assert!(mu.abs() < 1e-3 && (la - 1.0).abs() < 0.03 && rot == (0.0, 0.0));
         let vd = step(&mut e, 50, Some(1e-3), 1e-3);
-        assert_eq!(vd[0].fixed_rows::<3>(0).sum(), 3.0 * 51.0);
+        assert!((vd[0][0] - 51.0).abs() < 0.1, "{}", vd[0][0]);
         assert_eq!(vd[0].fixed_rows::<3>(3).sum(), 3.0 * 50.0);
         assert_eq!(vd[1], ramp(50)[1]);
         // a step of another size: constant acceleration, and the count starts again
         let vd = step(&mut e, 51, Some(1e-3), 5e-4);
         assert_eq!(vd, ramp(51));
         let vd = step(&mut e, 52, Some(5e-4), 5e-4);
-        assert_eq!((vd, e.lambda()), (ramp(52), [0.0; 2]));
+        assert_eq!((vd, e.coefficients()), (ramp(52), [(0.0, 0.0); 2]));
         // a restart forgets the past
         for t in 53..60 {
             step(&mut e, t, Some(5e-4), 5e-4);
         }
-        assert_eq!(e.lambda(), [1.0, 0.0]);
+        assert_ne!(e.coefficients(), [(0.0, 0.0); 2]);
         let vd = step(&mut e, 60, None, 5e-4);
-        assert_eq!((vd, e.lambda()), (ramp(60), [0.0; 2]));
+        assert_eq!((vd, e.coefficients()), (ramp(60), [(0.0, 0.0); 2]));
     }
 }
