@@ -11,7 +11,7 @@ use std::fmt;
 use rayon::prelude::*;
 
 use crate::closest::{point_triangle, segment_triangle, Feature};
-use crate::wide::{self, f32x3, lower, Disk4, Rounded, Wide, EMPTY, LEAF};
+use crate::wide::{self, f32x3, lower, Block4, Rounded, Wide, EMPTY, LEAF};
 use crate::{PointProjection, SegmentProjection, Surface, V3};
 
 const LEAF_SIZE: usize = 4;
@@ -217,7 +217,7 @@ pub struct TriMesh {
     /// The 4-wide float32 view of `nodes` for the clearance's queries, and per leaf its
     /// triangles' planes and disks in float32.
     wide: Vec<Wide>,
-    blocks: Vec<Disk4>,
+    blocks: Vec<Block4>,
     /// Largest vertex coordinate magnitude (the scale of the float32 round-off).
     scale: f64,
     /// Closed and consistently oriented (every edge in two faces, in opposite directions).
@@ -474,7 +474,7 @@ impl TriMesh {
                     continue;
                 }
                 let node = &self.nodes[wn.node[l] as usize];
-                let tb = self.blocks[(wn.wide[l] & !LEAF) as usize].point_bounds2(&pf, pad);
+                let tb = self.blocks[(wn.wide[l] & !LEAF) as usize].point_bounds2(p);
                 let start = node.index as usize;
                 for (i, b) in tb.iter().enumerate().take(node.count as usize) {
                     let t = start + i;
@@ -584,8 +584,9 @@ impl TriMesh {
                 let node = &self.nodes[wn.node[l] as usize];
                 let block = &self.blocks[(wn.wide[l] & !LEAF) as usize];
                 let mut tb = [[0f32; 4]; MAX_ENDS];
-                for (j, b) in bf.iter().enumerate() {
-                    tb[j] = block.segment_bounds2(&af, b, pad);
+                let al = block.local(a);
+                for (j, b) in ends.iter().enumerate() {
+                    tb[j] = block.segment_bounds2(&al, b);
                 }
                 let start = node.index as usize;
                 #[allow(clippy::needless_range_loop)] // tb is per segment, then lane

@@ -171,6 +171,93 @@ impl Disk4 {
     }
 }
 
+/// A leaf's triangle disks ([`Disk4`]) in float32 coordinates relative to the block's own
+/// origin, a float32 point near them: the round-off of the bounds, and so the allowance
+/// [`pad`], scale with the distances within the block and to the query instead of with the
+/// distance from the global origin (1 m away, 2⁻¹⁶ m ≈ 15 µm; 2 cm from a block, 0.3 µm).
+/// The query is shifted in float64 (exact to 2⁻⁵³ of the shift's size, far below the pad).
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(16))]
+pub(crate) struct Block4 {
+    pub disk: Disk4,
+    /// The origin (a float32 point: the same in float64).
+    pub origin: [f32; 3],
+    /// The largest magnitude of the block's float32 coordinates (centers, plane offsets).
+    pub extent: f32,
+}
+
+impl Block4 {
+    pub const NONE: Block4 = Block4 {
+        disk: Disk4::NONE,
+        origin: [0.0; 3],
+        extent: 0.0,
+    };
+
+    /// The block of up to four triangles' planes and disks (normal, n·c, n·c, centroid c,
+    /// circumradius; global), about the first centroid.
+    pub fn new(disks: &[(V3, f64, f64, V3, f64)]) -> Self {
+        let mut b = Block4::NONE;
+        let Some(first) = disks.first() else {
+            return b;
+        };
+        b.origin = f32x3(&first.3);
+        let o = b.origin_f64();
+        let mut extent: f64 = 0.0;
+        for (l, (n, _, _, c, r)) in disks.iter().enumerate() {
+            let c = c - o;
+            let x = n.dot(&c);
+            b.disk.set(l, n, x, x, &c, *r);
+            extent = extent.max(c.amax()).max(x.abs());
+        }
+        b.extent = f32_up(extent);
+        b
+    }
+
+    #[inline(always)]
+    fn origin_f64(&self) -> V3 {
+        V3::new(
+            self.origin[0] as f64,
+            self.origin[1] as f64,
+            self.origin[2] as f64,
+        )
+    }
+
+    /// A query point in the block's frame (float32) and the magnitude that sets its
+    /// allowance (with the block's extent).
+    #[inline(always)]
+    pub fn local(&self, p: &V3) -> ([f32; 3], f64) {
+        let q = p - self.origin_f64();
+        (f32x3(&q), q.amax().max(self.extent as f64))
+    }
+
+    /// [`Disk4::point_bounds2`] of the global point p.
+    #[inline(always)]
+    pub fn point_bounds2(&self, p: &V3) -> [f32; 4] {
+        let (q, m) = self.local(p);
+        self.disk.point_bounds2(&q, local_pad(m))
+    }
+
+    /// [`Disk4::segment_bounds2`] of the segment from `a` (given by [`Self::local`]) to the
+    /// global point b.
+    #[inline(always)]
+    pub fn segment_bounds2(&self, (a, ma): &([f32; 3], f64), b: &V3) -> [f32; 4] {
+        let (q, mb) = self.local(b);
+        self.disk.segment_bounds2(a, &q, local_pad(ma.max(mb)))
+    }
+}
+
+/// [`pad`] for [`Block4`] queries, without rounding up (round to nearest: within 2⁻²⁴ of
+/// it, well inside its margin) to keep it cheap; infinite (no pruning) where float32 squares
+/// could overflow.
+#[inline(always)]
+fn local_pad(scale: f64) -> f32 {
+    if scale < 1e15 {
+        scale as f32 * (1.0 / 65536.0)
+    } else {
+        f32::INFINITY
+    }
+}
+
 /// A float64 point rounded to nearest float32.
 #[inline(always)]
 pub(crate) fn f32x3(p: &V3) -> [f32; 3] {
@@ -266,7 +353,7 @@ pub(crate) trait Binary {
 /// or the root itself when it is a leaf) and the leaves' triangle disks. The subtrees under
 /// wide node 0 are counted, then collapsed in parallel into their places of arrays laid out
 /// as one depth-first pass would lay them out (the same arrays, no copies).
-pub(crate) fn collapse<T: Binary + Sync + ?Sized>(tree: &T, root: u32) -> (Vec<Wide>, Vec<Disk4>) {
+pub(crate) fn collapse<T: Binary + Sync + ?Sized>(tree: &T, root: u32) -> (Vec<Wide>, Vec<Block4>) {
     let lanes = match tree.children(root) {
         Some((l, r)) => vec![l, r],
         None => vec![root],
@@ -283,7 +370,10 @@ pub(crate) fn collapse<T: Binary + Sync + ?Sized>(tree: &T, root: u32) -> (Vec<W
     let n_wide = 1 + sizes.iter().map(|s| s.0).sum::<usize>();
     let n_blocks = sizes.iter().map(|s| s.1).sum::<usize>();
     let mut wide: Vec<Wide> = (0..n_wide).into_par_iter().map(|_| Wide::EMPTY).collect();
-    let mut blocks: Vec<Disk4> = (0..n_blocks).into_par_iter().map(|_| Disk4::NONE).collect();
+    let mut blocks: Vec<Block4> = (0..n_blocks)
+        .into_par_iter()
+        .map(|_| Block4::NONE)
+        .collect();
     let (head, mut wide_rest) = wide.split_at_mut(1);
     let mut block_rest = blocks.as_mut_slice();
     let mut sinks = Vec::with_capacity(lanes.len());
@@ -321,7 +411,7 @@ pub(crate) fn collapse<T: Binary + Sync + ?Sized>(tree: &T, root: u32) -> (Vec<W
 /// it wrote, and the index of the part's first node and block in the whole arrays.
 struct Sink<'a> {
     wide: &'a mut [Wide],
-    blocks: &'a mut [Disk4],
+    blocks: &'a mut [Block4],
     n_wide: usize,
     n_blocks: usize,
     w_base: u32,
@@ -375,24 +465,24 @@ fn set_lane<T: Binary + ?Sized>(tree: &T, w: &mut Wide, l: usize, n: u32) {
 fn leaf_block<T: Binary + ?Sized>(tree: &T, n: u32, sink: &mut Sink) -> u32 {
     let (first, count) = tree.triangles(n);
     assert!(count <= 4, "a leaf holds at most 4 triangles");
-    let block = &mut sink.blocks[sink.n_blocks];
-    for i in 0..count {
-        let (axis, lo, hi, center, radius) = tree.disk(first + i);
-        block.set(i, &axis, lo, hi, &center, radius);
+    let mut disks = [(V3::zeros(), 0.0, 0.0, V3::zeros(), 0.0); 4];
+    for (i, d) in disks.iter_mut().enumerate().take(count) {
+        *d = tree.disk(first + i);
     }
+    sink.blocks[sink.n_blocks] = Block4::new(&disks[..count]);
     sink.n_blocks += 1;
     LEAF | (sink.b_base + sink.n_blocks as u32 - 1)
 }
 
 /// [`collapse`] in one depth-first pass (what the parallel one must equal).
 #[cfg(test)]
-pub(crate) fn collapse_serial<T: Binary + ?Sized>(tree: &T, root: u32) -> (Vec<Wide>, Vec<Disk4>) {
+pub(crate) fn collapse_serial<T: Binary + ?Sized>(tree: &T, root: u32) -> (Vec<Wide>, Vec<Block4>) {
     let lanes = match tree.children(root) {
         Some((l, r)) => vec![l, r],
         None => vec![root],
     };
     let (n_wide, n_blocks) = count(tree, lanes.clone());
-    let mut out = (vec![Wide::EMPTY; n_wide], vec![Disk4::NONE; n_blocks]);
+    let mut out = (vec![Wide::EMPTY; n_wide], vec![Block4::NONE; n_blocks]);
     let mut sink = Sink {
         wide: &mut out.0,
         blocks: &mut out.1,
@@ -562,5 +652,72 @@ mod tests {
             }
         }
         assert!(over_without_pad > 100, "{over_without_pad}");
+    }
+
+    /// The same cases through a leaf block in its own frame: lower bounds at offsets up to
+    /// 1000 × the triangles' size from the origin, and as tight there as at the origin (the
+    /// allowance follows the distances within the block, not the offset).
+    #[test]
+    fn local_block_bounds_are_lower_bounds_and_tight_far_from_the_origin() {
+        use crate::closest::{point_triangle, segment_triangle};
+        let mut rnd = crate::test_random(5);
+        let mut tight = 0;
+        for case in 0..20000 {
+            let size = [1e-3, 1.0, 1e3][case % 3];
+            let off = V3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5)
+                * size
+                * [0.0, 10.0, 1000.0][case / 3 % 3];
+            let tri = |rnd: &mut dyn FnMut() -> f64| -> Vec<V3> {
+                (0..3)
+                    .map(|_| off + V3::new(rnd(), rnd(), rnd()) * size)
+                    .collect()
+            };
+            // a block of two triangles (its origin at the first's centroid)
+            let (v, w) = (tri(&mut rnd), tri(&mut rnd));
+            let disk = |v: &[V3]| {
+                let n = (v[1] - v[0]).cross(&(v[2] - v[0])).normalize();
+                let c = (v[0] + v[1] + v[2]) / 3.0;
+                let r = v.iter().map(|x| (x - c).norm()).fold(0.0, f64::max) * (1.0 + 1e-12);
+                (n, n.dot(&c), n.dot(&c), c, r)
+            };
+            let block = Block4::new(&[disk(&v), disk(&w)]);
+            let (n, _, _, c, _) = disk(&v);
+            let (w0, w1) = (rnd(), rnd());
+            let (w0, w1) = if w0 + w1 > 1.0 {
+                (1.0 - w0, 1.0 - w1)
+            } else {
+                (w0, w1)
+            };
+            let on = v[0] + (v[1] - v[0]) * w0 + (v[2] - v[0]) * w1;
+            let lift = size * 10f64.powf(-12.0 * rnd());
+            let p = on
+                + n * lift * if rnd() < 0.5 { 1.0 } else { -1.0 }
+                + V3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5) * size * 0.01 * rnd().powi(4);
+            let b = p
+                + (V3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5) * 0.2 + n * 0.01 * (rnd() - 0.5))
+                    * size;
+            for (k, t) in [&v, &w].into_iter().enumerate() {
+                let exact_p = (point_triangle(&p, &t[0], &t[1], &t[2]).0 - p).norm_squared();
+                let (_, sx, sy) = segment_triangle(&p, &b, &t[0], &t[1], &t[2]);
+                let exact_s = (sx - sy).norm_squared();
+                let gp = block.point_bounds2(&p)[k];
+                let gs = block.segment_bounds2(&block.local(&p), &b)[k];
+                assert!(lower(gp) <= exact_p, "point, case {case}, lane {k}");
+                assert!(lower(gs) <= exact_s, "segment, case {case}, lane {k}");
+            }
+            // tight: over the face, the plane distance less an allowance of the block's size
+            // (≤ 4 size / 65536), whatever the offset
+            let hp = n.dot(&(p - c)).abs();
+            let exact_p = (point_triangle(&p, &v[0], &v[1], &v[2]).0 - p).norm_squared();
+            if (exact_p.sqrt() - hp).abs() < 1e-9 * size {
+                let h = (hp - 2.0 * 4.0 * size / 65536.0).max(0.0);
+                assert!(
+                    block.point_bounds2(&p)[0] as f64 >= 0.98 * h * h,
+                    "case {case}"
+                );
+                tight += 1;
+            }
+        }
+        assert!(tight > 5000, "{tight}");
     }
 }
