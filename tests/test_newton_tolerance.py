@@ -148,58 +148,17 @@ def test_a_hose_held_by_high_friction_on_a_table_completes():
 
 
 def engine_harness(duration: float) -> dict:
-    """The harness of benchmarks/bench_harness.py: a trunk from the body to junction j1, a link
-    to j2, branches a, b to the body from j1 and c, d to the engine from j2 (400 segments),
-    the engine shaken by the ISO 16750-3 engine PSD (to 100 Hz) along z and x; 1 ms steps."""
-    material = {"youngs_modulus": 5.0e7, "poisson_ratio": 0.4, "density": 2000.0}
+    """The harness of benchmarks/bench_harness.py (6 cables, 400 segments, 2 junctions; the
+    engine shaken by the ISO 16750-3 engine PSD to 100 Hz along z and x), 1 ms steps."""
+    import sys
+    from pathlib import Path
 
-    def cable(name, length, segments, *clip):
-        section = {"shape": "circle", "radius": 0.005}
-        d = {"name": name, "length": length, "segments": segments, "section": section}
-        clips = [
-            {"name": c[0], "s": c[1], "position": c[2], "direction": c[3], "body": c[4]}
-            | {"normal": [0.0, 0.0, 1.0]}
-            for c in clip
-        ]
-        return d | {"material": material, "clips": clips}
+    benchmarks = str(Path(__file__).resolve().parents[1] / "benchmarks")
+    if benchmarks not in sys.path:
+        sys.path.append(benchmarks)
+    from bench_harness import scene
 
-    psd = {"type": "psd", "profile": "iso16750-3:2007/I-engine", "f_high": 100.0}
-    psd["fade_in"] = 0.2
-    return {
-        "simulation": {"mode": "dynamic", "time_step": 1e-3, "duration": duration},
-        "bodies": [
-            {
-                "name": "engine",
-                "origin": [1.0, 0.0, -0.1],
-                "motion": [
-                    {"channel": "z", "signal": psd | {"seed": 1}},
-                    {"channel": "x", "signal": psd | {"seed": 2}},
-                ],
-            }
-        ],
-        "cables": [
-            cable("trunk", 0.42, 80, ("body-1", 0.0, [0, 0, 0], [1, 0, 0], "world")),
-            cable("link", 0.32, 60),
-            cable("a", 0.33, 70, ("a-end", 0.33, [0.45, 0.3, 0], [0, 1, 0], "world")),
-            cable("b", 0.33, 60, ("b-end", 0.33, [0.45, -0.3, 0], [0, -1, 0], "world")),
-            cable("c", 0.35, 70, ("c-end", 0.35, [1.0, 0.1, -0.05], [1, 0, 0], "engine")),
-            cable("d", 0.37, 60, ("d-end", 0.37, [1.0, -0.15, -0.1], [1, 0, 0], "engine")),
-        ],
-        "junctions": [
-            {
-                "name": "j1",
-                "ends": ["trunk:end", "link:start", "a:start", "b:start"],
-                "position": [0.4, 0.0, 0.0],
-                "directions": [[-1, 0, 0], [1, 0, 0], [0.2, 1, 0], [0.2, -1, 0]],
-            },
-            {
-                "name": "j2",
-                "ends": ["link:end", "c:start", "d:start"],
-                "position": [0.7, 0.0, 0.0],
-                "directions": [[-1, 0, 0], [1, 0.3, 0], [1, -0.4, -0.3]],
-            },
-        ],
-    }
+    return scene("dynamic", duration)
 
 
 def harness_run(d: dict, tolerance: float | None, dt: float = 0.001):

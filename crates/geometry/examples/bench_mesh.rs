@@ -1,6 +1,6 @@
 //! Hierarchy build and query cost on a bumpy height field (n × n quads):
 //! `cargo run -p cablelife-geometry --release --example bench_mesh -- 707`
-use geometry::{Surface, TriMesh, V3};
+use geometry::{height_field, Surface, TriMesh, V3};
 use std::time::Instant;
 
 fn height(x: f64, y: f64) -> f64 {
@@ -11,22 +11,7 @@ fn height(x: f64, y: f64) -> f64 {
 
 fn main() {
     let n: usize = std::env::args().nth(1).map_or(707, |a| a.parse().unwrap());
-    let mut v = Vec::with_capacity((n + 1) * (n + 1));
-    for i in 0..=n {
-        for j in 0..=n {
-            let (x, y) = (i as f64 / n as f64, j as f64 / n as f64);
-            v.push(V3::new(x, y, height(x, y)));
-        }
-    }
-    let mut f = vec![];
-    for i in 0..n as u32 {
-        for j in 0..n as u32 {
-            let a = i * (n as u32 + 1) + j;
-            let (b, c, d) = (a + n as u32 + 1, a + 1, a + n as u32 + 2);
-            f.push([a, b, d]);
-            f.push([a, d, c]);
-        }
-    }
+    let (v, f) = height_field(n, height);
     let t0 = Instant::now();
     let m = TriMesh::new(&v, &f).unwrap();
     println!(

@@ -4,7 +4,7 @@
 use std::f64::consts::PI;
 use std::time::Instant;
 
-use geometry::{clearance, Part, RigidMap, Shape, TriMesh, V3};
+use geometry::{clearance, height_field, Part, RigidMap, Shape, TriMesh, V3};
 
 fn height(x: f64, y: f64) -> f64 {
     0.01 * (2.0 * PI * x / 0.15).sin() * (2.0 * PI * y / 0.1).cos()
@@ -32,22 +32,7 @@ fn main() {
     let steps = args.get(1).copied().unwrap_or(5001);
     // time between saved steps in µs (1000: the benchmark's 1 ms)
     let dt = args.get(2).copied().unwrap_or(1000) as f64 * 1e-6;
-    let mut v = Vec::with_capacity((n + 1) * (n + 1));
-    for i in 0..=n {
-        for j in 0..=n {
-            let (x, y) = (i as f64 / n as f64, j as f64 / n as f64);
-            v.push(V3::new(x, y, height(x, y)));
-        }
-    }
-    let mut f = Vec::with_capacity(2 * n * n);
-    for i in 0..n {
-        for j in 0..n {
-            let a = (i * (n + 1) + j) as u32;
-            let (b, c, d) = (a + n as u32 + 1, a + 1, a + n as u32 + 2);
-            f.push([a, b, d]);
-            f.push([a, d, c]);
-        }
-    }
+    let (v, f) = height_field(n, height);
     let (t0, c0) = (Instant::now(), cpu_time());
     let mesh = TriMesh::new(&v, &f).unwrap();
     let build = t0.elapsed().as_secs_f64();

@@ -409,24 +409,8 @@ mod tests {
         // node jumping far at one step: every step equals the step computed alone (cold: no
         // warm start, no set)
         use crate::TriMesh;
-        let n = 30;
         let h = |x: f64, y: f64| 0.05 * (x * 7.0).sin() * (y * 5.0).cos();
-        let mut v = vec![];
-        for i in 0..=n {
-            for j in 0..=n {
-                let (x, y) = (i as f64 / n as f64, j as f64 / n as f64);
-                v.push(V3::new(x, y, h(x, y)));
-            }
-        }
-        let mut f = vec![];
-        for i in 0..n {
-            for j in 0..n {
-                let a = (i * (n + 1) + j) as u32;
-                let (b, c, d) = (a + n as u32 + 1, a + 1, a + n as u32 + 2);
-                f.push([a, b, d]);
-                f.push([a, d, c]);
-            }
-        }
+        let (v, f) = crate::height_field(30, h);
         let parts = vec![Part {
             shape: Shape::Mesh(TriMesh::new(&v, &f).unwrap()),
             body: 0,

@@ -209,24 +209,7 @@ mod tests {
 
     /// A bumpy height field over [0, 1]² (n × n quads), normals up.
     fn bumpy(n: usize) -> (Vec<V3>, Vec<[u32; 3]>) {
-        let h = |x: f64, y: f64| 0.1 * (x * 6.0).sin() * (y * 9.0).cos();
-        let mut v = vec![];
-        for i in 0..=n {
-            for j in 0..=n {
-                let (x, y) = (i as f64 / n as f64, j as f64 / n as f64);
-                v.push(V3::new(x, y, h(x, y)));
-            }
-        }
-        let mut f = vec![];
-        for i in 0..n {
-            for j in 0..n {
-                let a = (i * (n + 1) + j) as u32;
-                let (b, c, d) = (a + n as u32 + 1, a + 1, a + n as u32 + 2);
-                f.push([a, b, d]);
-                f.push([a, d, c]);
-            }
-        }
-        (v, f)
+        crate::height_field(n, |x, y| 0.1 * (x * 6.0).sin() * (y * 9.0).cos())
     }
 
     #[test]

@@ -114,6 +114,28 @@ impl Surface for Shape {
     }
 }
 
+/// A height-field surface z = h(x, y) over [0, 1]² (n × n quads, 2 n² triangles, normals
+/// up): vertices and triangles. The benchmarks' and tests' bumpy surfaces.
+pub fn height_field(n: usize, h: impl Fn(f64, f64) -> f64) -> (Vec<V3>, Vec<[u32; 3]>) {
+    let mut v = Vec::with_capacity((n + 1) * (n + 1));
+    for i in 0..=n {
+        for j in 0..=n {
+            let (x, y) = (i as f64 / n as f64, j as f64 / n as f64);
+            v.push(V3::new(x, y, h(x, y)));
+        }
+    }
+    let mut f = Vec::with_capacity(2 * n * n);
+    for i in 0..n {
+        for j in 0..n {
+            let a = (i * (n + 1) + j) as u32;
+            let (b, c, d) = (a + n as u32 + 1, a + 1, a + n as u32 + 2);
+            f.push([a, b, d]);
+            f.push([a, d, c]);
+        }
+    }
+    (v, f)
+}
+
 /// Uniform numbers in [0, 1) from a 64-bit linear congruential generator (Knuth's MMIX
 /// constants): the tests' reproducible random points and segments.
 #[cfg(test)]

@@ -1325,24 +1325,7 @@ mod tests {
     #[test]
     fn parallel_collapse_lays_out_the_wide_tree_as_one_pass() {
         // 80 000 triangles (a bumpy grid): the root's subtrees are collapsed in parallel
-        let n = 200;
-        let v: Vec<V3> = (0..=n)
-            .flat_map(|i| {
-                (0..=n).map(move |j| {
-                    let (x, y) = (i as f64 / n as f64, j as f64 / n as f64);
-                    V3::new(x, y, 0.05 * (9.0 * x).sin() * (7.0 * y).cos())
-                })
-            })
-            .collect();
-        let mut f = vec![];
-        for i in 0..n as u32 {
-            for j in 0..n as u32 {
-                let a = i * (n as u32 + 1) + j;
-                let (b, c, d) = (a + n as u32 + 1, a + 1, a + n as u32 + 2);
-                f.push([a, b, d]);
-                f.push([a, d, c]);
-            }
-        }
+        let (v, f) = crate::height_field(200, |x, y| 0.05 * (9.0 * x).sin() * (7.0 * y).cos());
         let m = TriMesh::new(&v, &f).unwrap();
         let view = BinaryView {
             nodes: &m.nodes,
@@ -1414,23 +1397,7 @@ mod tests {
         // and triangles are tightest: the hierarchy must give the brute-force minimum exactly
         let h =
             |x: f64, y: f64| 0.1 * (x * 6.0).sin() * (y * 9.0).cos() + 0.05 * ((x + y) * 3.0).sin();
-        let n = 40;
-        let mut v = vec![];
-        for i in 0..=n {
-            for j in 0..=n {
-                let (x, y) = (i as f64 / n as f64, j as f64 / n as f64);
-                v.push(V3::new(x, y, h(x, y)));
-            }
-        }
-        let mut f = vec![];
-        for i in 0..n {
-            for j in 0..n {
-                let a = (i * (n + 1) + j) as u32;
-                let (b, c, d) = (a + n as u32 + 1, a + 1, a + n as u32 + 2);
-                f.push([a, b, d]);
-                f.push([a, d, c]);
-            }
-        }
+        let (v, f) = crate::height_field(40, h);
         let m = TriMesh::new(&v, &f).unwrap();
         let tri = |t: &[u32; 3]| [0, 1, 2].map(|k| v[t[k] as usize]);
         for q in 0..300 {

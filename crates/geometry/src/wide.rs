@@ -580,6 +580,51 @@ mod tests {
         }
     }
 
+    /// The size of case `case`'s triangles (1 mm, 1 m, 1 km in turn) and their offset from the
+    /// origin (0, 10 or 1000 × the size, in turn over three cases).
+    fn case_scale(rnd: &mut impl FnMut() -> f64, case: usize) -> (f64, V3) {
+        let size = [1e-3, 1.0, 1e3][case % 3];
+        let off = V3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5)
+            * size
+            * [0.0, 10.0, 1000.0][case / 3 % 3];
+        (size, off)
+    }
+
+    /// A triangle's plane and circumscribed disk about its centroid, as the mesh stores them:
+    /// (normal, n·c, n·c, centroid c, radius).
+    fn triangle_disk(v: &[V3]) -> (V3, f64, f64, V3, f64) {
+        let n = (v[1] - v[0]).cross(&(v[2] - v[0])).normalize();
+        let c = (v[0] + v[1] + v[2]) / 3.0;
+        let r = v.iter().map(|x| (x - c).norm()).fold(0.0, f64::max) * (1.0 + 1e-12);
+        (n, n.dot(&c), n.dot(&c), c, r)
+    }
+
+    /// A point near triangle v of normal n (on it, lifted by 1e-12 … 1 of its size, moved
+    /// across by up to 1 % of it) and the end of a segment from there (nearly parallel to the
+    /// triangle, up to 20 % of its size long).
+    fn near_point_and_segment(
+        rnd: &mut impl FnMut() -> f64,
+        v: &[V3],
+        n: &V3,
+        size: f64,
+    ) -> (V3, V3) {
+        let (w0, w1) = (rnd(), rnd());
+        let (w0, w1) = if w0 + w1 > 1.0 {
+            (1.0 - w0, 1.0 - w1)
+        } else {
+            (w0, w1)
+        };
+        let on = v[0] + (v[1] - v[0]) * w0 + (v[2] - v[0]) * w1;
+        let lift = size * 10f64.powf(-12.0 * rnd());
+        let p = on
+            + n * lift * if rnd() < 0.5 { 1.0 } else { -1.0 }
+            + V3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5) * size * 0.01 * rnd().powi(4);
+        let b = p
+            + (V3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5) * 0.2 + n * 0.01 * (rnd() - 0.5))
+                * size;
+        (p, b)
+    }
+
     /// Random triangles at scales 1 mm … 1 km and offsets up to 1000 × their size from the
     /// origin, and points and segments near them (nearly touching, nearly parallel, far):
     /// the float32 plane-and-disk bounds must stay at or below the exact distances, and
@@ -590,34 +635,14 @@ mod tests {
         let mut rnd = crate::test_random(99);
         let mut over_without_pad = 0;
         for case in 0..20000 {
-            let size = [1e-3, 1.0, 1e3][case % 3];
-            let off = V3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5)
-                * size
-                * [0.0, 10.0, 1000.0][case / 3 % 3];
+            let (size, off) = case_scale(&mut rnd, case);
             let v: Vec<V3> = (0..3)
                 .map(|_| off + V3::new(rnd(), rnd(), rnd()) * size)
                 .collect();
-            let n = (v[1] - v[0]).cross(&(v[2] - v[0])).normalize();
-            let c = (v[0] + v[1] + v[2]) / 3.0;
-            let r = v.iter().map(|x| (x - c).norm()).fold(0.0, f64::max) * (1.0 + 1e-12);
+            let (n, x, _, c, r) = triangle_disk(&v);
             let mut disk = Disk4::NONE;
-            let x = n.dot(&c);
             disk.set(0, &n, x, x, &c, r);
-            // a point near the triangle: on it, lifted by 1e-12 … 1 of its size
-            let (w0, w1) = (rnd(), rnd());
-            let (w0, w1) = if w0 + w1 > 1.0 {
-                (1.0 - w0, 1.0 - w1)
-            } else {
-                (w0, w1)
-            };
-            let on = v[0] + (v[1] - v[0]) * w0 + (v[2] - v[0]) * w1;
-            let lift = size * 10f64.powf(-12.0 * rnd());
-            let p = on
-                + n * lift * if rnd() < 0.5 { 1.0 } else { -1.0 }
-                + V3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5) * size * 0.01 * rnd().powi(4);
-            let b = p
-                + (V3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5) * 0.2 + n * 0.01 * (rnd() - 0.5))
-                    * size;
+            let (p, b) = near_point_and_segment(&mut rnd, &v, &n, size);
             let scale = v
                 .iter()
                 .chain([&p, &b])
@@ -663,10 +688,7 @@ mod tests {
         let mut rnd = crate::test_random(5);
         let mut tight = 0;
         for case in 0..20000 {
-            let size = [1e-3, 1.0, 1e3][case % 3];
-            let off = V3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5)
-                * size
-                * [0.0, 10.0, 1000.0][case / 3 % 3];
+            let (size, off) = case_scale(&mut rnd, case);
             let tri = |rnd: &mut dyn FnMut() -> f64| -> Vec<V3> {
                 (0..3)
                     .map(|_| off + V3::new(rnd(), rnd(), rnd()) * size)
@@ -674,28 +696,9 @@ mod tests {
             };
             // a block of two triangles (its origin at the first's centroid)
             let (v, w) = (tri(&mut rnd), tri(&mut rnd));
-            let disk = |v: &[V3]| {
-                let n = (v[1] - v[0]).cross(&(v[2] - v[0])).normalize();
-                let c = (v[0] + v[1] + v[2]) / 3.0;
-                let r = v.iter().map(|x| (x - c).norm()).fold(0.0, f64::max) * (1.0 + 1e-12);
-                (n, n.dot(&c), n.dot(&c), c, r)
-            };
-            let block = Block4::new(&[disk(&v), disk(&w)]);
-            let (n, _, _, c, _) = disk(&v);
-            let (w0, w1) = (rnd(), rnd());
-            let (w0, w1) = if w0 + w1 > 1.0 {
-                (1.0 - w0, 1.0 - w1)
-            } else {
-                (w0, w1)
-            };
-            let on = v[0] + (v[1] - v[0]) * w0 + (v[2] - v[0]) * w1;
-            let lift = size * 10f64.powf(-12.0 * rnd());
-            let p = on
-                + n * lift * if rnd() < 0.5 { 1.0 } else { -1.0 }
-                + V3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5) * size * 0.01 * rnd().powi(4);
-            let b = p
-                + (V3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5) * 0.2 + n * 0.01 * (rnd() - 0.5))
-                    * size;
+            let block = Block4::new(&[triangle_disk(&v), triangle_disk(&w)]);
+            let (n, _, _, c, _) = triangle_disk(&v);
+            let (p, b) = near_point_and_segment(&mut rnd, &v, &n, size);
             for (k, t) in [&v, &w].into_iter().enumerate() {
                 let exact_p = (point_triangle(&p, &t[0], &t[1], &t[2]).0 - p).norm_squared();
                 let (_, sx, sy) = segment_triangle(&p, &b, &t[0], &t[1], &t[2]);
