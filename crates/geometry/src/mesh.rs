@@ -215,7 +215,7 @@ pub struct TriMesh {
     vertex_normals: Vec<V3>,
     nodes: Vec<Node>,
     /// The 4-wide float32 view of `nodes` for the clearance's queries, and per leaf its
-    /// triangles' planes and disks in float32.
+    /// triangles' planes and disks in float32, in the leaf block's own frame.
     wide: Vec<Wide>,
     blocks: Vec<Block4>,
     /// Largest vertex coordinate magnitude (the scale of the float32 round-off).
