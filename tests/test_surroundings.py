@@ -746,9 +746,29 @@ def test_decimation_for_display():
     assert r.min() > 0.95 and r.max() <= 1.0 + 1e-12  # still the sphere
 
 
+def test_decimation_takes_few_passes(monkeypatch):
+    # the triangles of a surface scale with the square of the cells across the grid: from the
+    # first pass's count the grid is coarsened by that estimate, so a 327 680-triangle sphere
+    # comes down to the 20 000 allowed in two or three passes (×0.7 per pass took six)
+    from cablelife.surroundings import display
+
+    passes = []
+    real = display.next_cells
+
+    def counted(faces, max_faces):
+        passes.append(faces)
+        return real(faces, max_faces)
+
+    monkeypatch.setattr(display, "next_cells", counted)
+    ico = trimesh.creation.icosphere(subdivisions=7, radius=1.0)
+    v, f = display.decimate(np.asarray(ico.vertices), np.asarray(ico.faces), 20_000)
+    assert len(passes) <= 2, passes
+    assert 0.8 * 20_000 < len(f) <= 20_000
+
+
 def test_decimation_equals_the_row_unique_clustering():
     # the packed-key clustering gives exactly what np.unique over rows and np.add.at give
-    from cablelife.surroundings.display import _unique_rows, decimate
+    from cablelife.surroundings.display import _unique_rows, decimate, next_cells
 
     def reference(vertices, faces, max_faces):
         lo = vertices.min(axis=0)
@@ -767,7 +787,7 @@ def test_decimation_equals_the_row_unique_clustering():
             if len(f) <= max_faces or cells < 4:
                 used, f = np.unique(f, return_inverse=True)
                 return v[used], f.reshape(-1, 3)
-            cells *= 0.7
+            cells *= next_cells(len(f), max_faces)
 
     ico = trimesh.creation.icosphere(subdivisions=5, radius=0.3)  # 20 480 triangles
     ico.apply_transform(trimesh.transformations.rotation_matrix(0.3, [1, 2, 3]))

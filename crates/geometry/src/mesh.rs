@@ -594,7 +594,7 @@ impl TriMesh {
                     let t = start + i;
                     let [p, q, r] = &self.triangles[t];
                     for (j, b) in ends.iter().enumerate() {
-                        if lower(tb[j][i]) > best_d2 {
+                        if lower(tb[j][i]) > best_d2 || self.segment_excluded(t, a, b, best_d2) {
                             continue;
                         }
                         let (_, x, y) = segment_triangle(a, b, p, q, r);

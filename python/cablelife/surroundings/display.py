@@ -53,7 +53,10 @@ class SurroundingsGeometry:
 
 def decimate(vertices: np.ndarray, faces: np.ndarray, max_faces: int = MAX_FACES):
     """Vertex-clustering decimation: vertices snapped to a grid whose cell grows until at most
-    ``max_faces`` non-degenerate triangles remain (for display only)."""
+    ``max_faces`` non-degenerate triangles remain (for display only). The triangles of a
+    surface scale with the square of the cells across it, so a grid with too many is coarsened
+    by that estimate (with 5 % to spare): 2–3 passes instead of one per ×0.7 before, and nearer
+    to ``max_faces``."""
     if len(faces) <= max_faces:
         return vertices, faces
     lo = vertices.min(axis=0)
@@ -74,7 +77,13 @@ def decimate(vertices: np.ndarray, faces: np.ndarray, max_faces: int = MAX_FACES
         if len(f) <= max_faces or cells < 4:
             used, f = np.unique(f, return_inverse=True)
             return v[used], f.reshape(-1, 3)
-        cells *= 0.7
+        cells *= next_cells(len(f), max_faces)
+
+
+def next_cells(faces: int, max_faces: int) -> float:
+    """The factor on the cells across the grid after a pass that left ``faces`` triangles
+    (more than ``max_faces``): below 0.95, so the passes end."""
+    return 0.95 * float(np.sqrt(max_faces / faces))
 
 
 def _unique_rows(rows: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
