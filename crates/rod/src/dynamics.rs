@@ -308,7 +308,7 @@ pub struct Dynamics {
     pose_n: Vec<Pose>,
     v_n: Vec<Vector6<f64>>,
     vdot_n: Vec<Vector6<f64>>,
-    /// The predictor's extrapolation of v̇ (learns λ from the accepted steps).
+    /// The predictor of v̇ (a recursion fitted to the accepted steps: crate::predictor).
     extrapolation: Extrapolation,
     a_n: Vec<Vector6<f64>>,
     pub(crate) delta: Vec<Vector6<f64>>,
@@ -558,14 +558,14 @@ impl Dynamics {
         self.ghost_n.clone_from(&st.ghost);
         self.pose_n.clone_from(&st.clip_pose);
         self.v_n.clone_from(&self.rates.v);
-        // v̇_n into vdot_n, and the predictor (below): v̇_{n+1} = v̇_n + λ (v̇_n − v̇_{n−1})
-        // on the inertial slots, λ ∈ [0, 1] learnt from the accepted steps (crate::predictor)
+        // v̇_n into vdot_n, and the predictor (below): v̇_{n+1} = (1 + μ) v̇_n + λ (v̇_n −
+        // v̇_{n−1}) on the inertial slots, μ, λ fitted to the accepted steps (crate::predictor)
         let restarted = self.restarted;
         self.extrapolation.begin_step(
             &mut self.vdot,
             &mut self.vdot_n,
             Some(&self.inertial),
-            (!restarted).then_some(self.h),
+            restarted,
             h,
             !restarted && self.contact.is_none(),
         );
@@ -597,12 +597,11 @@ impl Dynamics {
         self.poses.extend(clips.iter().map(|m| m.pose));
         st.set_clip_poses(rod, &self.poses);
         self.prescribe_rates(rod, st, clips);
-        // Predictor: v̇_{n+1} = v̇_n + λ (v̇_n − v̇_{n−1}), λ ∈ [0, 1] learnt from the run
-        // (crate::predictor, above; λ = 0 is constant acceleration). docs/dynamics.md,
-        // "Predictor": constant acceleration took 2.70 → 2.04 iterations per step on
-        // bench_harness.py's cable, 4.45 → 4.32 on bench_dynamic.py, against the former
-        // constant-velocity predictor Δq = v_n; the learnt extrapolation 2.36 → 2.08 on
-        // bench_harness.py's harness. The first step after a (re)start takes
+        // Predictor: the recursion fitted to the run (crate::predictor, above; μ = λ = 0 is
+        // constant acceleration). docs/dynamics.md, "Predictor": constant acceleration took
+        // 2.70 → 2.04 iterations per step on bench_harness.py's cable, 4.45 → 4.32 on
+        // bench_dynamic.py, against the former constant-velocity predictor Δq = v_n; the
+        // fitted recursion 2.36 → 2.00 on bench_harness.py's harness. The first step after a (re)start takes
         // constant velocity: v̇ may hold the response to a jump of the clip velocities (a
         // shock), which constant acceleration would carry through the whole step; so does
         // every step with contact (an impact is a shock; the contact term's energy behaviour

@@ -55,9 +55,8 @@ pub struct HarnessDynamics {
     ja: Vec<Vector6<f64>>,
     jv_n: Vec<Vector6<f64>>,
     jvdot_n: Vec<Vector6<f64>>,
-    /// The junctions' predictor (as the cables': crate::predictor) and the last step size.
+    /// The junctions' predictor (as the cables': crate::predictor).
     jextrapolation: Extrapolation,
-    last_dt: f64,
     ja_n: Vec<Vector6<f64>>,
     jpose_n: Vec<Pose>,
     jdq0: Vec<Vector6<f64>>,
@@ -103,7 +102,6 @@ impl HarnessDynamics {
             jv_n: vec![Vector6::zeros(); nj],
             jvdot_n: vec![Vector6::zeros(); nj],
             jextrapolation: Extrapolation::new(nj),
-            last_dt: 0.0,
             ja_n: vec![Vector6::zeros(); nj],
             jpose_n: st.junctions.clone(),
             jdq0: vec![Vector6::zeros(); nj],
@@ -517,11 +515,10 @@ impl HarnessDynamics {
             &mut self.jvdot,
             &mut self.jvdot_n,
             None,
-            (!restarted).then_some(self.last_dt),
+            restarted,
             dt,
             predict,
         );
-        self.last_dt = dt;
         self.ja_n.clone_from(&self.ja);
         self.prescribe_held(h, clips);
         self.end_motions(h, st, clips);
@@ -530,7 +527,7 @@ impl HarnessDynamics {
         }
         // The junctions' predictor after a restart and with contact: constant velocity (as
         // the cables'); their kinematics.
-        if restarted || self.has_contact() {
+        if !predict {
             let c_a = ((1.0 - ga.alpha_m) * (-(0.5 - ga.beta) / ga.beta) + ga.alpha_m)
                 / (1.0 - ga.alpha_f);
             let c_v = -ga.alpha_f / (1.0 - ga.alpha_f);

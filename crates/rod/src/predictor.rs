@@ -56,6 +56,8 @@ pub(crate) struct Extrapolation {
     /// Step size of the observed steps; steps observed since the last reset.
     h: f64,
     observed: usize,
+    /// Size of the step begun last (None: none since a restart).
+    last: Option<f64>,
 }
 
 impl Extrapolation {
@@ -75,8 +77,9 @@ impl Extrapolation {
     }
 
     /// The start of a step of size `h`, in one pass: `vdot` holds v̇_n (the end of the step
-    /// just accepted, of size `h_last`; None after a restart, which forgets the past: the last
-    /// accelerations may hold a shock) and `vdot_n` v̇_{n−1}. Adds the accepted step to the
+    /// just accepted; `restarted`: the step begun last was given up or the integrator
+    /// restarted, which forgets the past: the last accelerations may hold a shock) and
+    /// `vdot_n` v̇_{n−1}. Adds the accepted step to the
     /// fit (d = v̇_n − v̇_{n−1} against v̇_{n−1} and d_old = v̇_{n−1} − v̇_{n−2}), sets `vdot_n`
     /// to v̇_n and, with `predict` and a step of the observed size, `vdot` to the prediction
     /// v̇_n + μ v̇_n + λ (v̇_n − v̇_{n−1}) (the fit of the steps before; the unknowns with
@@ -87,10 +90,12 @@ impl Extrapolation {
         vdot: &mut [Vector6<f64>],
         vdot_n: &mut [Vector6<f64>],
         inertial: Option<&[[bool; 6]]>,
-        h_last: Option<f64>,
+        restarted: bool,
         h: f64,
         predict: bool,
     ) {
+        let h_last = if restarted { None } else { self.last };
+        self.last = Some(h);
         match h_last {
             Some(h_last) if h_last == self.h => {}
             _ => {
@@ -167,7 +172,7 @@ mod tests {
         let mut predicted = vec![];
         for t in 1..steps {
             let mut vdot = vec![Vector6::repeat(signal(t))];
-            e.begin_step(&mut vdot, &mut vdot_n, None, Some(1e-3), 1e-3, true);
+            e.begin_step(&mut vdot, &mut vdot_n, None, false, 1e-3, true);
             assert_eq!(vdot_n[0], Vector6::repeat(signal(t)));
             predicted.push(vdot[0][0]);
         }
@@ -232,32 +237,32 @@ mod tests {
         let mask = [[true, true, true, false, false, false], [false; 6]];
         let mut e = Extrapolation::new(2);
         let mut vdot_n = ramp(0);
-        let mut step = |e: &mut Extrapolation, t: usize, h_last: Option<f64>, h: f64| {
+        let mut step = |e: &mut Extrapolation, t: usize, restarted: bool, h: f64| {
             let mut vdot = ramp(t);
-            e.begin_step(&mut vdot, &mut vdot_n, Some(&mask), h_last, h, true);
+            e.begin_step(&mut vdot, &mut vdot_n, Some(&mask), restarted, h, true);
             vdot
         };
         for t in 1..50 {
-            step(&mut e, t, Some(1e-3), 1e-3);
+            step(&mut e, t, false, 1e-3);
         }
         // a ramp: λ ≈ 1 for translations (up to the ridge, above); no rotational unknowns: 0
         let [(mu, la), rot] = e.coefficients();
         assert!(mu.abs() < 1e-3 && (la - 1.0).abs() < 0.03 && rot == (0.0, 0.0));
-        let vd = step(&mut e, 50, Some(1e-3), 1e-3);
+        let vd = step(&mut e, 50, false, 1e-3);
         assert!((vd[0][0] - 51.0).abs() < 0.1, "{}", vd[0][0]);
         assert_eq!(vd[0].fixed_rows::<3>(3).sum(), 3.0 * 50.0);
         assert_eq!(vd[1], ramp(50)[1]);
         // a step of another size: constant acceleration, and the count starts again
-        let vd = step(&mut e, 51, Some(1e-3), 5e-4);
+        let vd = step(&mut e, 51, false, 5e-4);
         assert_eq!(vd, ramp(51));
-        let vd = step(&mut e, 52, Some(5e-4), 5e-4);
+        let vd = step(&mut e, 52, false, 5e-4);
         assert_eq!((vd, e.coefficients()), (ramp(52), [(0.0, 0.0); 2]));
         // a restart forgets the past
         for t in 53..60 {
-            step(&mut e, t, Some(5e-4), 5e-4);
+            step(&mut e, t, false, 5e-4);
         }
         assert_ne!(e.coefficients(), [(0.0, 0.0); 2]);
-        let vd = step(&mut e, 60, None, 5e-4);
+        let vd = step(&mut e, 60, true, 5e-4);
         assert_eq!((vd, e.coefficients()), (ramp(60), [(0.0, 0.0); 2]));
     }
 }
