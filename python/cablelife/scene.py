@@ -511,9 +511,10 @@ class Simulation(_Model):
     output_step: PositiveFloat | None = None  # s (default: every step)
     max_iterations: PositiveInt = 40
     spectral_radius: Annotated[float, Strict(), Field(ge=0.0, le=1.0)] = 0.9  # ρ∞ of generalized-α
-    # Dynamic Newton iteration: converged when the correction is below this fraction of the
-    # estimated local time error, at most 5e-3 of the step's increment (1e-4 while touching a
-    # contact barrier); docs/dynamics.md: the error it leaves vs the time-step error.
+    # Dynamic Newton iteration: converged when its estimated remaining error (from the
+    # corrections' contraction) is below this fraction of the estimated local time error, the
+    # correction at most 5e-3 of the step's increment (1e-4 while touching a contact barrier);
+    # docs/dynamics.md: the error it leaves vs the time-step error.
     newton_tolerance: Annotated[float, Strict(), Field(gt=0.0, lt=1.0)] = (
         _core.DEFAULT_NEWTON_TOLERANCE
     )

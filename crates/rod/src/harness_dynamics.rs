@@ -14,6 +14,7 @@
 //! compute_with_rates`); the rate of a held ghost is taken as c_damp δθ (its J_r⁻¹(hΔq)
 //! factor, 1 + O(hΔq), is left out).
 use crate::assembly::{KinkAt, Part};
+use crate::contraction::Contraction;
 use crate::dynamics::{
     guard_verdict, ClipMotion, DynamicOptions, Dynamics, Energies, GenAlpha, StepStats,
     STALL_TOLERANCE,
@@ -68,6 +69,8 @@ pub struct HarnessDynamics {
     motions: Vec<Vec<ClipMotion>>,
     factor_valid: bool,
     factor_h: f64,
+    /// The Newton iteration's contraction with the reused matrix (the stopping rule).
+    contraction: Contraction,
     /// The shortest cable (junction displacements are scaled by it).
     length: f64,
     /// Harness totals (cables and junctions) after the last step or `update_outputs`.
@@ -111,6 +114,7 @@ impl HarnessDynamics {
             motions: clips.to_vec(),
             factor_valid: false,
             factor_h: 0.0,
+            contraction: Contraction::new(),
             length: h
                 .cables
                 .iter()
@@ -647,6 +651,7 @@ impl HarnessDynamics {
         let mut budget = self.opts.max_iterations;
         let mut strikes = 0;
         let mut next = 0;
+        self.contraction.begin_step();
         while next < budget {
             let it = next;
             next += 1;
@@ -706,10 +711,13 @@ impl HarnessDynamics {
             // Frictional guides: a correction small against the stick width (`Dynamics`).
             for (rod, dy) in h.cables.iter().zip(&self.cables) {
                 if let Some(s) = SlidingClips::frictional(&dy.sliding) {
-                    tolerance = tolerance.min(s.newton_tolerance(rod.spec.length));
+                    tolerance = tolerance.at_most(s.newton_tolerance(rod.spec.length));
                 }
             }
-            if alpha == 1.0 && norm < tolerance {
+            if !refactor && last_norm.is_finite() {
+                self.contraction.measure(norm, last_norm);
+            }
+            if alpha == 1.0 && self.contraction.converged(norm, tolerance) {
                 converged = true;
                 break;
             }
@@ -719,7 +727,8 @@ impl HarnessDynamics {
                 self.opts.refactor_rate
             };
             // … unless expected to finish at the next iterate (`Dynamics`).
-            if norm > rate * last_norm && !refactor && norm * (norm / last_norm) >= tolerance {
+            if norm > rate * last_norm && !refactor && norm * (norm / last_norm) >= tolerance.value
+            {
                 self.factor_valid = false;
             }
             last_norm = norm;

@@ -81,7 +81,7 @@ fn lift(t: f64) -> [f64; 3] {
 fn tight() -> DynamicOptions {
     DynamicOptions {
         rho_inf: 1.0,
-        tolerance: 1e-6,
+        tolerance: 1e-8,
         ..Default::default()
     }
 }
@@ -137,7 +137,7 @@ fn collinear_pair_follows_the_single_cable_in_dynamics() {
     // rotation instead of one. The curvature (2/δs) tan(φ/2) is not additive over half cells
     // (their energy differs from the cell's by a relative O(φ²), φ ~ κΔs: O(Δs³) in all), so
     // the responses differ by O(Δs³), independent of the time step and of the Newton
-    // tolerance (which stops both at 1e-6 of the local error estimate).
+    // tolerance (which stops both at 1e-8 of the local error estimate).
     let mut diffs = Vec::new();
     for n in [8, 16, 32] {
         let (worst, moved) = pair_difference(n, 1e-3);

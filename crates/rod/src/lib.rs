@@ -7,6 +7,7 @@ pub mod block_tridiag;
 pub mod conditioning;
 pub mod contact;
 pub mod contact_mesh;
+mod contraction;
 pub mod dynamics;
 mod escape;
 #[cfg(test)]
