@@ -14,10 +14,15 @@
 //! translational unknowns (m/s²), the bending rotations and the twist (rad/s²; the twist's
 //! torsion dynamics are of their own), with a ridge of 1e-5 on the normal equations' diagonal
 //! (collinear data: one sinusoid, alternation, constant motion), on every `STRIDE`-th block
-//! in turn (the fit costs ORDER² per unknown, the prediction ORDER); a fit that explains the
-//! increments no better than none is not used. Session 16's recursion of order 2 (d_n ≈
-//! μ v̇_n + λ d_{n−1}, exact for one sinusoid) took the harness benchmark to 1.70 iterations
-//! per step; order 6 takes it to 1.16 (docs/dynamics.md, "Predictor").
+//! in turn (the fit costs ORDER² per unknown, the prediction ORDER). The full order is used
+//! only where it leaves less than a quarter (`HIGHER`) of the squared residual of order 2
+//! (the leading two terms: session 16's recursion d_n ≈ μ v̇_n + λ d_{n−1}, exact for one
+//! sinusoid), else order 2; a fit that explains the increments no better than none is not
+//! used. Where a few modes dominate (the harness benchmark) order 6 takes the iterations per
+//! step from 1.70 to 1.16–1.19; in a broadband response (bench_dynamic.py, 10–200 Hz) its
+//! smaller first corrections left more of what a stale matrix handles badly (0.23 → 0.36
+//! refactorizations per step, 7 % slower), which the choice avoids (docs/dynamics.md,
+//! "Predictor").
 //!
 //! The predictor changes only where Newton starts: the converged step is the same to the
 //! tolerance, which bounds the iteration error by the time error.
@@ -31,6 +36,9 @@ const MEMORY: f64 = 20.0;
 const WARM_UP: usize = 3;
 /// Ridge on the diagonal of the normal equations, relative.
 const RIDGE: f64 = 1e-5;
+/// The full order is used where its fit leaves less than this fraction of the squared
+/// residual of order 2 (otherwise order 2; see `Fit::solve`).
+const HIGHER: f64 = 0.25;
 /// Groups of unknowns fitted separately (translations, bending rotations, twist) and each
 /// slot's group.
 const GROUPS: usize = 3;
@@ -68,15 +76,27 @@ impl Fit {
         for k in 0..ORDER {
             a[(k, k)] *= 1.0 + RIDGE;
         }
-        let Some(ch) = a.cholesky() else {
-            return Coefficients::zeros();
+        // order 2 (the leading block: v̇_n, d_{n−1})
+        let (a2, b2) = (
+            a.fixed_view::<2, 2>(0, 0).into_owned(),
+            self.b.fixed_rows::<2>(0),
+        );
+        let c2 = a2.cholesky().map(|ch| ch.solve(&b2.into_owned()));
+        let sse2 = c2.map_or(self.yy, |c| self.yy - c.dot(&b2));
+        let c = a.cholesky().map(|ch| ch.solve(&self.b));
+        let sse = c.map_or(self.yy, |c| self.yy - c.dot(&self.b));
+        let pick = match (c, c2) {
+            (Some(c), _) if sse < HIGHER * sse2 && sse < self.yy => Some(c),
+            (_, Some(c2)) if sse2 < self.yy => {
+                let mut c = Coefficients::zeros();
+                c.fixed_rows_mut::<2>(0).copy_from(&c2);
+                Some(c)
+            }
+            _ => None,
         };
-        let c = ch.solve(&self.b);
-        let sse = self.yy - c.dot(&self.b);
-        if c.iter().all(|x| x.is_finite()) && sse < self.yy {
-            c
-        } else {
-            Coefficients::zeros()
+        match pick {
+            Some(c) if c.iter().all(|x| x.is_finite()) => c,
+            _ => Coefficients::zeros(),
         }
     }
 }
@@ -332,9 +352,11 @@ mod tests {
         // best prediction, error ratio 1/√2; six coefficients fitted to 20 steps of one
         // unknown scatter about it: measured 0.87)
         let noise = same(|t| ((t as f64 * 12.9898).sin() * 43758.5453).fract());
-        let (_, predicted) = run(&noise, 2000);
+        let (e, predicted) = run(&noise, 2000);
         let ratio = error_ratio(&noise, &predicted, 100);
         assert!(ratio < 0.95, "{ratio}");
+        // … by order 2: the higher terms explain too little of the noise to be used (`HIGHER`)
+        assert_eq!(e.coefficients()[0].rows(2, ORDER - 2).norm(), 0.0);
         // too few steps: constant acceleration
         let (e, _) = run(same(|t| (t * t) as f64), ORDER + WARM_UP);
         assert_eq!(e.coefficients(), [Coefficients::zeros(); GROUPS]);
