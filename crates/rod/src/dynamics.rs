@@ -670,16 +670,15 @@ impl Dynamics {
         for (k, seg) in rod.segments.iter().enumerate() {
             let clips_still = seg.clips.iter().all(|&c| self.clip_still[c]);
             self.resting[k] &= clips_still;
-            self.increments[k] = if self.resting[k] {
-                0.0 // unchanged: Δq = 0
+            (self.increments[k], self.local_errors[k]) = if self.resting[k] {
+                (0.0, 0.0) // unchanged: Δq = 0
             } else {
-                let inc = self.update_kinematics(st, h, seg.blocks.clone());
-                self.limit_predictor(st, h, seg).unwrap_or(inc)
-            };
-            self.local_errors[k] = if self.resting[k] {
-                0.0
-            } else {
-                self.local_error(seg.blocks.clone())
+                let (inc, error) = self.predicted_kinematics(st, h, seg.blocks.clone());
+                match self.limit_predictor(st, h, seg) {
+                    // shortened against the contact barrier: v̇ changed
+                    Some(inc) => (inc, self.local_error(seg.blocks.clone())),
+                    None => (inc, error),
+                }
             };
         }
         let mut stats = StepStats {
@@ -1120,32 +1119,56 @@ impl Dynamics {
         h: f64,
         r: std::ops::Range<usize>,
     ) -> f64 {
-        let mut dx_max = 0.0f64;
-        let mut dth_max = 0.0f64;
+        self.predicted_kinematics(st, h, r).0
+    }
+
+    /// `update_kinematics` and `local_error` of blocks `r` in one pass (the predicted state
+    /// at the start of a step): (largest increment h|Δq|, local error estimate at v̇).
+    pub(crate) fn predicted_kinematics(
+        &mut self,
+        st: &mut State,
+        h: f64,
+        r: std::ops::Range<usize>,
+    ) -> (f64, f64) {
+        let (mut dx_max, mut dth_max) = (0.0f64, 0.0f64);
+        let (mut ex, mut eth) = (0.0f64, 0.0f64);
         let (k_dq, k_v) = (self.k_dq, self.k_v);
-        for b in r {
-            let [node, edge] = self.inertial_half[b];
-            let vdot = &self.vdot[b];
-            if node {
-                let vd: Vector3<f64> = vdot.fixed_rows::<3>(0).into();
-                let dq: Vector3<f64> = self.dq0[b].fixed_rows::<3>(0) + k_dq * vd;
-                let v: Vector3<f64> = self.v0[b].fixed_rows::<3>(0) + k_v * vd;
-                self.rates.v[b].fixed_rows_mut::<3>(0).copy_from(&v);
-                let dx = h * dq;
-                st.x[b] = self.x_n[b] + dx;
+        let re = r.start..r.end.min(st.p.len());
+        let blocks = self.inertial_half[r.clone()]
+            .iter()
+            .zip(&self.vdot[r.clone()])
+            .zip(&self.vdot_n[r.clone()])
+            .zip(&self.dq0[r.clone()])
+            .zip(&self.v0[r.clone()])
+            .zip(&mut self.rates.v[r.clone()])
+            .zip(&mut st.x[r.clone()])
+            .zip(&self.x_n[r.clone()]);
+        let mut edges = st.p[re.clone()].iter_mut().zip(&self.p_n[re]);
+        for (((((((half, vdot), vd_n), dq0), v0), v), x), x_n) in blocks {
+            let dq = dq0 + k_dq * vdot;
+            let vel = v0 + k_v * vdot;
+            let d = vdot - vd_n;
+            if half[0] {
+                v.fixed_rows_mut::<3>(0).copy_from(&vel.fixed_rows::<3>(0));
+                let dx: Vector3<f64> = h * dq.fixed_rows::<3>(0);
+                *x = x_n + dx;
                 dx_max = dx_max.max(dx.amax());
+                ex = ex.max(d.fixed_rows::<3>(0).amax());
             }
-            if edge {
-                let vd: Vector3<f64> = vdot.fixed_rows::<3>(3).into();
-                let dq: Vector3<f64> = self.dq0[b].fixed_rows::<3>(3) + k_dq * vd;
-                let v: Vector3<f64> = self.v0[b].fixed_rows::<3>(3) + k_v * vd;
-                self.rates.v[b].fixed_rows_mut::<3>(3).copy_from(&v);
-                let dth = h * dq;
-                st.p[b] = rotate_body(&self.p_n[b], &dth);
+            let Some((p, p_n)) = edges.next() else {
+                break;
+            };
+            if half[1] {
+                v.fixed_rows_mut::<3>(3).copy_from(&vel.fixed_rows::<3>(3));
+                let dth: Vector3<f64> = h * dq.fixed_rows::<3>(3);
+                *p = rotate_body(p_n, &dth);
                 dth_max = dth_max.max(dth.amax());
+                eth = eth.max(d.fixed_rows::<3>(3).amax());
             }
         }
-        (dx_max / self.length).max(dth_max)
+        let error =
+            (self.ga.beta - 1.0 / 6.0).abs() * self.h * self.h * (ex / self.length).max(eth);
+        ((dx_max / self.length).max(dth_max), error)
     }
 
     /// Applies the Newton correction `delta` of a segment (v̇ += c_m δq on inertial slots, the

@@ -554,8 +554,8 @@ impl HarnessDynamics {
         let mut err = self.junction_error(h, dt);
         for (c, rod) in h.cables.iter().enumerate() {
             let dy = &mut self.cables[c];
-            inc = inc.max(dy.update_kinematics(&mut st.cables[c], dt, 0..rod.arc.len()));
-            err = err.max(dy.local_error(0..rod.arc.len()));
+            let (i, e) = dy.predicted_kinematics(&mut st.cables[c], dt, 0..rod.arc.len());
+            (inc, err) = (inc.max(i), err.max(e));
         }
         self.sync_ends(h, st);
         if let Some(shortened) = self.limit_predictor(h, st, dt) {
