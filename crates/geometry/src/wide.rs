@@ -625,6 +625,13 @@ mod tests {
         (p, b)
     }
 
+    /// A triangle with corners uniform in the cube of side `size` at `off`.
+    fn random_triangle(rnd: &mut impl FnMut() -> f64, size: f64, off: V3) -> Vec<V3> {
+        (0..3)
+            .map(|_| off + V3::new(rnd(), rnd(), rnd()) * size)
+            .collect()
+    }
+
     /// Random triangles at scales 1 mm … 1 km and offsets up to 1000 × their size from the
     /// origin, and points and segments near them (nearly touching, nearly parallel, far):
     /// the float32 plane-and-disk bounds must stay at or below the exact distances, and
@@ -636,9 +643,7 @@ mod tests {
         let mut over_without_pad = 0;
         for case in 0..20000 {
             let (size, off) = case_scale(&mut rnd, case);
-            let v: Vec<V3> = (0..3)
-                .map(|_| off + V3::new(rnd(), rnd(), rnd()) * size)
-                .collect();
+            let v = random_triangle(&mut rnd, size, off);
             let (n, x, _, c, r) = triangle_disk(&v);
             let mut disk = Disk4::NONE;
             disk.set(0, &n, x, x, &c, r);
@@ -689,13 +694,11 @@ mod tests {
         let mut tight = 0;
         for case in 0..20000 {
             let (size, off) = case_scale(&mut rnd, case);
-            let tri = |rnd: &mut dyn FnMut() -> f64| -> Vec<V3> {
-                (0..3)
-                    .map(|_| off + V3::new(rnd(), rnd(), rnd()) * size)
-                    .collect()
-            };
             // a block of two triangles (its origin at the first's centroid)
-            let (v, w) = (tri(&mut rnd), tri(&mut rnd));
+            let (v, w) = (
+                random_triangle(&mut rnd, size, off),
+                random_triangle(&mut rnd, size, off),
+            );
             let block = Block4::new(&[triangle_disk(&v), triangle_disk(&w)]);
             let (n, _, _, c, _) = triangle_disk(&v);
             let (p, b) = near_point_and_segment(&mut rnd, &v, &n, size);

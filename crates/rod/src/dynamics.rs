@@ -1166,8 +1166,7 @@ impl Dynamics {
                 eth = eth.max(d.fixed_rows::<3>(3).amax());
             }
         }
-        let error =
-            (self.ga.beta - 1.0 / 6.0).abs() * self.h * self.h * (ex / self.length).max(eth);
+        let error = self.error_estimate(ex, eth);
         ((dx_max / self.length).max(dth_max), error)
     }
 
@@ -1230,8 +1229,7 @@ impl Dynamics {
             }
         }
         self.apply_massless(rod, st, seg);
-        let error =
-            (self.ga.beta - 1.0 / 6.0).abs() * self.h * self.h * (ex / self.length).max(eth);
+        let error = self.error_estimate(ex, eth);
         ((dx_max / self.length).max(dth_max), error)
     }
 
@@ -1253,6 +1251,12 @@ impl Dynamics {
                 dth = dth.max(d.fixed_rows::<3>(3).amax());
             }
         }
+        self.error_estimate(dx, dth)
+    }
+
+    /// |β − 1/6| h² |Δv̇| from the largest change of v̇ over the translations (`dx`, m/s²) and
+    /// the rotations (`dth`), positions relative to the cable length as the corrections.
+    fn error_estimate(&self, dx: f64, dth: f64) -> f64 {
         (self.ga.beta - 1.0 / 6.0).abs() * self.h * self.h * (dx / self.length).max(dth)
     }
 

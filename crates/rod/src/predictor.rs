@@ -107,7 +107,6 @@ pub(crate) struct Extrapolation {
     /// The increments d_{n−2} … d_{n−ORDER} per block (rows by age, `head` the newest).
     ring: Vec<Vector6<f64>>,
     head: usize,
-    n: usize,
     fits: [Fit; GROUPS],
     /// Step size of the observed steps; steps observed since the last reset.
     h: f64,
@@ -120,7 +119,6 @@ impl Extrapolation {
     pub(crate) fn new(n: usize) -> Self {
         Extrapolation {
             ring: vec![Vector6::zeros(); (ORDER - 1) * n],
-            n,
             ..Default::default()
         }
     }
@@ -168,9 +166,9 @@ impl Extrapolation {
         let extrapolate = c.iter().any(|c| c.iter().any(|&x| x != 0.0));
         // the fit needs v̇_{n−1} and d_{n−2} … d_{n−ORDER}: vdot_n and ORDER − 1 rows
         let observe = self.observed >= ORDER;
-        let stride = if self.n >= 8 * STRIDE { STRIDE } else { 1 };
+        let n = self.ring.len() / (ORDER - 1);
+        let stride = if n >= 8 * STRIDE { STRIDE } else { 1 };
         let phase = self.observed % stride;
-        let n = self.n;
         let rows: [usize; ORDER - 1] = std::array::from_fn(|j| ((self.head + j) % (ORDER - 1)) * n);
         // per slot the coefficients of its group (Vector6 arithmetic over the block)
         let cv: [Vector6<f64>; ORDER] =
