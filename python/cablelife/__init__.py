@@ -10,8 +10,12 @@ fatigue analysis (pseudo-damage) to choose the best mounting variant.
 The names below are imported on first use (``cablelife._lazy``): ``import cablelife`` is fast.
 """
 
-from cablelife import _core
-from cablelife._lazy import lazy_package
+from cablelife._cpu import check_processor
+
+check_processor()  # before the compiled core loads: a clear error, not SIGILL
+
+from cablelife import _core  # noqa: E402
+from cablelife._lazy import lazy_package  # noqa: E402
 
 __version__: str = _core.__version__
 

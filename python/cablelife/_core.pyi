@@ -4,6 +4,10 @@ flags. Arrays are numpy float64 unless said otherwise. Kept current by tests/tes
 
 from typing import Any
 
+cpu_features: str
+"""Processor features the build's code may use, as named in /proc/cpuinfo (space-separated;
+empty where not checked). Also in the ELF section ``.cablelife_cpu`` (``cablelife._cpu``)."""
+
 class Cable:
     """One cable: mesh, state and solver."""
     def __init__(

@@ -2,6 +2,7 @@
 use pyo3::prelude::*;
 
 mod cable;
+mod cpu;
 mod fatigue;
 mod geometry;
 mod harness;
@@ -11,6 +12,7 @@ mod volume;
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add("cpu_features", cpu::features())?;
     cable::register(m)?;
     volume::register(m)?;
     fatigue::register(m)?;
