@@ -92,6 +92,8 @@ def compose_rotations(
     omega = np.zeros((n, 3))
     alpha = np.zeros((n, 3))
     for axis, kin in factors:
+        if not (kin.value.any() or kin.velocity.any() or kin.acceleration.any()):
+            continue  # a channel at rest: R_i = I, no term (the same values to the last bit)
         a = rotation @ np.asarray(axis, float)
         alpha = alpha + kin.acceleration[:, None] * a + kin.velocity[:, None] * np.cross(omega, a)
         omega = omega + kin.velocity[:, None] * a
