@@ -1,9 +1,9 @@
 """The processor check before the compiled core loads.
 
-The core (``cablelife._core``) is built for the processor of the machine that builds it
-(``-C target-cpu=native`` in ``.cargo/config.toml``: AVX2, FMA, AVX-512 where present). Run on
-a processor without one of those instruction sets — a copy of the installation on another
-machine, a home folder shared by different computers — it would stop at the first such
+The core (``cablelife._core``) is built for the generic x86-64 instruction set, but a build
+with other flags (``RUSTFLAGS="-C target-cpu=native"``: AVX2, FMA, AVX-512 where present) run
+on a processor without one of its instruction sets — a copy of the installation on another
+machine, a home folder shared by different computers — would stop at the first such
 instruction with "Illegal instruction" and no further word. So before it loads, the features
 stamped into it at build time (ELF section ``.cablelife_cpu``, names as in /proc/cpuinfo;
 ``crates/py/build.rs``) are compared with this processor's, from the file, without loading
@@ -76,9 +76,9 @@ def message(missing: list[str], path: str) -> str:
     return (
         f"cablelife's compiled core ({path}) was built on a processor with instruction sets "
         f"this one lacks: {', '.join(missing)}. It would stop with 'Illegal instruction'. "
-        "Build it on this machine: python3 -m pip install -e . (in the cablelife folder); for "
-        "one build that runs on several machines, build with "
-        "RUSTFLAGS='-C target-cpu=x86-64-v2' (or the oldest processor's level)."
+        "Rebuild it for the generic instruction set: unset RUSTFLAGS, then "
+        "python3 -m pip install -e . in the cablelife folder (or set RUSTFLAGS to the oldest "
+        "processor's level, e.g. '-C target-cpu=x86-64-v2')."
     )
 
 
