@@ -3,7 +3,7 @@
 //! (python/cablelife/_cpu.py reads the ELF section `.cablelife_cpu`; see src/cpu.rs).
 //!
 //! The features are the compilation's (`CARGO_CFG_TARGET_FEATURE`: those of
-//! x86-64's baseline, or e.g. those of `-C target-cpu=native` in RUSTFLAGS). Only names that the
+//! AVX and FMA from .cargo/config.toml, or those of RUSTFLAGS). Only names that the
 //! building machine's /proc/cpuinfo lists are stamped, so the machine that built the
 //! extension always passes the check (a feature whose name we would map wrongly is left
 //! out rather than reported missing on the very machine that has it).

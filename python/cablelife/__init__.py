@@ -12,7 +12,7 @@ The names below are imported on first use (``cablelife._lazy``): ``import cablel
 
 from cablelife._cpu import check_processor
 
-check_processor()  # before the compiled core loads: a clear error, not SIGILL
+check_processor(__path__)  # before the compiled core loads: a clear error, not SIGILL
 
 from cablelife import _core  # noqa: E402
 from cablelife._lazy import lazy_package  # noqa: E402
