@@ -320,6 +320,12 @@ def section_strains(positions, quaternions, arc_length) -> Any:
     (T, N + 1, 3), edge quaternions (T, N, 4, scalar first) and node arc lengths (N + 1)."""
     ...
 
+def strain_extremes(positions, quaternions, arc_length) -> Any:
+    """((value, step, edge) of the largest axial strain, of the largest compression −Γ₃, of
+    the largest shear strain), or None for no steps or edges; arrays as `section_strains`,
+    C-contiguous. The first of equal values; a NaN counts as largest (numpy's argmax)."""
+    ...
+
 def weld_vertices(vertices, faces) -> Any:
     """Merges the vertices (N, 3) of a triangle soup that agree to 8 decimals (first appearance's
     order and coordinates kept) and re-indexes the faces (F, 3): (vertices (M, 3), faces (F, 3)).

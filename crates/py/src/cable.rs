@@ -1138,6 +1138,46 @@ impl Cable {
 
 type StrainArrays<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>);
 
+/// Checks saved positions (T, N + 1, 3), quaternions (T, N, 4) and arc lengths (N + 1, as a
+/// slice: None if not contiguous) of `what`; returns 1/Δs per edge.
+fn saved_shapes(what: &str, x: &[usize], p: &[usize], s: Option<&[f64]>) -> PyResult<Vec<f64>> {
+    let (t, n) = (p[0], p[1]);
+    let s = s.unwrap_or(&[]);
+    if x != [t, n + 1, 3] || p[2] != 4 || s.len() != n + 1 {
+        return Err(PyValueError::new_err(format!(
+            "{what}: positions {x:?}, quaternions {p:?} and arc lengths ({}) do not match: \
+             (T, N + 1, 3), (T, N, 4), N + 1 (contiguous)",
+            s.len()
+        )));
+    }
+    Ok((0..n).map(|e| 1.0 / (s[e + 1] - s[e])).collect())
+}
+
+/// Per saved step: (value, step, edge) of the largest axial strain Γ₃, the largest
+/// compression −Γ₃ and the largest shear strain |(Γ₁, Γ₂)| of saved positions (T, N + 1, 3),
+/// edge quaternions (T, N, 4) and node arc lengths (N + 1), all C-contiguous; the first of
+/// equal values, a NaN counts as largest (numpy's argmax). None for no steps or edges.
+#[pyfunction]
+fn strain_extremes(
+    positions: PyReadonlyArray3<'_, f64>,
+    quaternions: PyReadonlyArray3<'_, f64>,
+    arc_length: PyReadonlyArray1<'_, f64>,
+) -> PyResult<Option<[(f64, usize, usize); 3]>> {
+    let inv_ds = saved_shapes(
+        "strain_extremes",
+        positions.as_array().shape(),
+        quaternions.as_array().shape(),
+        arc_length.as_slice().ok(),
+    )?;
+    let (Ok(x), Ok(p)) = (positions.as_slice(), quaternions.as_slice()) else {
+        return Err(PyValueError::new_err(
+            "strain_extremes: positions and quaternions must be C-contiguous",
+        ));
+    };
+    Ok(rod::shear::saved_strain_extremes(x, p, &inv_ds)
+        .map(|e| e.map(|e| (e.value, e.step, e.edge))))
+}
+
 /// Axial strain Γ₃ and shear strain |(Γ₁, Γ₂)| per step and edge (T, N) of saved positions
 /// (T, N + 1, 3), edge quaternions (T, N, 4, scalar first) and node arc lengths (N + 1).
 #[pyfunction]
@@ -1153,16 +1193,7 @@ fn section_strains<'py>(
         arc_length.as_array(),
     );
     let (t, n) = (p.shape()[0], p.shape()[1]);
-    if x.shape() != [t, n + 1, 3] || p.shape()[2] != 4 || s.len() != n + 1 {
-        return Err(PyValueError::new_err(format!(
-            "section_strains: positions {:?}, quaternions {:?} and arc lengths ({}) do not \
-             match: (T, N + 1, 3), (T, N, 4), N + 1",
-            x.shape(),
-            p.shape(),
-            s.len()
-        )));
-    }
-    let inv_ds: Vec<f64> = (0..n).map(|e| 1.0 / (s[e + 1] - s[e])).collect();
+    let inv_ds = saved_shapes("section_strains", x.shape(), p.shape(), s.as_slice())?;
     let (mut axial, mut shear) = (vec![0.0; t * n], vec![0.0; t * n]);
     for k in 0..t {
         for e in 0..n {
@@ -1183,6 +1214,7 @@ fn section_strains<'py>(
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Cable>()?;
     m.add_function(wrap_pyfunction!(section_strains, m)?)?;
+    m.add_function(wrap_pyfunction!(strain_extremes, m)?)?;
     m.add("DEFAULT_NEWTON_TOLERANCE", rod::dynamics::DEFAULT_TOLERANCE)?;
     Ok(())
 }

@@ -50,6 +50,76 @@ pub fn saved_strain(
     v + k * (u.cross(&c) - w * c) - Vector3::z()
 }
 
+/// The largest value of a scan and where it is (saved step, edge).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Extreme {
+    pub value: f64,
+    pub step: usize,
+    pub edge: usize,
+}
+
+impl Extreme {
+    /// Takes (value, step, edge) if it is the scan's new largest: the first of equal values,
+    /// and the first NaN over any number (numpy's `argmax`, so a NaN in a result is reported).
+    #[inline]
+    fn offer(slot: &mut Option<Extreme>, value: f64, step: usize, edge: usize) {
+        let take = match slot {
+            None => true,
+            Some(e) => !e.value.is_nan() && (value.is_nan() || value > e.value),
+        };
+        if take {
+            *slot = Some(Extreme { value, step, edge });
+        }
+    }
+}
+
+/// The validity scan of a saved run in one pass, without the strain arrays: the largest
+/// axial strain Γ₃, the largest compression (−Γ₃) and the largest shear strain |(Γ₁, Γ₂)|
+/// over the steps and edges, each with where it is (the first of equal values; a NaN
+/// counts as largest). `positions`: (T, N + 1, 3) and `quaternions` (T, N, 4, scalar first,
+/// any length) row-major; `inv_ds`: 1/Δs per edge (N). None for no steps or no edges.
+pub fn saved_strain_extremes(
+    positions: &[f64],
+    quaternions: &[f64],
+    inv_ds: &[f64],
+) -> Option<[Extreme; 3]> {
+    let n = inv_ds.len();
+    if n == 0 {
+        return None;
+    }
+    let steps = quaternions.len() / (4 * n);
+    assert_eq!(
+        positions.len(),
+        steps * 3 * (n + 1),
+        "positions (T, N + 1, 3)"
+    );
+    assert_eq!(quaternions.len(), steps * 4 * n, "quaternions (T, N, 4)");
+    let mut best = [None; 3];
+    for k in 0..steps {
+        let x = &positions[k * 3 * (n + 1)..(k + 1) * 3 * (n + 1)];
+        let p = &quaternions[k * 4 * n..(k + 1) * 4 * n];
+        for (e, inv) in inv_ds.iter().enumerate() {
+            let at = |i: usize| Vector3::new(x[3 * i], x[3 * i + 1], x[3 * i + 2]);
+            let q = &p[4 * e..4 * e + 4];
+            let g = saved_strain(
+                &at(e),
+                &at(e + 1),
+                q[0],
+                &Vector3::new(q[1], q[2], q[3]),
+                *inv,
+            );
+            let shear = (g.x * g.x + g.y * g.y).sqrt();
+            for (slot, v) in best.iter_mut().zip([g.z, -g.z, shear]) {
+                Extreme::offer(slot, v, k, e);
+            }
+        }
+    }
+    match best {
+        [Some(a), Some(c), Some(s)] => Some([a, c, s]),
+        _ => None,
+    }
+}
+
 /// Strain Γ − Γ⁰ of an edge and its derivatives: the pieces from which forces, stiffness
 /// and viscous damping are assembled (static and dynamic alike).
 #[derive(Clone, Copy, Debug)]
@@ -247,6 +317,48 @@ pub fn shear_element(
 mod tests {
     use super::*;
     use crate::rotation::{exp_half, rotate_body};
+
+    #[test]
+    fn strain_extremes_are_the_first_largest_and_report_nan() {
+        // three steps of a straight cable of 4 edges along z (Δs = 0.1): step 1 stretches
+        // edge 2 by 3 %, step 2 compresses edge 0 by 2 % and shears edge 3 by 0.05 twice
+        // (edges 3 at steps 1 and 2 equal: the first is reported)
+        let (n, ds) = (4, 0.1);
+        let mut x = vec![];
+        let mut q = vec![];
+        let stretch = [[0.0; 4], [0.0, 0.0, 0.03, 0.0], [-0.02, 0.0, 0.0, 0.0]];
+        let shear = [[0.0; 4], [0.0, 0.0, 0.0, 0.05], [0.0, 0.0, 0.0, 0.05]];
+        for k in 0..3 {
+            let mut p = Vector3::zeros();
+            x.extend_from_slice(p.as_slice());
+            for e in 0..n {
+                p += Vector3::new(shear[k][e], 0.0, 1.0 + stretch[k][e]) * ds;
+                x.extend_from_slice(p.as_slice());
+                q.extend_from_slice(&[2.0, 0.0, 0.0, 0.0]); // identity, not unit
+            }
+        }
+        let inv = vec![1.0 / ds; n];
+        let [a, c, s] = saved_strain_extremes(&x, &q, &inv).unwrap();
+        assert!(
+            (a.value - 0.03).abs() < 1e-12 && (a.step, a.edge) == (1, 2),
+            "{a:?}"
+        );
+        assert!(
+            (c.value - 0.02).abs() < 1e-12 && (c.step, c.edge) == (2, 0),
+            "{c:?}"
+        );
+        assert!(
+            (s.value - 0.05).abs() < 1e-12 && (s.step, s.edge) == (1, 3),
+            "{s:?}"
+        );
+        // a NaN position at step 2, node 3: edges 2 and 3 are NaN, the first is reported
+        x[2 * 3 * (n + 1) + 3 * 3] = f64::NAN;
+        for e in saved_strain_extremes(&x, &q, &inv).unwrap() {
+            assert!(e.value.is_nan() && (e.step, e.edge) == (2, 2), "{e:?}");
+        }
+        assert_eq!(saved_strain_extremes(&[], &[], &inv), None);
+        assert_eq!(saved_strain_extremes(&[0.0; 3], &[], &[]), None);
+    }
 
     #[test]
     fn saved_strain_is_the_element_strain_for_any_quaternion_length() {
