@@ -156,13 +156,14 @@ def clip_kinematics(
             "angular_accelerations",
         )
     }
-    frames = np.empty((n_t, n_c, 3, 3))
+    # per clip its frame: one matrix for a clip at rest, else (T, 3, 3); to quaternions below
+    frames: list[np.ndarray] = []
     for j, clip in enumerate(cable.clips):
         local = frame_matrix(clip.direction, clip.normal)
         pos = np.asarray(clip.position, float)
         if clip.body == "world":
             out["positions"][:, j] = pos
-            frames[:, j] = local
+            frames.append(local)
             continue
         body, r0, motion = motions[clip.body]
         origin = np.asarray(body.origin, float)
@@ -170,7 +171,7 @@ def clip_kinematics(
             pos, local = origin + r0 @ pos, r0 @ local
         if motion is None:
             out["positions"][:, j] = pos
-            frames[:, j] = local
+            frames.append(local)
             continue
         rot = motion.rotation[:n_t]
         arm = rot @ (pos - origin)  # r = R(X − o)
@@ -182,10 +183,12 @@ def clip_kinematics(
         )
         out["angular_velocities"][:, j] = w
         out["angular_accelerations"][:, j] = alpha
-        frames[:, j] = rot @ local
+        frames.append(rot @ local)
     _check_clip_motion(cable, times, out)
-    quats = matrix_quaternions(frames.reshape(-1, 3, 3))
-    out["quaternions"] = quats.reshape(n_t, n_c, 4)
+    # a clip at rest converts its one matrix (the same quaternion as each of T copies)
+    out["quaternions"] = np.empty((n_t, n_c, 4))
+    for j, frame in enumerate(frames):
+        out["quaternions"][:, j] = matrix_quaternions(frame)
     return out
 
 
