@@ -1153,10 +1153,11 @@ fn saved_shapes(what: &str, x: &[usize], p: &[usize], s: Option<&[f64]>) -> PyRe
     Ok((0..n).map(|e| 1.0 / (s[e + 1] - s[e])).collect())
 }
 
-/// Per saved step: (value, step, edge) of the largest axial strain Γ₃, the largest
-/// compression −Γ₃ and the largest shear strain |(Γ₁, Γ₂)| of saved positions (T, N + 1, 3),
-/// edge quaternions (T, N, 4) and node arc lengths (N + 1), all C-contiguous; the first of
-/// equal values, a NaN counts as largest (numpy's argmax). None for no steps or edges.
+/// Over all saved steps and edges, (value, step, edge) of the largest axial strain Γ₃, of the
+/// largest compression −Γ₃ and of the largest shear strain |(Γ₁, Γ₂)|, from saved positions
+/// (T, N + 1, 3), edge quaternions (T, N, 4) and node arc lengths (N + 1), all C-contiguous;
+/// the first of equal values, a NaN counts as largest (numpy's argmax). None for no steps or
+/// edges (`rod::shear::saved_strain_extremes`).
 #[pyfunction]
 fn strain_extremes(
     positions: PyReadonlyArray3<'_, f64>,
