@@ -95,10 +95,13 @@ pub fn saved_strain_extremes(
     );
     assert_eq!(quaternions.len(), steps * 4 * n, "quaternions (T, N, 4)");
     let mut best = [None; 3];
+    // per step the strains of all edges first (a loop free of branches), then the scans
+    let (mut axial, mut shear) = (vec![0.0; n], vec![0.0; n]);
     for k in 0..steps {
         let x = &positions[k * 3 * (n + 1)..(k + 1) * 3 * (n + 1)];
         let p = &quaternions[k * 4 * n..(k + 1) * 4 * n];
-        for (e, inv) in inv_ds.iter().enumerate() {
+        let strains = inv_ds.iter().zip(axial.iter_mut().zip(&mut shear));
+        for (e, (inv, (ax, sh))) in strains.enumerate() {
             let at = |i: usize| Vector3::new(x[3 * i], x[3 * i + 1], x[3 * i + 2]);
             let q = &p[4 * e..4 * e + 4];
             let g = saved_strain(
@@ -108,10 +111,13 @@ pub fn saved_strain_extremes(
                 &Vector3::new(q[1], q[2], q[3]),
                 *inv,
             );
-            let shear = (g.x * g.x + g.y * g.y).sqrt();
-            for (slot, v) in best.iter_mut().zip([g.z, -g.z, shear]) {
-                Extreme::offer(slot, v, k, e);
-            }
+            *ax = g.z;
+            *sh = (g.x * g.x + g.y * g.y).sqrt();
+        }
+        for (e, (a, s)) in axial.iter().zip(&shear).enumerate() {
+            Extreme::offer(&mut best[0], *a, k, e);
+            Extreme::offer(&mut best[1], -a, k, e);
+            Extreme::offer(&mut best[2], *s, k, e);
         }
     }
     match best {
