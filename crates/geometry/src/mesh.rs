@@ -566,11 +566,20 @@ impl TriMesh {
             }
             let wn = &self.wide[w as usize];
             let mut g = [f32::INFINITY; 4];
-            for (q, b) in qs.iter().zip(bf) {
-                let gb = wn.gaps2(q);
-                let gd = wn.disk.segment_bounds2(&af, b, pad);
+            if let (&[q0, q1], &[b0, b1]) = (qs, bf) {
+                // the two half-edges of a node: eight lanes at once (the same values)
+                let gb = wn.gaps2_pair(&[q0, q1]);
+                let gd = wn.disk.segment_bounds2_pair(&af, &[b0, b1], [pad, pad]);
                 for l in 0..4 {
-                    g[l] = g[l].min(gb[l].max(gd[l]));
+                    g[l] = gb[l].max(gd[l]).min(gb[l + 4].max(gd[l + 4]));
+                }
+            } else {
+                for (q, b) in qs.iter().zip(bf) {
+                    let gb = wn.gaps2(q);
+                    let gd = wn.disk.segment_bounds2(&af, b, pad);
+                    for l in 0..4 {
+                        g[l] = g[l].min(gb[l].max(gd[l]));
+                    }
                 }
             }
             let order = wide::order(&g);
@@ -585,8 +594,14 @@ impl TriMesh {
                 let block = &self.blocks[(wn.wide[l] & !LEAF) as usize];
                 let mut tb = [[0f32; 4]; MAX_ENDS];
                 let al = block.local(a);
-                for (j, b) in ends.iter().enumerate() {
-                    tb[j] = block.segment_bounds2(&al, b);
+                if let &[b0, b1] = &ends {
+                    let t = block.segment_bounds2_pair(&al, [b0, b1]);
+                    tb[0].copy_from_slice(&t[..4]);
+                    tb[1].copy_from_slice(&t[4..]);
+                } else {
+                    for (j, b) in ends.iter().enumerate() {
+                        tb[j] = block.segment_bounds2(&al, b);
+                    }
                 }
                 let start = node.index as usize;
                 #[allow(clippy::needless_range_loop)] // tb is per segment, then lane

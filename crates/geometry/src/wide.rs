@@ -9,6 +9,7 @@
 //! skip. The binary nodes keep their float64 data (slab and ball bounds, triangle ranges): the
 //! wide nodes point at them, and the leaves are tested exactly.
 use rayon::prelude::*;
+use wide::f32x8;
 
 use crate::V3;
 
@@ -171,6 +172,54 @@ impl Disk4 {
     }
 }
 
+/// Four lanes twice (eight lanes: both halves the same).
+#[inline(always)]
+fn twice(v: &[f32; 4]) -> f32x8 {
+    f32x8::from([v[0], v[1], v[2], v[3], v[0], v[1], v[2], v[3]])
+}
+
+/// `x` in lanes 0–3, `y` in lanes 4–7.
+#[inline(always)]
+fn halves(x: f32, y: f32) -> f32x8 {
+    f32x8::from([x, x, x, x, y, y, y, y])
+}
+
+impl Disk4 {
+    /// [`Self::segment_bounds2`] of two segments from one start `a` to `b[0]` and `b[1]`
+    /// (the two half-edges of a cable node; `pad` per segment) in eight lanes: 0–3 the first
+    /// segment, 4–7 the second, each lane the same float32 operations in the same order as the four-lane
+    /// version (the same values; the `wide` crate's 8-lane vectors, AVX where built with it).
+    #[inline(always)]
+    pub fn segment_bounds2_pair(&self, a: &[f32; 3], b: &[[f32; 3]; 2], pad: [f32; 2]) -> [f32; 8] {
+        let zero = f32x8::ZERO;
+        let pad = halves(pad[0], pad[1]);
+        let n = [
+            twice(&self.axis[0]),
+            twice(&self.axis[1]),
+            twice(&self.axis[2]),
+        ];
+        let av = [f32x8::splat(a[0]), f32x8::splat(a[1]), f32x8::splat(a[2])];
+        let d: [f32x8; 3] = std::array::from_fn(|k| halves(b[0][k] - a[k], b[1][k] - a[k]));
+        let xa = n[0] * av[0] + n[1] * av[1] + n[2] * av[2];
+        let xd = n[0] * d[0] + n[1] * d[1] + n[2] * d[2];
+        let xb = xa + xd;
+        let g = ((twice(&self.lo) - xa.max(xb)).max(xa.min(xb) - twice(&self.hi)) - pad).max(zero);
+        let u: [f32x8; 3] = std::array::from_fn(|k| av[k] - twice(&self.center[k]));
+        let xu = n[0] * u[0] + n[1] * u[1] + n[2] * u[2];
+        let pu: [f32x8; 3] = std::array::from_fn(|k| u[k] - n[k] * xu);
+        let e: [f32x8; 3] = std::array::from_fn(|k| d[k] - n[k] * xd);
+        let l2 = e[0] * e[0] + e[1] * e[1] + e[2] * e[2];
+        let pe = pu[0] * e[0] + pu[1] * e[1] + pu[2] * e[2];
+        // l2 = 0 (e = 0, so pe = 0): 0/0 is NaN, and max(NaN, 0) = 0 in `wide` as in the
+        // four-lane version's branch
+        let s = (-pe / l2).max(zero).min(f32x8::ONE);
+        let q: [f32x8; 3] = std::array::from_fn(|k| pu[k] + e[k] * s);
+        let qn = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2]).sqrt();
+        let lat = (qn - twice(&self.radius) - pad).max(zero);
+        (g * g + lat * lat).to_array()
+    }
+}
+
 /// A leaf's triangle disks ([`Disk4`]) in float32 coordinates relative to the block's own
 /// origin, a float32 point near them: the round-off of the bounds, and so the allowance
 /// [`pad`], scale with the distances within the block and to the query instead of with the
@@ -235,6 +284,15 @@ impl Block4 {
     pub fn point_bounds2(&self, p: &V3) -> [f32; 4] {
         let (q, m) = self.local(p);
         self.disk.point_bounds2(&q, local_pad(m))
+    }
+
+    /// [`Self::segment_bounds2`] of the two segments from `a` to `b[0]` and `b[1]` in eight
+    /// lanes ([`Disk4::segment_bounds2_pair`]; the same values).
+    #[inline(always)]
+    pub fn segment_bounds2_pair(&self, (a, ma): &([f32; 3], f64), b: [&V3; 2]) -> [f32; 8] {
+        let ((q0, m0), (q1, m1)) = (self.local(b[0]), self.local(b[1]));
+        let pad = [local_pad(ma.max(m0)), local_pad(ma.max(m1))];
+        self.disk.segment_bounds2_pair(a, &[q0, q1], pad)
     }
 
     /// [`Disk4::segment_bounds2`] of the segment from `a` (given by [`Self::local`]) to the
@@ -303,6 +361,20 @@ impl Rounded {
 }
 
 impl Wide {
+    /// [`Self::gaps2`] of two boxes in eight lanes (0–3: `q[0]`, 4–7: `q[1]`; the same
+    /// values).
+    #[inline(always)]
+    pub fn gaps2_pair(&self, q: &[Rounded; 2]) -> [f32; 8] {
+        let mut d2 = f32x8::ZERO;
+        for k in 0..3 {
+            let e = (twice(&self.min[k]) - halves(q[0].hi[k], q[1].hi[k]))
+                .max(halves(q[0].lo[k], q[1].lo[k]) - twice(&self.max[k]))
+                .max(f32x8::ZERO);
+            d2 += e * e;
+        }
+        d2.to_array()
+    }
+
     /// A node with no lanes.
     const EMPTY: Wide = Wide {
         min: [[f32::INFINITY; 4]; 3],
@@ -682,6 +754,80 @@ mod tests {
             }
         }
         assert!(over_without_pad > 100, "{over_without_pad}");
+    }
+
+    /// The eight-lane bounds of two segments (the two half-edges of a node) are the four-lane
+    /// ones to the last bit: wide-node boxes and disks, leaf blocks in their frame; full and
+    /// empty lanes, scales from 1 mm to 1 km, a zero-length segment, a segment along a
+    /// slab's axis.
+    #[test]
+    fn eight_lane_pairs_equal_the_four_lane_bounds() {
+        let mut rnd = crate::test_random(17);
+        let same =
+            |x: [f32; 4], y: &[f32]| x.iter().zip(y).all(|(p, q)| p.to_bits() == q.to_bits());
+        for case in 0..5000 {
+            let (size, off) = case_scale(&mut rnd, case);
+            let tris: Vec<Vec<V3>> = (0..3)
+                .map(|_| random_triangle(&mut rnd, size, off))
+                .collect();
+            let disks: Vec<_> = tris.iter().map(|v| triangle_disk(v)).collect();
+            // a disk lane per triangle, lane 3 empty (NONE), as wide nodes and leaves have
+            let mut disk = Disk4::NONE;
+            for (l, (n, x, _, c, r)) in disks.iter().enumerate() {
+                disk.set(l, n, *x, *x + size * rnd(), c, *r);
+            }
+            let (a, b0) = near_point_and_segment(&mut rnd, &tris[0], &disks[0].0, size);
+            let b1 = match case % 5 {
+                0 => a,                                     // zero length
+                1 => a + disks[0].0 * size * (rnd() + 0.1), // along the axis of lane 0
+                _ => near_point_and_segment(&mut rnd, &tris[1], &disks[1].0, size).1,
+            };
+            let scale = [a, b0, b1].iter().fold(size, |m: f64, x| m.max(x.amax()));
+            let (af, b0f, b1f) = (f32x3(&a), f32x3(&b0), f32x3(&b1));
+            let pair = disk.segment_bounds2_pair(&af, &[b0f, b1f], [pad(scale), 0.5 * pad(scale)]);
+            assert!(
+                same(disk.segment_bounds2(&af, &b0f, pad(scale)), &pair[..4]),
+                "case {case}"
+            );
+            assert!(
+                same(
+                    disk.segment_bounds2(&af, &b1f, 0.5 * pad(scale)),
+                    &pair[4..]
+                ),
+                "case {case}"
+            );
+            // boxes: a node's four lanes (the last empty) against the two segments' boxes
+            let mut w = Wide::EMPTY;
+            for (l, v) in tris.iter().enumerate() {
+                let (lo, hi) = (v[0].inf(&v[1]).inf(&v[2]), v[0].sup(&v[1]).sup(&v[2]));
+                let r = Rounded::new(&lo, &hi);
+                for k in 0..3 {
+                    w.min[k][l] = r.lo[k];
+                    w.max[k][l] = r.hi[k];
+                }
+            }
+            let q = [
+                Rounded::new(&a.inf(&b0), &a.sup(&b0)),
+                Rounded::new(&a.inf(&b1), &a.sup(&b1)),
+            ];
+            let gaps = w.gaps2_pair(&q);
+            assert!(
+                same(w.gaps2(&q[0]), &gaps[..4]) && same(w.gaps2(&q[1]), &gaps[4..]),
+                "case {case}"
+            );
+            // a leaf block of the three triangles in its own frame
+            let block = Block4::new(&disks);
+            let al = block.local(&a);
+            let pair = block.segment_bounds2_pair(&al, [&b0, &b1]);
+            assert!(
+                same(block.segment_bounds2(&al, &b0), &pair[..4]),
+                "case {case}"
+            );
+            assert!(
+                same(block.segment_bounds2(&al, &b1), &pair[4..]),
+                "case {case}"
+            );
+        }
     }
 
     /// The same cases through a leaf block in its own frame: lower bounds at offsets up to
