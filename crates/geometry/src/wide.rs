@@ -186,9 +186,10 @@ fn halves(x: f32, y: f32) -> f32x8 {
 
 impl Disk4 {
     /// [`Self::segment_bounds2`] of two segments from one start `a` to `b[0]` and `b[1]`
-    /// (the two half-edges of a cable node; `pad` per segment) in eight lanes: 0–3 the first
-    /// segment, 4–7 the second, each lane the same float32 operations in the same order as the four-lane
-    /// version (the same values; the `wide` crate's 8-lane vectors, AVX where built with it).
+    /// (the two half-edges of a cable node; `pad` per segment) in eight lanes: 0–3 the
+    /// first segment, 4–7 the second, each lane the same float32 operations in the same
+    /// order as the four-lane version, so the same values (the `wide` crate's 8-lane
+    /// vectors: AVX where built with it, two SSE halves otherwise).
     #[inline(always)]
     pub fn segment_bounds2_pair(&self, a: &[f32; 3], b: &[[f32; 3]; 2], pad: [f32; 2]) -> [f32; 8] {
         let zero = f32x8::ZERO;
