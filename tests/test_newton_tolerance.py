@@ -173,12 +173,12 @@ def harness_run(d: dict, tolerance: float | None, dt: float = 0.001):
 
 
 def test_the_learnt_predictor_saves_iterations_within_the_error_rule():
-    # The accelerations' predictor fits a linear recursion of order two to the past
-    # accelerations (crate::predictor): on the harness shaken by the engine PSD the iterations
-    # per step fall from 2.44 (constant acceleration) to 2.01 over 0.5 s (2.36 → 2.00 over
-    # 1 s); the stopping rule on the estimated remaining error (crate::contraction, session
-    # 17) takes them to 1.64, the recursion of order 6 (session 17) to 1.24. The iteration
-    # error stays below the time error.
+    # The accelerations' predictor fits a linear recursion to the past accelerations
+    # (crate::predictor; of order two in session 16): on the harness shaken by the engine PSD
+    # the iterations per step fall from 2.44 (constant acceleration) to 2.01 over 0.5 s (2.36
+    # → 2.00 over 1 s); the stopping rule on the estimated remaining error
+    # (crate::contraction, session 17) takes them to 1.64, the recursion of order 6 (session
+    # 17) to 1.24. The iteration error stays below the time error.
     d = engine_harness(0.5)
     default, tight = harness_run(d, None), harness_run(d, 1e-9)
     fine = harness_run(d, 1e-9, 0.00025)

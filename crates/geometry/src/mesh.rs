@@ -512,19 +512,12 @@ impl TriMesh {
         max_distance: f64,
         hint: usize,
     ) -> Option<(f64, usize, usize)> {
-        const MAX_ENDS: usize = 4;
-        assert!(ends.len() <= MAX_ENDS, "at most {MAX_ENDS} segments");
+        assert!(ends.len() <= 2, "at most two segments");
+        if ends.is_empty() {
+            return None;
+        }
         let mut best_d2 = max_distance * max_distance;
         let mut best: Option<(usize, usize)> = None;
-        // per segment: box, midpoint, half length
-        let mut seg = [(V3::zeros(), V3::zeros(), V3::zeros(), 0.0); MAX_ENDS];
-        let (mut vlo, mut vhi) = (*a, *a);
-        for (j, b) in ends.iter().enumerate() {
-            seg[j] = (a.inf(b), a.sup(b), (a + b) * 0.5, (b - a).norm() * 0.5);
-            vlo = vlo.inf(b);
-            vhi = vhi.sup(b);
-        }
-        let seg = &seg[..ends.len()];
         let check = |t: usize, best_d2: &mut f64, best: &mut Option<(usize, usize)>| {
             let [p, q, r] = &self.triangles[t];
             for (j, b) in ends.iter().enumerate() {
@@ -542,20 +535,17 @@ impl TriMesh {
         if hint < self.triangles.len() {
             check(hint, &mut best_d2, &mut best);
         }
-        // the wide tree: per visit and segment four float32 boxes and slab-and-ball bounds, a
-        // lane's bound the least over the segments; leaves nearest first (per triangle and
-        // segment the float32 plane-and-disk bound, the float64 one, then the exact
-        // distance), inner lanes pushed farthest first
+        // the wide tree: per visit eight float32 lanes, the four boxes and slab-and-ball
+        // bounds for each segment (one segment: taken twice, its lanes then equal), a lane's
+        // bound the least over the segments; leaves nearest first (per triangle and segment
+        // the float32 plane-and-disk bound, the float64 one, then the exact distance), inner
+        // lanes pushed farthest first
         let scale = ends.iter().fold(a.amax(), |m, b| m.max(b.amax()));
         let pad = wide::pad(scale.max(self.scale));
         let af = f32x3(a);
-        let mut bf = [[0f32; 3]; MAX_ENDS];
-        let mut qs = [Rounded::new(a, a); MAX_ENDS];
-        for j in 0..ends.len() {
-            bf[j] = f32x3(&ends[j]);
-            qs[j] = Rounded::new(&seg[j].0, &seg[j].1);
-        }
-        let (bf, qs) = (&bf[..ends.len()], &qs[..ends.len()]);
+        let pair = [&ends[0], &ends[ends.len() - 1]];
+        let bf = pair.map(f32x3);
+        let qs = pair.map(|b| Rounded::new(&a.inf(b), &a.sup(b)));
         let mut stack = [(0u32, 0f32); STACK];
         let mut top = 1;
         while top > 0 {
@@ -565,23 +555,10 @@ impl TriMesh {
                 continue;
             }
             let wn = &self.wide[w as usize];
-            let mut g = [f32::INFINITY; 4];
-            if let (&[q0, q1], &[b0, b1]) = (qs, bf) {
-                // the two half-edges of a node: eight lanes at once (the same values)
-                let gb = wn.gaps2_pair(&[q0, q1]);
-                let gd = wn.disk.segment_bounds2_pair(&af, &[b0, b1], [pad, pad]);
-                for l in 0..4 {
-                    g[l] = gb[l].max(gd[l]).min(gb[l + 4].max(gd[l + 4]));
-                }
-            } else {
-                for (q, b) in qs.iter().zip(bf) {
-                    let gb = wn.gaps2(q);
-                    let gd = wn.disk.segment_bounds2(&af, b, pad);
-                    for l in 0..4 {
-                        g[l] = g[l].min(gb[l].max(gd[l]));
-                    }
-                }
-            }
+            let gb = wn.gaps2_pair(&qs);
+            let gd = wn.disk.segment_bounds2_pair(&af, &bf, [pad, pad]);
+            let g: [f32; 4] =
+                std::array::from_fn(|l| gb[l].max(gd[l]).min(gb[l + 4].max(gd[l + 4])));
             let order = wide::order(&g);
             for &l in &order {
                 if lower(g[l]) > best_d2 {
@@ -592,24 +569,15 @@ impl TriMesh {
                 }
                 let node = &self.nodes[wn.node[l] as usize];
                 let block = &self.blocks[(wn.wide[l] & !LEAF) as usize];
-                let mut tb = [[0f32; 4]; MAX_ENDS];
-                let al = block.local(a);
-                if let &[b0, b1] = &ends {
-                    let t = block.segment_bounds2_pair(&al, [b0, b1]);
-                    tb[0].copy_from_slice(&t[..4]);
-                    tb[1].copy_from_slice(&t[4..]);
-                } else {
-                    for (j, b) in ends.iter().enumerate() {
-                        tb[j] = block.segment_bounds2(&al, b);
-                    }
-                }
+                // per segment j its four lanes: tb[4 j + i] for triangle i
+                let tb = block.segment_bounds2_pair(&block.local(a), pair);
                 let start = node.index as usize;
-                #[allow(clippy::needless_range_loop)] // tb is per segment, then lane
                 for i in 0..node.count as usize {
                     let t = start + i;
                     let [p, q, r] = &self.triangles[t];
                     for (j, b) in ends.iter().enumerate() {
-                        if lower(tb[j][i]) > best_d2 || self.segment_excluded(t, a, b, best_d2) {
+                        if lower(tb[4 * j + i]) > best_d2 || self.segment_excluded(t, a, b, best_d2)
+                        {
                             continue;
                         }
                         let (_, x, y) = segment_triangle(a, b, p, q, r);

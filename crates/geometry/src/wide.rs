@@ -135,8 +135,9 @@ impl Disk4 {
 
     /// Lower bounds of the squared distances of segment [a, b] (float32) to the four sets:
     /// the least axial gap over the segment and the least in-plane offset of the projected
-    /// segment beyond the radius, taken apart.
-    #[inline(always)]
+    /// segment beyond the radius, taken apart. The scalar reference of
+    /// [`Self::segment_bounds2_pair`], which the queries use (tests).
+    #[cfg(test)]
     pub fn segment_bounds2(&self, a: &[f32; 3], b: &[f32; 3], pad: f32) -> [f32; 4] {
         let d = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
         let mut out = [0.0f32; 4];
@@ -185,11 +186,13 @@ fn halves(x: f32, y: f32) -> f32x8 {
 }
 
 impl Disk4 {
-    /// [`Self::segment_bounds2`] of two segments from one start `a` to `b[0]` and `b[1]`
-    /// (the two half-edges of a cable node; `pad` per segment) in eight lanes: 0–3 the
-    /// first segment, 4–7 the second, each lane the same float32 operations in the same
-    /// order as the four-lane version, so the same values (the `wide` crate's 8-lane
-    /// vectors: AVX where built with it, two SSE halves otherwise).
+    /// Lower bounds of the squared distances of two segments from one start `a` to `b[0]` and
+    /// `b[1]` (the two half-edges of a cable node; one segment: given twice) to the four
+    /// sets, `pad` per segment: the least axial gap over the segment and the least in-plane
+    /// offset of the projected segment beyond the radius, taken apart. Eight lanes: 0–3 the
+    /// first segment, 4–7 the second (the `wide` crate's 8-lane vectors: AVX where built with
+    /// it, two SSE halves otherwise); each lane the float32 operations of the scalar
+    /// reference `segment_bounds2` (tests) in the same order, so the same values.
     #[inline(always)]
     pub fn segment_bounds2_pair(&self, a: &[f32; 3], b: &[[f32; 3]; 2], pad: [f32; 2]) -> [f32; 8] {
         let zero = f32x8::ZERO;
@@ -287,8 +290,8 @@ impl Block4 {
         self.disk.point_bounds2(&q, local_pad(m))
     }
 
-    /// [`Self::segment_bounds2`] of the two segments from `a` to `b[0]` and `b[1]` in eight
-    /// lanes ([`Disk4::segment_bounds2_pair`]; the same values).
+    /// [`Disk4::segment_bounds2_pair`] of the two segments from `a` (given by
+    /// [`Self::local`]) to the global points `b[0]` and `b[1]`.
     #[inline(always)]
     pub fn segment_bounds2_pair(&self, (a, ma): &([f32; 3], f64), b: [&V3; 2]) -> [f32; 8] {
         let ((q0, m0), (q1, m1)) = (self.local(b[0]), self.local(b[1]));
@@ -296,9 +299,8 @@ impl Block4 {
         self.disk.segment_bounds2_pair(a, &[q0, q1], pad)
     }
 
-    /// [`Disk4::segment_bounds2`] of the segment from `a` (given by [`Self::local`]) to the
-    /// global point b.
-    #[inline(always)]
+    /// The scalar reference of [`Self::segment_bounds2_pair`] for one segment (tests).
+    #[cfg(test)]
     pub fn segment_bounds2(&self, (a, ma): &([f32; 3], f64), b: &V3) -> [f32; 4] {
         let (q, mb) = self.local(b);
         self.disk.segment_bounds2(a, &q, local_pad(ma.max(mb)))
@@ -730,7 +732,7 @@ mod tests {
             let exact_s = (sx - sy).norm_squared();
             let (pf, bf) = (f32x3(&p), f32x3(&b));
             let gp = disk.point_bounds2(&pf, pad(scale))[0];
-            let gs = disk.segment_bounds2(&pf, &bf, pad(scale))[0];
+            let gs = disk.segment_bounds2_pair(&pf, &[bf, bf], [pad(scale); 2])[0];
             assert!(
                 lower(gp) <= exact_p,
                 "point, case {case}: {} > {exact_p}",
@@ -742,7 +744,7 @@ mod tests {
                 lower(gs)
             );
             let gp0 = disk.point_bounds2(&pf, 0.0)[0];
-            let gs0 = disk.segment_bounds2(&pf, &bf, 0.0)[0];
+            let gs0 = disk.segment_bounds2_pair(&pf, &[bf, bf], [0.0; 2])[0];
             if lower(gp0) > exact_p || lower(gs0) > exact_s {
                 over_without_pad += 1;
             }
@@ -854,7 +856,7 @@ mod tests {
                 let (_, sx, sy) = segment_triangle(&p, &b, &t[0], &t[1], &t[2]);
                 let exact_s = (sx - sy).norm_squared();
                 let gp = block.point_bounds2(&p)[k];
-                let gs = block.segment_bounds2(&block.local(&p), &b)[k];
+                let gs = block.segment_bounds2_pair(&block.local(&p), [&b, &b])[k];
                 assert!(lower(gp) <= exact_p, "point, case {case}, lane {k}");
                 assert!(lower(gs) <= exact_s, "segment, case {case}, lane {k}");
             }

@@ -571,8 +571,9 @@ impl Dynamics {
         self.ghost_n.clone_from(&st.ghost);
         self.pose_n.clone_from(&st.clip_pose);
         self.v_n.clone_from(&self.rates.v);
-        // v̇_n into vdot_n, and the predictor (below): v̇_{n+1} = (1 + μ) v̇_n + λ (v̇_n −
-        // v̇_{n−1}) on the inertial slots, μ, λ fitted to the accepted steps (crate::predictor)
+        // v̇_n into vdot_n, and the predictor (below): v̇_{n+1} from a linear recursion on the
+        // past accelerations of the inertial slots, fitted to the accepted steps
+        // (crate::predictor)
         let restarted = self.restarted;
         self.extrapolation.begin_step(
             &mut self.vdot,
@@ -610,8 +611,8 @@ impl Dynamics {
         self.poses.extend(clips.iter().map(|m| m.pose));
         st.set_clip_poses(rod, &self.poses);
         self.prescribe_rates(rod, st, clips);
-        // Predictor: the recursion fitted to the run (crate::predictor, above; μ = λ = 0 is
-        // constant acceleration). docs/dynamics.md, "Predictor": constant acceleration took
+        // Predictor: the recursion fitted to the run (crate::predictor, above; all coefficients
+        // zero is constant acceleration). docs/dynamics.md, "Predictor": constant acceleration took
         // 2.70 → 2.04 iterations per step on bench_harness.py's cable, 4.45 → 4.32 on
         // bench_dynamic.py, against the former constant-velocity predictor Δq = v_n; the
         // fitted recursion 2.36 → 2.00 on bench_harness.py's harness. The first step after a (re)start takes
