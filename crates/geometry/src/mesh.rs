@@ -479,9 +479,11 @@ impl TriMesh {
             }
             let wn = &self.wide[w as usize];
             let mut g = wn.gaps2(&q);
-            let gd = wn.disk.point_bounds2(&pf, pad);
-            for l in 0..4 {
-                g[l] = g[l].max(gd[l]);
+            if wn.has_disk() {
+                let gd = wn.disk.point_bounds2(&pf, pad);
+                for l in 0..4 {
+                    g[l] = g[l].max(gd[l]);
+                }
             }
             let order = wide::order(&g);
             for &l in &order {
@@ -577,11 +579,14 @@ impl TriMesh {
             }
             let wn = &self.wide[w as usize];
             let gb = wn.gaps2_pair(&qs);
-            let gd = wn
-                .disk
-                .segment_bounds2_pair(&af, &bf, [pad, pad], f32::INFINITY);
-            let g: [f32; 4] =
-                std::array::from_fn(|l| gb[l].max(gd[l]).min(gb[l + 4].max(gd[l + 4])));
+            let g: [f32; 4] = if wn.has_disk() {
+                let gd = wn
+                    .disk
+                    .segment_bounds2_pair(&af, &bf, [pad, pad], f32::INFINITY);
+                std::array::from_fn(|l| gb[l].max(gd[l]).min(gb[l + 4].max(gd[l + 4])))
+            } else {
+                std::array::from_fn(|l| gb[l].min(gb[l + 4]))
+            };
             let order = wide::order(&g);
             for &l in &order {
                 if lower(g[l]) > best_d2 {

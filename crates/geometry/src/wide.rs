@@ -57,6 +57,15 @@ pub(crate) struct Wide {
     pub disk: Disk4,
 }
 
+impl Wide {
+    /// Whether a lane has a slab and ball (nodes of up to `SLAB_MAX` triangles, near the
+    /// leaves): the boxes alone bound the others, so their disk bounds are not computed.
+    #[inline(always)]
+    pub fn has_disk(&self) -> bool {
+        self.disk.radius != [f32::INFINITY; 4]
+    }
+}
+
 /// Flag of a leaf lane in [`Wide::wide`].
 pub(crate) const LEAF: u32 = 1 << 31;
 
