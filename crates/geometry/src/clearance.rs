@@ -419,9 +419,10 @@ mod tests {
         let mut positions = vec![];
         for t in 0..steps {
             for i in 0..nodes {
-                let s = t as f64 * 1e-5;
+                // ~0.005 % of the distance per step: candidate sets kept over steps
+                let s = t as f64 * 1e-6;
                 let (x, y) = (0.1 + 0.1 * i as f64 + s, 0.4 + 0.03 * i as f64 - s);
-                let mut p = V3::new(x, y, h(x, y) + 0.04 + 2e-4 * (t as f64 * 0.1).sin());
+                let mut p = V3::new(x, y, h(x, y) + 0.04 + 2e-5 * (t as f64 * 0.1).sin());
                 if i == 3 && t == 120 {
                     p.z += 0.5;
                 }

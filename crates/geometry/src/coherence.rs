@@ -14,9 +14,13 @@
 //! lasts several steps of steady motion. The set grows with d·margin (more so under a
 //! concave surface), the hierarchy's work with d alone: where that margin exceeds
 //! `SKIN_OF_DISTANCE` of the distance, the query goes to the hierarchy (warm-started) and
-//! no set is kept. Measured on the clearance benchmark (docs/environment.md): nodes moving
-//! 0.04 % of their distance per step take a third of the time, at 0.2 % it is even, at 2 %
-//! (the benchmark's 60 Hz motion) every query goes to the hierarchy. Where many triangles
+//! no set is kept. Measured on the clearance benchmark's case (`clearance_profile -- 707 1000
+//! DT`, one thread), after the hierarchy's bounds were tightened (session 19): with saved
+//! steps 3 µs apart (nodes moving ~0.006 % of their distance per step) 0.165 s instead of
+//! 0.244 s, at 10 µs 0.228 s instead of 0.242 s; from 30 µs (~0.06 %) on the sets no longer
+//! pay, and a margin of 1 % of the distance (as before) made 100 µs 54 % slower: so sets only
+//! where the margin is within 0.2 % of the distance. At the benchmark's 1 ms (2 % per step,
+//! 60 Hz motion) every query goes to the hierarchy. Where many triangles
 //! are nearly equally far (near the axis of a ring, under a concave surface) a set is long
 //! even for a small margin: a set longer than `MAX_SET` halves the node's margin (in steps),
 //! below `MIN_SKIN` steps the hierarchy answers and the margin grows back slowly.
@@ -32,7 +36,7 @@ const MAX_SET: usize = 96;
 const MIN_SKIN: f64 = 2.0;
 const REGROW: f64 = 1.02;
 /// A set only where the margin is at most this fraction of the distance.
-const SKIN_OF_DISTANCE: f64 = 0.01;
+const SKIN_OF_DISTANCE: f64 = 0.002;
 
 /// Candidate triangles of one query (a node, or its half-edges) on one mesh.
 #[derive(Clone, Debug)]
@@ -235,11 +239,11 @@ mod tests {
         // surface (distance 0: the margin falls to 0, the hierarchy answers)
         let n = 5;
         let node = |t: usize, i: usize| {
-            let s = t as f64 * 2e-5;
+            let s = t as f64 * 2e-6;
             let mut p = V3::new(
                 0.2 + 0.12 * i as f64 + s,
                 0.3 + 0.05 * i as f64 + 0.5 * s,
-                0.03 + 0.01 * i as f64 + 0.3 * (0.7 * s * 1e3).sin() * 1e-3,
+                0.03 + 0.01 * i as f64 + 0.3 * (0.7 * s * 1e4).sin() * 1e-4,
             );
             if i == 2 && t == 40 {
                 p += V3::new(0.3, -0.1, 0.05);
@@ -329,9 +333,9 @@ mod tests {
                 .map(|i| {
                     let w = 0.3 + 0.2 * i as f64;
                     V3::new(
-                        2e-3 * (w * s * 0.05).sin(),
-                        0.03 + 0.02 * i as f64 + 1e-5 * s,
-                        -4e-3 + 2e-3 * (w * s * 0.037).cos(),
+                        2e-3 * (w * s * 0.01).sin(),
+                        0.03 + 0.02 * i as f64 + 1e-6 * s,
+                        -4e-3 + 2e-3 * (w * s * 0.0074).cos(),
                     )
                 })
                 .collect();
