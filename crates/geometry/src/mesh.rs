@@ -498,7 +498,7 @@ impl TriMesh {
                 let start = node.index as usize;
                 for (i, b) in tb.iter().enumerate().take(node.count as usize) {
                     let t = start + i;
-                    if lower(*b) > best_d2 || self.point_lower2(t, p) > best_d2 {
+                    if lower(*b) > best_d2 {
                         continue;
                     }
                     let [a, b, c] = &self.triangles[t];
