@@ -498,8 +498,8 @@ impl TriMesh {
                 let start = node.index as usize;
                 for (i, b) in tb.iter().enumerate().take(node.count as usize) {
                     let t = start + i;
-                    if lower(*b) > best_d2 {
-                        continue;
+                    if lower(*b) > best_d2 || t == hint {
+                        continue; // (the hint: measured first)
                     }
                     let [a, b, c] = &self.triangles[t];
                     let (cp, _) = point_triangle(p, a, b, c);
@@ -602,6 +602,9 @@ impl TriMesh {
                 let start = node.index as usize;
                 for i in 0..node.count as usize {
                     let t = start + i;
+                    if t == hint {
+                        continue; // measured first
+                    }
                     let [p, q, r] = &self.triangles[t];
                     for (j, b) in ends.iter().enumerate() {
                         if lower(tb[4 * j + i]) > best_d2 {
