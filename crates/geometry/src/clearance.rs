@@ -20,7 +20,7 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use nalgebra::Matrix3;
 use rayon::prelude::*;
 
-use crate::{Candidates, Shape, Surface, V3};
+use crate::{Shape, Surface, V3};
 
 /// Takes global points into a body's reference frame at one step: X = m x + v.
 #[derive(Clone, Copy, Debug)]
@@ -132,8 +132,6 @@ pub fn clearance(
             let first = k * chunk_steps;
             // per node and part: the feature nearest to the node, to its two half-edges
             let mut hints = vec![usize::MAX; 3 * n_nodes * parts.len()];
-            // per node and mesh part: candidate sets of the node and of its half-edges
-            let mut sets = vec![(Candidates::new(), Candidates::new()); n_nodes * parts.len()];
             let mut dist = vec![f64::INFINITY; parts.len()];
             // per node and part: a lower bound of the node's distance while it is outside a
             // closed mesh (0: none) and where it held
@@ -166,7 +164,6 @@ pub fn clearance(
                         n_nodes,
                         radius,
                         &mut hints,
-                        &mut sets,
                         &mut outside,
                         &mut dist,
                         &mut val[row.clone()],
@@ -207,7 +204,6 @@ fn node_clearance(
     n: usize,
     radius: f64,
     hints: &mut [usize],
-    sets: &mut [(Candidates, Candidates)],
     outside: &mut [(f64, V3)],
     dist: &mut [f64],
     value: &mut [f64],
@@ -235,10 +231,7 @@ fn node_clearance(
             }
             out.0 = 0.0;
         }
-        let found = match &pt.shape {
-            Shape::Mesh(mesh) => sets[i * n_parts + k].0.project_point(mesh, x, *h),
-            shape => shape.project_point(x, f64::INFINITY, *h),
-        };
+        let found = pt.shape.project_point(x, f64::INFINITY, *h);
         if let Some(r) = found {
             *h = r.feature;
             dist[k] = r.distance;
@@ -273,27 +266,17 @@ fn node_clearance(
                 m += 1;
             }
             if let Shape::Mesh(mesh) = &pt.shape {
-                // both half-edges in one traversal; warm start: the triangle nearest to
-                // them at the previous step, else the node's
-                // (all of the node's half-edges: the candidate set is theirs)
+                // the half-edges in one traversal; warm start: the triangle nearest to them
+                // at the previous step, else the node's
                 let out = &mut outside[i * n_parts + k];
                 if m == 0 {
                     continue;
-                }
-                let mut all = [V3::zeros(); 2];
-                let mut m = 0;
-                for nb in [i.wrapping_sub(1), i + 1] {
-                    if nb < n {
-                        all[m] = (x + local[base + nb]) * 0.5;
-                        m += 1;
-                    }
                 }
                 let h = match hints[at + 1] {
                     usize::MAX => hints[at],
                     h => h,
                 };
-                let set = &mut sets[i * n_parts + k].1;
-                let found = set.nearest_of_segments(mesh, x, &all[..m], best, h);
+                let found = mesh.nearest_of_segments(x, &ends[..m], best, h);
                 if out.0 > 0.0 {
                     // the node is at least as far as its half-edges (beyond the bound
                     // when none came within it)
@@ -405,9 +388,9 @@ mod tests {
 
     #[test]
     fn coherent_steps_equal_cold_steps() {
-        // a slowly moving cable over a bumpy mesh (candidate sets kept over steps), with one
-        // node jumping far at one step: every step equals the step computed alone (cold: no
-        // warm start, no set)
+        // a slowly moving cable over a bumpy mesh (warm starts from the previous step), with
+        // one node jumping far at one step: every step equals the step computed alone (cold:
+        // no warm start)
         use crate::TriMesh;
         let h = |x: f64, y: f64| 0.05 * (x * 7.0).sin() * (y * 5.0).cos();
         let (v, f) = crate::height_field(30, h);
@@ -419,7 +402,6 @@ mod tests {
         let mut positions = vec![];
         for t in 0..steps {
             for i in 0..nodes {
-                // ~0.005 % of the distance per step: candidate sets kept over steps
                 let s = t as f64 * 1e-6;
                 let (x, y) = (0.1 + 0.1 * i as f64 + s, 0.4 + 0.03 * i as f64 - s);
                 let mut p = V3::new(x, y, h(x, y) + 0.04 + 2e-5 * (t as f64 * 0.1).sin());

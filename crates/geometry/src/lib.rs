@@ -16,7 +16,6 @@
 
 pub mod clearance;
 pub mod closest;
-pub mod coherence;
 pub mod mesh;
 pub mod primitives;
 pub mod weld;
@@ -27,7 +26,6 @@ use nalgebra::Vector3;
 pub type V3 = Vector3<f64>;
 
 pub use clearance::{clearance, Clearance, ClearanceError, Control, Part, RigidMap};
-pub use coherence::Candidates;
 pub use mesh::{MeshError, TriMesh};
 pub use primitives::{Cuboid, Cylinder, HalfSpace, Sphere};
 pub use weld::weld_vertices;
