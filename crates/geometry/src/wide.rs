@@ -746,6 +746,19 @@ mod tests {
         (p, b)
     }
 
+    /// `k` triangles of [`random_triangle`] and their disks ([`triangle_disk`]).
+    #[allow(clippy::type_complexity)]
+    fn random_triangles(
+        k: usize,
+        rnd: &mut impl FnMut() -> f64,
+        size: f64,
+        off: V3,
+    ) -> (Vec<Vec<V3>>, Vec<(V3, f64, f64, V3, f64)>) {
+        let tris: Vec<Vec<V3>> = (0..k).map(|_| random_triangle(rnd, size, off)).collect();
+        let disks = tris.iter().map(|v| triangle_disk(v)).collect();
+        (tris, disks)
+    }
+
     /// A triangle with corners uniform in the cube of side `size` at `off`.
     fn random_triangle(rnd: &mut impl FnMut() -> f64, size: f64, off: V3) -> Vec<V3> {
         (0..3)
@@ -814,12 +827,16 @@ mod tests {
         let mut rnd = crate::test_random(17);
         let same =
             |x: [f32; 4], y: &[f32]| x.iter().zip(y).all(|(p, q)| p.to_bits() == q.to_bits());
+        // a pair's lanes are each segment's own (that segment given twice: both halves equal)
+        let own = |pair: &[f32; 8], one: &[f32; 8], other: &[f32; 8]| {
+            let half = |x: &[f32]| -> [f32; 4] { x.try_into().unwrap() };
+            same(half(&one[..4]), &pair[..4])
+                && same(half(&other[4..]), &pair[4..])
+                && same(half(&one[..4]), &one[4..])
+        };
         for case in 0..5000 {
             let (size, off) = case_scale(&mut rnd, case);
-            let tris: Vec<Vec<V3>> = (0..3)
-                .map(|_| random_triangle(&mut rnd, size, off))
-                .collect();
-            let disks: Vec<_> = tris.iter().map(|v| triangle_disk(v)).collect();
+            let (tris, disks) = random_triangles(3, &mut rnd, size, off);
             // a disk lane per triangle, lane 3 empty (NONE), as wide nodes and leaves have
             let mut disk = Disk4::NONE;
             for (l, (n, x, _, c, r)) in disks.iter().enumerate() {
@@ -838,15 +855,7 @@ mod tests {
                 let pair = disk.segment_bounds2_pair(&af, &[b0f, b1f], [p0, p1], best);
                 let one = disk.segment_bounds2_pair(&af, &[b0f, b0f], [p0, p0], best);
                 let other = disk.segment_bounds2_pair(&af, &[b1f, b1f], [p1, p1], best);
-                assert!(
-                    same(one[..4].try_into().unwrap(), &pair[..4]),
-                    "case {case}"
-                );
-                assert!(
-                    same(other[4..].try_into().unwrap(), &pair[4..]),
-                    "case {case}"
-                );
-                assert!(same(one[..4].try_into().unwrap(), &one[4..]), "case {case}");
+                assert!(own(&pair, &one, &other), "case {case}");
             }
             // boxes: a node's four lanes (the last empty) against the two segments' boxes
             let mut w = Wide::EMPTY;
@@ -874,14 +883,7 @@ mod tests {
             let pair = block.segment_bounds2_pair(&al, [&b0, &b1], best);
             let one = block.segment_bounds2_pair(&al, [&b0, &b0], best);
             let other = block.segment_bounds2_pair(&al, [&b1, &b1], best);
-            assert!(
-                same(one[..4].try_into().unwrap(), &pair[..4]),
-                "case {case}"
-            );
-            assert!(
-                same(other[4..].try_into().unwrap(), &pair[4..]),
-                "case {case}"
-            );
+            assert!(own(&pair, &one, &other), "case {case}");
         }
     }
 
@@ -900,10 +902,7 @@ mod tests {
         let (mut staged, mut by_float64) = (0, 0);
         for case in 0..30000 {
             let (size, off) = case_scale(&mut rnd, case);
-            let tris: Vec<Vec<V3>> = (0..4)
-                .map(|_| random_triangle(&mut rnd, size, off))
-                .collect();
-            let disks: Vec<_> = tris.iter().map(|v| triangle_disk(v)).collect();
+            let (tris, disks) = random_triangles(4, &mut rnd, size, off);
             let block = Block4::new(&disks);
             let (n, ..) = disks[0];
             let far = case % 3 == 1;
