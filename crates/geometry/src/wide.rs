@@ -195,8 +195,7 @@ impl Disk4 {
         let e: [f32x8; 3] = std::array::from_fn(|k| d[k] - n[k] * xd);
         let l2 = e[0] * e[0] + e[1] * e[1] + e[2] * e[2];
         let pe = pu[0] * e[0] + pu[1] * e[1] + pu[2] * e[2];
-        // l2 = 0 (e = 0, so pe = 0): 0/0 is NaN, and max(NaN, 0) = 0 in `wide` as in the
-        // four-lane version's branch
+        // l2 = 0 (e = 0, so pe = 0): 0/0 is NaN, and max(NaN, 0) = 0 in `wide` (the start)
         let s0 = -pe / l2;
         let s = s0.max(zero).min(f32x8::ONE);
         let q: [f32x8; 3] = std::array::from_fn(|k| pu[k] + e[k] * s);
@@ -262,7 +261,7 @@ impl Disk4 {
         let s1 = (s0 - delta).max(zero);
         let s2 = (s0 + delta).min(f32x8::ONE);
         let (x1, x2) = (xa + xd * s1, xa + xd * s2);
-        let gi = ((twice(&self.lo) - x1.max(x2)).max(x1.min(x2) - twice(&self.hi)) - pad).max(zero);
+        let gi = ((lo - x1.max(x2)).max(x1.min(x2) - hi) - pad).max(zero);
         let dd = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
         let staged = l2.simd_gt(dd * f32x8::splat(1e-4))
             & disc.simd_ge(zero)
