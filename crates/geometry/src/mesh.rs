@@ -291,45 +291,53 @@ impl TriMesh {
             }
             normals.push(n / len);
         }
-        // vertex pseudo-normals: incident face normals weighted by the incident angle
-        let mut vertex_normals = vec![V3::zeros(); vertices.len()];
-        for (f, n) in faces.iter().zip(&normals) {
-            for k in 0..3 {
-                let p = vertices[f[k] as usize];
-                let u = vertices[f[(k + 1) % 3] as usize] - p;
-                let w = vertices[f[(k + 2) % 3] as usize] - p;
-                let angle = u.angle(&w);
-                vertex_normals[f[k] as usize] += n * angle;
+        // the pseudo-normals (for the sign: vertices, then edges, largely serial) beside the
+        // hierarchy over the triangle centroids (parallel): independent work, joined
+        let pseudo_normals = || {
+            // vertex pseudo-normals: incident face normals weighted by the incident angle
+            let mut vertex_normals = vec![V3::zeros(); vertices.len()];
+            for (f, n) in faces.iter().zip(&normals) {
+                for k in 0..3 {
+                    let p = vertices[f[k] as usize];
+                    let u = vertices[f[(k + 1) % 3] as usize] - p;
+                    let w = vertices[f[(k + 2) % 3] as usize] - p;
+                    let angle = u.angle(&w);
+                    vertex_normals[f[k] as usize] += n * angle;
+                }
             }
-        }
-        // edge pseudo-normals: sum of the normals of the faces sharing the edge, and whether the
-        // mesh is closed and consistently oriented: every edge in two faces, once in each
-        // direction
-        let (edge_of, closed) = edge_normals(vertices.len(), faces, &normals);
-        // hierarchy over the triangle centroids
-        let mut items: Vec<(V3, u32)> = faces
-            .par_iter()
-            .enumerate()
-            .map(|(i, f)| {
-                let c = f.iter().fold(V3::zeros(), |s, &k| s + vertices[k as usize]) / 3.0;
-                (c, i as u32)
-            })
-            .collect();
-        let boxes: Vec<(V3, V3)> = faces
-            .par_iter()
-            .map(|f| {
-                let [a, b, c] = f.map(|k| vertices[k as usize]);
-                (a.inf(&b).inf(&c), a.sup(&b).sup(&c))
-            })
-            .collect();
-        let ctx = BuildData {
-            boxes: &boxes,
-            vertices,
-            faces,
-            normals: &normals,
+            // edge pseudo-normals: sum of the normals of the faces sharing the edge, and
+            // whether the mesh is closed and consistently oriented: every edge in two faces,
+            // once in each direction
+            (vertex_normals, edge_normals(vertices.len(), faces, &normals))
         };
-        let mut nodes = vec![Node::EMPTY; tree_size(items.len())];
-        build(&mut items, 0, 0, &mut nodes, &ctx);
+        let hierarchy = || {
+            let mut items: Vec<(V3, u32)> = faces
+                .par_iter()
+                .enumerate()
+                .map(|(i, f)| {
+                    let c = f.iter().fold(V3::zeros(), |s, &k| s + vertices[k as usize]) / 3.0;
+                    (c, i as u32)
+                })
+                .collect();
+            let boxes: Vec<(V3, V3)> = faces
+                .par_iter()
+                .map(|f| {
+                    let [a, b, c] = f.map(|k| vertices[k as usize]);
+                    (a.inf(&b).inf(&c), a.sup(&b).sup(&c))
+                })
+                .collect();
+            let ctx = BuildData {
+                boxes: &boxes,
+                vertices,
+                faces,
+                normals: &normals,
+            };
+            let mut nodes = vec![Node::EMPTY; tree_size(items.len())];
+            build(&mut items, 0, 0, &mut nodes, &ctx);
+            (items, nodes)
+        };
+        let ((vertex_normals, (edge_of, closed)), (items, nodes)) =
+            rayon::join(pseudo_normals, hierarchy);
         // the per-triangle arrays in hierarchy order (parallel gathers)
         let order: Vec<usize> = items.par_iter().map(|&(_, i)| i as usize).collect();
         let triangles = order
