@@ -213,7 +213,6 @@ pub struct TriMesh {
     face_normals: Vec<V3>,
     /// Bounding sphere (centroid, radius) of each triangle: a cheap, tight lower bound of its
     /// distance to a segment.
-    spheres: Vec<(V3, f64)>,
     edge_normals: Vec<[V3; 3]>,
     vertex_normals: Vec<V3>,
     nodes: Vec<Node>,
@@ -229,7 +228,7 @@ pub struct TriMesh {
 
 struct BinaryView<'a> {
     nodes: &'a [Node],
-    spheres: &'a [(V3, f64)],
+    triangles: &'a [[V3; 3]],
     normals: &'a [V3],
 }
 
@@ -257,7 +256,7 @@ impl wide::Binary for BinaryView<'_> {
             .then_some((n.axis, n.lo, n.hi, n.center, n.radius))
     }
     fn disk(&self, t: usize) -> (V3, f64, f64, V3, f64) {
-        let (c, r) = self.spheres[t];
+        let (c, r) = triangle_sphere(&self.triangles[t]);
         let n = self.normals[t];
         let x = n.dot(&c);
         (n, x, x, c, r)
@@ -340,12 +339,11 @@ impl TriMesh {
             rayon::join(pseudo_normals, hierarchy);
         // the per-triangle arrays in hierarchy order (parallel gathers)
         let order: Vec<usize> = items.par_iter().map(|&(_, i)| i as usize).collect();
-        let triangles = order
+        let triangles: Vec<[V3; 3]> = order
             .par_iter()
             .map(|&i| faces[i].map(|k| vertices[k as usize]))
             .collect();
         let corners = order.par_iter().map(|&i| faces[i]).collect();
-        let spheres = triangles_spheres(&order, faces, vertices);
         let face_normals: Vec<V3> = order.par_iter().map(|&i| normals[i]).collect();
         let edge_normals = order
             .par_iter()
@@ -353,7 +351,7 @@ impl TriMesh {
             .collect();
         let view = BinaryView {
             nodes: &nodes,
-            spheres: &spheres,
+            triangles: &triangles,
             normals: &face_normals,
         };
         let (wide, blocks) = wide::collapse(&view, 0);
@@ -362,7 +360,6 @@ impl TriMesh {
             triangles,
             corners,
             face_normals,
-            spheres,
             edge_normals,
             vertex_normals,
             nodes,
@@ -412,9 +409,8 @@ impl TriMesh {
     /// centroid (cheap, and tight under a nearly parallel surface).
     #[inline]
     fn segment_excluded(&self, t: usize, a: &V3, b: &V3, best_d2: f64) -> bool {
-        let (c, r) = &self.spheres[t];
-        let n = &self.face_normals[t];
-        segment_excluded_by(n, c, *r, a, b, best_d2)
+        let (c, r) = triangle_sphere(&self.triangles[t]);
+        segment_excluded_by(&self.face_normals[t], &c, r, a, b, best_d2)
     }
 
     /// Closest triangle to p within sqrt(best_d2): (triangle, closest point, squared distance).
@@ -713,16 +709,12 @@ impl Surface for TriMesh {
     }
 }
 
-fn triangles_spheres(order: &[usize], faces: &[[u32; 3]], vertices: &[V3]) -> Vec<(V3, f64)> {
-    order
-        .par_iter()
-        .map(|&i| {
-            let v = faces[i].map(|k| vertices[k as usize]);
-            let c = (v[0] + v[1] + v[2]) / 3.0;
-            let r = v.iter().map(|x| (x - c).norm()).fold(0.0, f64::max);
-            (c, r * (1.0 + 1e-12))
-        })
-        .collect()
+/// A triangle's centroid and the radius about it that holds the triangle (rounded up).
+#[inline]
+fn triangle_sphere(v: &[V3; 3]) -> (V3, f64) {
+    let c = (v[0] + v[1] + v[2]) / 3.0;
+    let r = v.iter().map(|x| (x - c).norm()).fold(0.0, f64::max);
+    (c, r * (1.0 + 1e-12))
 }
 
 /// Per triangle side (3 t + k: from corner k to corner k + 1) the sum of the normals of the
@@ -1091,7 +1083,7 @@ mod tests {
         let m = TriMesh::new(&v, &f).unwrap();
         let view = BinaryView {
             nodes: &m.nodes,
-            spheres: &m.spheres,
+            triangles: &m.triangles,
             normals: &m.face_normals,
         };
         let (wide, blocks) = wide::collapse_serial(&view, 0);
