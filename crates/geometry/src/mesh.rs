@@ -318,15 +318,7 @@ impl TriMesh {
                     (c, i as u32)
                 })
                 .collect();
-            let boxes: Vec<(V3, V3)> = faces
-                .par_iter()
-                .map(|f| {
-                    let [a, b, c] = f.map(|k| vertices[k as usize]);
-                    (a.inf(&b).inf(&c), a.sup(&b).sup(&c))
-                })
-                .collect();
             let ctx = BuildData {
-                boxes: &boxes,
                 vertices,
                 faces,
                 normals: &normals,
@@ -817,7 +809,6 @@ fn edge_normals(n_vertices: usize, faces: &[[u32; 3]], normals: &[V3]) -> (EdgeS
 }
 
 struct BuildData<'a> {
-    boxes: &'a [(V3, V3)],
     vertices: &'a [V3],
     faces: &'a [[u32; 3]],
     normals: &'a [V3],
@@ -883,13 +874,15 @@ fn tree_size(k: usize) -> usize {
 /// (`tree_size(items.len())` nodes, depth first); `offset` is the position of items[0] in
 /// the whole triangle order, `base` the index of out[0] among all nodes.
 fn build(items: &mut [(V3, u32)], offset: usize, base: usize, out: &mut [Node], d: &BuildData) {
-    let boxes = d.boxes;
     if items.len() <= LEAF_SIZE {
         let (mut lo, mut hi) = (V3::repeat(f64::INFINITY), V3::repeat(f64::NEG_INFINITY));
         for (_, i) in items.iter() {
-            let (a, b) = boxes[*i as usize];
-            lo = lo.inf(&a);
-            hi = hi.sup(&b);
+            // (the triangle's box: its vertices')
+            for &k in &d.faces[*i as usize] {
+                let v = &d.vertices[k as usize];
+                lo = lo.inf(v);
+                hi = hi.sup(v);
+            }
         }
         let (axis, slo, shi, center, radius) = slab(items, d);
         out[0] = Node {
