@@ -213,7 +213,10 @@ pub struct TriMesh {
     face_normals: Vec<V3>,
     /// Bounding sphere (centroid, radius) of each triangle: a cheap, tight lower bound of its
     /// distance to a segment.
-    edge_normals: Vec<[V3; 3]>,
+    /// Per triangle its edges' indices in `edge_sums`, the edges' pseudo-normals (the sums of
+    /// their faces' normals).
+    edges: Vec<[u32; 3]>,
+    edge_sums: Vec<V3>,
     vertex_normals: Vec<V3>,
     nodes: Vec<Node>,
     /// The 4-wide float32 view of `nodes` for the clearance's queries, and per leaf its
@@ -307,7 +310,10 @@ impl TriMesh {
             // edge pseudo-normals: sum of the normals of the faces sharing the edge, and
             // whether the mesh is closed and consistently oriented: every edge in two faces,
             // once in each direction
-            (vertex_normals, edge_normals(vertices.len(), faces, &normals))
+            (
+                vertex_normals,
+                edge_normals(vertices.len(), faces, &normals),
+            )
         };
         let hierarchy = || {
             let mut items: Vec<(V3, u32)> = faces
@@ -337,9 +343,9 @@ impl TriMesh {
             .collect();
         let corners = order.par_iter().map(|&i| faces[i]).collect();
         let face_normals: Vec<V3> = order.par_iter().map(|&i| normals[i]).collect();
-        let edge_normals = order
+        let edges = order
             .par_iter()
-            .map(|&i| [0, 1, 2].map(|k| edge_of.of(3 * i + k)))
+            .map(|&i| [0, 1, 2].map(|k| edge_of.edge[3 * i + k]))
             .collect();
         let view = BinaryView {
             nodes: &nodes,
@@ -352,7 +358,8 @@ impl TriMesh {
             triangles,
             corners,
             face_normals,
-            edge_normals,
+            edges,
+            edge_sums: edge_of.sum,
             vertex_normals,
             nodes,
             wide,
@@ -391,7 +398,7 @@ impl TriMesh {
     fn pseudo_normal(&self, tri: usize, feature: Feature) -> V3 {
         match feature {
             Feature::Face => self.face_normals[tri],
-            Feature::Edge(k) => self.edge_normals[tri][k as usize],
+            Feature::Edge(k) => self.edge_sums[self.edges[tri][k as usize] as usize],
             Feature::Vertex(k) => self.vertex_normals[self.corners[tri][k as usize] as usize],
         }
     }
@@ -711,23 +718,28 @@ fn triangle_sphere(v: &[V3; 3]) -> (V3, f64) {
 
 /// Per triangle side (3 t + k: from corner k to corner k + 1) the sum of the normals of the
 /// faces sharing its edge: `sum[slot[side]]`.
+/// The edges' pseudo-normals: per side (3 t + k: edge k of triangle t) its edge, per edge the
+/// sum of the normals of its faces.
 struct EdgeSums {
-    slot: Vec<u32>,
+    edge: Vec<u32>,
     sum: Vec<V3>,
 }
 
 impl EdgeSums {
-    #[inline]
+    #[cfg(test)]
     fn of(&self, side: usize) -> V3 {
-        self.sum[self.slot[side] as usize]
+        self.sum[self.edge[side] as usize]
     }
 }
 
 /// The edges' normal sums ([`EdgeSums`]) and whether every edge is in two faces, once in each
 /// direction. The sides are grouped by a counting sort on their lower vertex (linear in the
 /// triangles; the edges of one vertex, a handful, are matched by their other vertex), in
-/// parallel over vertex ranges; an edge's sum is taken in increasing side order.
+/// parallel over vertex ranges: each range sorts its buckets and counts its edges, then, the
+/// ranges' first edges known, numbers them and sums their normals (an edge's sum in
+/// increasing side order). One sum per edge, not per side: half the memory to fault in.
 fn edge_normals(n_vertices: usize, faces: &[[u32; 3]], normals: &[V3]) -> (EdgeSums, bool) {
+    use std::sync::atomic::{AtomicU32, Ordering};
     let ends = |side: usize| {
         let f = &faces[side / 3];
         let (a, b) = (f[side % 3], f[(side + 1) % 3]);
@@ -738,8 +750,7 @@ fn edge_normals(n_vertices: usize, faces: &[[u32; 3]], normals: &[V3]) -> (EdgeS
         }
     };
     let n_sides = 3 * faces.len();
-    // bucket boundaries by lower vertex, then each side's other vertex into its bucket (in
-    // increasing side order)
+    // bucket boundaries by lower vertex, then each side's other vertex into its bucket
     let mut start = vec![0u32; n_vertices + 1];
     for side in 0..n_sides {
         start[ends(side).0 as usize + 1] += 1;
@@ -748,23 +759,21 @@ fn edge_normals(n_vertices: usize, faces: &[[u32; 3]], normals: &[V3]) -> (EdgeS
         start[v + 1] += start[v];
     }
     let mut other = vec![(0u32, 0u32); n_sides];
-    let mut slot = vec![0u32; n_sides];
     let mut next = start.clone();
-    for (side, at_side) in slot.iter_mut().enumerate() {
+    for side in 0..n_sides {
         let (lo, hi, _) = ends(side);
         let at = &mut next[lo as usize];
         other[*at as usize] = (hi, side as u32);
-        *at_side = *at;
         *at += 1;
     }
     drop(next);
-    // per range of vertices (in parallel): the sides of one edge share the other vertex
+    // per range of vertices (in parallel): each bucket sorted by other vertex, then side (the
+    // sides of one edge together, in increasing order); its edges counted
     let chunk = n_vertices
         .div_ceil(8 * rayon::current_num_threads())
         .max(1024);
-    let mut sum = vec![V3::zeros(); n_sides];
     let mut parts = Vec::new();
-    let (mut rest, mut done) = (sum.as_mut_slice(), 0usize);
+    let (mut rest, mut done) = (other.as_mut_slice(), 0usize);
     for v0 in (0..n_vertices).step_by(chunk) {
         let v1 = (v0 + chunk).min(n_vertices);
         let (part, tail) = std::mem::take(&mut rest).split_at_mut(start[v1] as usize - done);
@@ -772,40 +781,61 @@ fn edge_normals(n_vertices: usize, faces: &[[u32; 3]], normals: &[V3]) -> (EdgeS
         rest = tail;
         done = start[v1] as usize;
     }
-    let closed = parts
+    let counted: Vec<(usize, bool)> = parts
         .into_par_iter()
         .map(|(vertices, part)| {
             let base = start[vertices.start] as usize;
-            let mut closed = true;
-            let mut order: Vec<usize> = Vec::new();
+            let (mut edges, mut closed) = (0, true);
             for v in vertices {
-                let (a, b) = (start[v] as usize, start[v + 1] as usize);
-                // the bucket's entries by other vertex, then side (sides arrive in increasing
-                // order, so a stable sort by other vertex; buckets hold a handful)
-                order.clear();
-                order.extend(0..b - a);
-                order.sort_by_key(|&k| other[a + k].0);
-                let mut g = 0;
-                while g < order.len() {
-                    let hi = other[a + order[g]].0;
-                    let mut h = g;
-                    let mut total = V3::zeros();
-                    while h < order.len() && other[a + order[h]].0 == hi {
-                        total += normals[other[a + order[h]].1 as usize / 3];
-                        h += 1;
-                    }
-                    let side = |i: usize| other[a + order[i]].1 as usize;
-                    closed &= h - g == 2 && ends(side(g)).2 != ends(side(g + 1)).2;
-                    for &k in &order[g..h] {
-                        part[a - base + k] = total;
-                    }
-                    g = h;
+                let bucket = &mut part[start[v] as usize - base..start[v + 1] as usize - base];
+                bucket.sort_unstable();
+                for group in bucket.chunk_by(|x, y| x.0 == y.0) {
+                    edges += 1;
+                    let side = |i: usize| group[i].1 as usize;
+                    closed &= group.len() == 2 && ends(side(0)).2 != ends(side(1)).2;
                 }
             }
-            closed
+            (edges, closed)
         })
-        .reduce(|| true, |x, y| x && y);
-    (EdgeSums { slot, sum }, closed)
+        .collect();
+    let closed = counted.iter().all(|c| c.1);
+    let mut first = Vec::with_capacity(counted.len() + 1);
+    first.push(0usize);
+    for c in &counted {
+        first.push(first.last().unwrap() + c.0);
+    }
+    // the ranges' edges numbered in turn: sums, and each side's edge
+    let mut sum = vec![V3::zeros(); *first.last().unwrap()];
+    let edge: Vec<AtomicU32> = (0..n_sides).map(|_| AtomicU32::new(0)).collect();
+    let mut sums = Vec::new();
+    let mut rest = sum.as_mut_slice();
+    for w in first.windows(2) {
+        let (part, tail) = std::mem::take(&mut rest).split_at_mut(w[1] - w[0]);
+        sums.push((w[0], part));
+        rest = tail;
+    }
+    let ranges: Vec<_> = (0..n_vertices).step_by(chunk).collect();
+    ranges
+        .into_par_iter()
+        .zip(sums)
+        .for_each(|(v0, (e0, part))| {
+            let v1 = (v0 + chunk).min(n_vertices);
+            let mut g = 0;
+            for v in v0..v1 {
+                let bucket = &other[start[v] as usize..start[v + 1] as usize];
+                for group in bucket.chunk_by(|x, y| x.0 == y.0) {
+                    let mut total = V3::zeros();
+                    for &(_, side) in group {
+                        total += normals[side as usize / 3];
+                        edge[side as usize].store((e0 + g) as u32, Ordering::Relaxed);
+                    }
+                    part[g] = total;
+                    g += 1;
+                }
+            }
+        });
+    let edge = edge.into_iter().map(AtomicU32::into_inner).collect();
+    (EdgeSums { edge, sum }, closed)
 }
 
 struct BuildData<'a> {
@@ -1038,32 +1068,40 @@ mod tests {
         let w = v.len() as u32;
         v.push(V3::new(5.0, 0.0, 1.0));
         f.push([s, s + 1, w]); // a third face on the strip's first edge
-        let normals: Vec<V3> = f
-            .iter()
-            .map(|t| {
-                let [a, b, c] = t.map(|k| v[k as usize]);
-                (b - a).cross(&(c - a)).normalize()
-            })
-            .collect();
-        let (sums, closed) = edge_normals(v.len(), &f, &normals);
-        assert!(!closed);
-        let key = |t: &[u32; 3], k: usize| {
-            let (a, b) = (t[k], t[(k + 1) % 3]);
-            (a.min(b), a.max(b))
+        let check = |v: &[V3], f: &[[u32; 3]]| {
+            let normals: Vec<V3> = f
+                .iter()
+                .map(|t| {
+                    let [a, b, c] = t.map(|k| v[k as usize]);
+                    (b - a).cross(&(c - a)).normalize()
+                })
+                .collect();
+            let (sums, closed) = edge_normals(v.len(), f, &normals);
+            let key = |t: &[u32; 3], k: usize| {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                (a.min(b), a.max(b))
+            };
+            let mut keys: Vec<((u32, u32), usize)> = (0..3 * f.len())
+                .map(|side| (key(&f[side / 3], side % 3), side))
+                .collect();
+            keys.sort();
+            let edges = keys.chunk_by(|x, y| x.0 == y.0).count();
+            assert_eq!(sums.sum.len(), edges);
+            for g in keys.chunk_by(|x, y| x.0 == y.0) {
+                let mut total = V3::zeros();
+                for &(_, side) in g {
+                    total += normals[side / 3];
+                }
+                for &(_, side) in g {
+                    assert_eq!(sums.of(side), total, "side {side}");
+                }
+            }
+            closed
         };
-        let mut keys: Vec<((u32, u32), usize)> = (0..3 * f.len())
-            .map(|side| (key(&f[side / 3], side % 3), side))
-            .collect();
-        keys.sort();
-        for g in keys.chunk_by(|x, y| x.0 == y.0) {
-            let mut total = V3::zeros();
-            for &(_, side) in g {
-                total += normals[side / 3];
-            }
-            for &(_, side) in g {
-                assert_eq!(sums.of(side), total, "side {side}");
-            }
-        }
+        assert!(!check(&v, &f));
+        // 40 000 vertices: buckets numbered over many vertex ranges in parallel
+        let (v, f) = crate::height_field(199, |x, y| 0.1 * (5.0 * x).sin() * y);
+        assert!(!check(&v, &f));
         // the closed cube
         let cube = cube();
         assert!(cube.is_closed());
