@@ -316,12 +316,26 @@ impl TriMesh {
             )
         };
         let hierarchy = || {
-            let mut items: Vec<(V3, u32)> = faces
+            // centroids relative to the mesh's middle: float32 keeps their order at the mesh's
+            // scale wherever it lies
+            let middle = vertices
+                .par_iter()
+                .fold(
+                    || (V3::repeat(f64::INFINITY), V3::repeat(f64::NEG_INFINITY)),
+                    |(lo, hi), v| (lo.inf(v), hi.sup(v)),
+                )
+                .reduce(
+                    || (V3::repeat(f64::INFINITY), V3::repeat(f64::NEG_INFINITY)),
+                    |a, b| (a.0.inf(&b.0), a.1.sup(&b.1)),
+                );
+            let middle = (middle.0 + middle.1) * 0.5;
+            let mut items: Vec<Item> = faces
                 .par_iter()
                 .enumerate()
                 .map(|(i, f)| {
                     let c = f.iter().fold(V3::zeros(), |s, &k| s + vertices[k as usize]) / 3.0;
-                    (c, i as u32)
+                    let c = c - middle;
+                    ([c.x as f32, c.y as f32, c.z as f32], i as u32)
                 })
                 .collect();
             let ctx = BuildData {
@@ -849,7 +863,7 @@ const SLAB_MAX: usize = 64;
 
 /// The slab of a node's triangles (axis = mean normal, the range of axis·x over them) and a
 /// ball holding them (center, radius); axis zero and radius infinite when there is none.
-fn slab(items: &[(V3, u32)], d: &BuildData) -> (V3, f64, f64, V3, f64) {
+fn slab(items: &[Item], d: &BuildData) -> (V3, f64, f64, V3, f64) {
     let none = (
         V3::zeros(),
         f64::NEG_INFINITY,
@@ -903,7 +917,10 @@ fn tree_size(k: usize) -> usize {
 /// Builds the hierarchy over `items` (centroid, triangle), reordering them, into `out`
 /// (`tree_size(items.len())` nodes, depth first); `offset` is the position of items[0] in
 /// the whole triangle order, `base` the index of out[0] among all nodes.
-fn build(items: &mut [(V3, u32)], offset: usize, base: usize, out: &mut [Node], d: &BuildData) {
+/// A triangle in the build: its centroid (float32: the splits' keys only) and index.
+type Item = ([f32; 3], u32);
+
+fn build(items: &mut [Item], offset: usize, base: usize, out: &mut [Node], d: &BuildData) {
     if items.len() <= LEAF_SIZE {
         let (mut lo, mut hi) = (V3::repeat(f64::INFINITY), V3::repeat(f64::NEG_INFINITY));
         for (_, i) in items.iter() {
@@ -928,13 +945,16 @@ fn build(items: &mut [(V3, u32)], offset: usize, base: usize, out: &mut [Node], 
         };
         return;
     }
-    let (mut clo, mut chi) = (V3::repeat(f64::INFINITY), V3::repeat(f64::NEG_INFINITY));
+    let (mut clo, mut chi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
     for (c, _) in items.iter() {
-        clo = clo.inf(c);
-        chi = chi.sup(c);
+        for k in 0..3 {
+            clo[k] = clo[k].min(c[k]);
+            chi[k] = chi[k].max(c[k]);
+        }
     }
     let (slab_axis, slab_lo, slab_hi, center, radius) = slab(items, d);
-    let axis = (chi - clo).imax();
+    let extent = [0, 1, 2].map(|k| chi[k] - clo[k]);
+    let axis = (0..3).fold(0, |m, k| if extent[k] > extent[m] { k } else { m });
     let mid = items.len() / 2;
     items.select_nth_unstable_by(mid, |x, y| x.0[axis].total_cmp(&y.0[axis]));
     let (left_items, right_items) = items.split_at_mut(mid);
