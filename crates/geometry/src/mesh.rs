@@ -28,8 +28,8 @@ impl fmt::Display for MeshError {
 
 impl std::error::Error for MeshError {}
 
-/// A hierarchy node, laid out so that the box test reads one cache line (box, links and the
-/// slab's range) and the slab-and-ball test the second.
+/// A node of the binary hierarchy (built, then collapsed into the wide tree the searches
+/// walk): its box and links, one cache line.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
 struct Node {
@@ -39,15 +39,6 @@ struct Node {
     index: u32,
     /// Leaf: number of triangles (> 0); inner node: 0.
     count: u32,
-    /// Slab bound: the node's triangles lie in lo ≤ axis·x ≤ hi (axis zero: no slab). Tight
-    /// where the surface is nearly flat, which the box is not when the surface is inclined.
-    lo: f64,
-    hi: f64,
-    axis: V3,
-    /// With a slab: a ball (center, radius) holding the node's triangles (radius infinite
-    /// without a slab). Slab and ball together bound the distance like a thin disk.
-    center: V3,
-    radius: f64,
 }
 
 impl Node {
@@ -57,63 +48,7 @@ impl Node {
         max: V3::new(0.0, 0.0, 0.0),
         index: 0,
         count: 0,
-        lo: 0.0,
-        hi: 0.0,
-        axis: V3::new(0.0, 0.0, 0.0),
-        center: V3::new(0.0, 0.0, 0.0),
-        radius: 0.0,
     };
-
-    /// Squared distance of p to the box (a lower bound; cheap, to order the children).
-    #[inline(always)]
-    fn box_distance2(&self, p: &V3) -> f64 {
-        let mut d2 = 0.0;
-        for k in 0..3 {
-            let e = (self.min[k] - p[k]).max(p[k] - self.max[k]).max(0.0);
-            d2 += e * e;
-        }
-        d2
-    }
-
-    /// Whether segment [a, b] (with box lo..hi, midpoint mid, half length half) is farther
-    /// than sqrt(best_d2) from the node: by the boxes, then with a slab by [`disk_excludes`]
-    /// (slab and ball, the tighter test), else by the box and the ball about mid.
-    #[inline]
-    #[allow(clippy::too_many_arguments)]
-    fn excludes_segment(
-        &self,
-        a: &V3,
-        b: &V3,
-        lo: &V3,
-        hi: &V3,
-        mid: &V3,
-        half: f64,
-        best_d2: f64,
-    ) -> bool {
-        let mut d2 = 0.0;
-        for k in 0..3 {
-            let e = (self.min[k] - hi[k]).max(lo[k] - self.max[k]).max(0.0);
-            d2 += e * e;
-        }
-        if d2 > best_d2 {
-            return true;
-        }
-        if !self.radius.is_finite() {
-            // no slab: the box and the ball about mid
-            let dm = (self.box_distance2(mid).sqrt() - half).max(0.0);
-            return dm * dm > best_d2;
-        }
-        let n = &self.axis;
-        let (xa, xb) = (n.dot(a), n.dot(b));
-        let gap = (self.lo - xa.max(xb)).max(xa.min(xb) - self.hi).max(0.0);
-        if gap * gap * (1.0 - 1e-10) > best_d2 {
-            return true;
-        }
-        let (u, w) = (a - self.center, b - self.center);
-        let pu = u - n * n.dot(&u);
-        let e = (w - n * n.dot(&w)) - pu;
-        disk_excludes(xa, xb, self.lo, self.hi, &pu, &e, self.radius, best_d2)
-    }
 }
 
 /// Whether a thin disk-like set is farther than sqrt(best_d2) from a segment, exactly
@@ -253,10 +188,18 @@ impl wide::Binary for BinaryView<'_> {
         (n.index as usize, n.count as usize)
     }
     fn slab(&self, node: u32) -> Option<(V3, f64, f64, V3, f64)> {
-        let n = &self.nodes[node as usize];
-        n.radius
-            .is_finite()
-            .then_some((n.axis, n.lo, n.hi, n.center, n.radius))
+        // the subtree's triangles: from its leftmost leaf's first to its rightmost leaf's last
+        let leaf = |mut n: u32, next: &dyn Fn(u32) -> u32| {
+            while self.nodes[n as usize].count == 0 {
+                n = next(n);
+            }
+            &self.nodes[n as usize]
+        };
+        let first = leaf(node, &|n| n + 1).index as usize;
+        let last = leaf(node, &|n| self.nodes[n as usize].index);
+        let end = (last.index + last.count) as usize;
+        let s = slab(&self.triangles[first..end], &self.normals[first..end]);
+        s.4.is_finite().then_some(s)
     }
     fn disk(&self, t: usize) -> (V3, f64, f64, V3, f64) {
         let (c, r) = triangle_sphere(&self.triangles[t]);
@@ -338,11 +281,7 @@ impl TriMesh {
                     ([c.x as f32, c.y as f32, c.z as f32], i as u32)
                 })
                 .collect();
-            let ctx = BuildData {
-                vertices,
-                faces,
-                normals: &normals,
-            };
+            let ctx = BuildData { vertices, faces };
             let mut nodes = vec![Node::EMPTY; tree_size(items.len())];
             build(&mut items, 0, 0, &mut nodes, &ctx);
             (items, nodes)
@@ -626,63 +565,19 @@ impl TriMesh {
         }
     }
 
-    /// Closest triangle to segment [a, b] within sqrt(best_d2).
+    /// Closest triangle to segment [a, b] within `max_distance`: (triangle, parameter on the
+    /// segment, closest points), by the wide tree's search.
     fn nearest_to_segment(
         &self,
         a: &V3,
         b: &V3,
-        mut best_d2: f64,
+        max_distance: f64,
         hint: usize,
     ) -> Option<(usize, f64, V3, V3)> {
-        let mut best = None;
-        let mid = (a + b) * 0.5;
-        let half = (b - a).norm() * 0.5;
-        let (lo, hi) = (a.inf(b), a.sup(b));
-
-        let check = |t: usize, best_d2: &mut f64, best: &mut Option<_>| {
-            if self.segment_excluded(t, a, b, *best_d2) {
-                return;
-            }
-            let [p, q, r] = &self.triangles[t];
-            let (s, x, y) = segment_triangle(a, b, p, q, r);
-            let d2 = (x - y).norm_squared();
-            if d2 < *best_d2 || (d2 == *best_d2 && best.is_none()) {
-                *best_d2 = d2;
-                *best = Some((t, s, x, y));
-            }
-        };
-        if hint < self.triangles.len() {
-            check(hint, &mut best_d2, &mut best);
-        }
-        let mut stack = [0u32; 64];
-        let mut top = 1;
-        while top > 0 {
-            top -= 1;
-            let node = &self.nodes[stack[top] as usize];
-            if node.excludes_segment(a, b, &lo, &hi, &mid, half, best_d2) {
-                continue;
-            }
-            if node.count > 0 {
-                let start = node.index as usize;
-                for t in start..start + node.count as usize {
-                    check(t, &mut best_d2, &mut best);
-                }
-            } else {
-                let left = stack[top] + 1;
-                let right = node.index;
-                let dl = self.nodes[left as usize].box_distance2(&mid);
-                let dr = self.nodes[right as usize].box_distance2(&mid);
-                let (near, far) = if dl <= dr {
-                    (left, right)
-                } else {
-                    (right, left)
-                };
-                stack[top] = far;
-                stack[top + 1] = near;
-                top += 2;
-            }
-        }
-        best
+        let (_, _, t) = self.nearest_of_segments(a, std::slice::from_ref(b), max_distance, hint)?;
+        let [p, q, r] = &self.triangles[t];
+        let (s, x, y) = segment_triangle(a, b, p, q, r);
+        Some((t, s, x, y))
     }
 }
 
@@ -699,7 +594,7 @@ impl Surface for TriMesh {
         max_distance: f64,
         hint: usize,
     ) -> Option<SegmentProjection> {
-        let (t, s, x, y) = self.nearest_to_segment(a, b, max_distance * max_distance, hint)?;
+        let (t, s, x, y) = self.nearest_to_segment(a, b, max_distance, hint)?;
         let [p, q, r] = &self.triangles[t];
         let (_, feature) = point_triangle(&x, p, q, r);
         let n = self.pseudo_normal(t, feature);
@@ -855,15 +750,16 @@ fn edge_normals(n_vertices: usize, faces: &[[u32; 3]], normals: &[V3]) -> (EdgeS
 struct BuildData<'a> {
     vertices: &'a [V3],
     faces: &'a [[u32; 3]],
-    normals: &'a [V3],
 }
 
 /// Subtrees up to this many triangles get a slab bound (the surface is nearly flat there).
 const SLAB_MAX: usize = 64;
 
-/// The slab of a node's triangles (axis = mean normal, the range of axis·x over them) and a
-/// ball holding them (center, radius); axis zero and radius infinite when there is none.
-fn slab(items: &[Item], d: &BuildData) -> (V3, f64, f64, V3, f64) {
+/// The slab of a subtree's triangles (`tris` and their unit `normals`, in hierarchy order:
+/// axis = mean normal, the range of axis·x over them) and a ball holding them (center,
+/// radius); axis zero and radius infinite when there is none (more than `SLAB_MAX`
+/// triangles, or normals spread). Computed for the wide tree's lanes only.
+fn slab(tris: &[[V3; 3]], normals: &[V3]) -> (V3, f64, f64, V3, f64) {
     let none = (
         V3::zeros(),
         f64::NEG_INFINITY,
@@ -871,34 +767,29 @@ fn slab(items: &[Item], d: &BuildData) -> (V3, f64, f64, V3, f64) {
         V3::zeros(),
         f64::INFINITY,
     );
-    if items.len() > SLAB_MAX {
+    if tris.len() > SLAB_MAX {
         return none;
     }
-    let mean: V3 = items.iter().map(|(_, i)| d.normals[*i as usize]).sum();
+    let mean: V3 = normals.iter().sum();
     let len = mean.norm();
-    if len < 0.5 * items.len() as f64 {
+    if len < 0.5 * tris.len() as f64 {
         return none; // normals spread: the slab would not be thin
     }
     let axis = mean / len;
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
     let (mut bmin, mut bmax) = (V3::repeat(f64::INFINITY), V3::repeat(f64::NEG_INFINITY));
-    for (_, i) in items {
-        for &k in &d.faces[*i as usize] {
-            let v = &d.vertices[k as usize];
-            let x = axis.dot(v);
-            lo = lo.min(x);
-            hi = hi.max(x);
-            bmin = bmin.inf(v);
-            bmax = bmax.sup(v);
-        }
+    for v in tris.iter().flatten() {
+        let x = axis.dot(v);
+        lo = lo.min(x);
+        hi = hi.max(x);
+        bmin = bmin.inf(v);
+        bmax = bmax.sup(v);
     }
     let center = (bmin + bmax) * 0.5;
-    let mut radius: f64 = 0.0;
-    for (_, i) in items {
-        for &k in &d.faces[*i as usize] {
-            radius = radius.max((d.vertices[k as usize] - center).norm());
-        }
-    }
+    let radius = tris
+        .iter()
+        .flatten()
+        .fold(0.0, |r: f64, v| r.max((v - center).norm()));
     // widen by the round-off of the projections
     let pad = 1e-12 * (lo.abs() + hi.abs() + (hi - lo));
     let radius = radius * (1.0 + 1e-12) + 1e-12 * center.norm();
@@ -931,15 +822,9 @@ fn build(items: &mut [Item], offset: usize, base: usize, out: &mut [Node], d: &B
                 hi = hi.sup(v);
             }
         }
-        let (axis, slo, shi, center, radius) = slab(items, d);
         out[0] = Node {
             min: lo,
             max: hi,
-            axis,
-            lo: slo,
-            hi: shi,
-            center,
-            radius,
             index: offset as u32,
             count: items.len() as u32,
         };
@@ -952,7 +837,6 @@ fn build(items: &mut [Item], offset: usize, base: usize, out: &mut [Node], d: &B
             chi[k] = chi[k].max(c[k]);
         }
     }
-    let (slab_axis, slab_lo, slab_hi, center, radius) = slab(items, d);
     let extent = [0, 1, 2].map(|k| chi[k] - clo[k]);
     let axis = (0..3).fold(0, |m, k| if extent[k] > extent[m] { k } else { m });
     let mid = items.len() / 2;
@@ -974,11 +858,6 @@ fn build(items: &mut [Item], offset: usize, base: usize, out: &mut [Node], d: &B
     head[0] = Node {
         min: left[0].min.inf(&right[0].min),
         max: left[0].max.sup(&right[0].max),
-        axis: slab_axis,
-        lo: slab_lo,
-        hi: slab_hi,
-        center,
-        radius,
         index: right_at as u32,
         count: 0,
     };
