@@ -475,18 +475,21 @@ pub(crate) trait Binary {
 /// as one depth-first pass would lay them out (the same arrays, no copies).
 pub(crate) fn collapse<T: Binary + Sync + ?Sized>(tree: &T, root: u32) -> (Vec<Wide>, Vec<Block4>) {
     let lanes = match tree.children(root) {
-        Some((l, r)) => vec![l, r],
-        None => vec![root],
+        Some(c) => lanes_of(tree, c),
+        None => ([root, 0, 0, 0], 1),
     };
-    let lanes = open(tree, lanes);
-    // per lane of wide node 0: its subtree's wide nodes and blocks
-    let sizes: Vec<(usize, usize)> = lanes
+    let lanes = &lanes.0[..lanes.1];
+    // per lane of wide node 0: its subtree's wide nodes and blocks, and their lanes
+    let (sizes, plans): (Vec<(usize, usize)>, Vec<Vec<Lanes>>) = lanes
         .par_iter()
         .map(|&n| {
-            tree.children(n)
-                .map_or((0, 1), |(a, b)| count(tree, vec![a, b]))
+            let mut plan = Vec::new();
+            let size = tree
+                .children(n)
+                .map_or((0, 1), |c| count(tree, lanes_of(tree, c), &mut plan));
+            (size, plan)
         })
-        .collect();
+        .unzip();
     let n_wide = 1 + sizes.iter().map(|s| s.0).sum::<usize>();
     let n_blocks = sizes.iter().map(|s| s.1).sum::<usize>();
     let mut wide: Vec<Wide> = (0..n_wide).into_par_iter().map(|_| Wide::EMPTY).collect();
@@ -515,8 +518,9 @@ pub(crate) fn collapse<T: Binary + Sync + ?Sized>(tree: &T, root: u32) -> (Vec<W
     let links: Vec<u32> = lanes
         .par_iter()
         .zip(sinks)
-        .map(|(&n, mut sink)| match tree.children(n) {
-            Some((a, b)) => push(tree, vec![a, b], &mut sink),
+        .zip(plans)
+        .map(|((&n, mut sink), plan)| match tree.children(n) {
+            Some(_) => push(tree, &mut plan.into_iter(), &mut sink),
             None => leaf_block(tree, n, &mut sink),
         })
         .collect();
@@ -538,10 +542,13 @@ struct Sink<'a> {
     b_base: u32,
 }
 
+/// Up to four lanes (binary nodes) of a wide node.
+type Lanes = ([u32; 4], usize);
+
 /// `lanes` with the largest inner lanes opened until there are four (or only leaves).
-fn open<T: Binary + ?Sized>(tree: &T, mut lanes: Vec<u32>) -> Vec<u32> {
-    while lanes.len() < 4 {
-        let open = lanes
+fn open<T: Binary + ?Sized>(tree: &T, (mut lanes, mut len): Lanes) -> Lanes {
+    while len < 4 {
+        let open = lanes[..len]
             .iter()
             .enumerate()
             .filter(|(_, &n)| tree.children(n).is_some())
@@ -549,18 +556,26 @@ fn open<T: Binary + ?Sized>(tree: &T, mut lanes: Vec<u32>) -> Vec<u32> {
         let Some((i, &n)) = open else { break };
         let (l, r) = tree.children(n).unwrap();
         lanes[i] = l;
-        lanes.push(r);
+        lanes[len] = r;
+        len += 1;
     }
-    lanes
+    (lanes, len)
 }
 
-/// The wide nodes and blocks [`push`] writes for `lanes`.
-fn count<T: Binary + ?Sized>(tree: &T, lanes: Vec<u32>) -> (usize, usize) {
+/// The lanes of an inner node's wide node: its two children, opened.
+fn lanes_of<T: Binary + ?Sized>(tree: &T, (a, b): (u32, u32)) -> Lanes {
+    open(tree, ([a, b, 0, 0], 2))
+}
+
+/// The wide nodes and blocks [`push`] writes for the wide node of `lanes`, whose lanes (and
+/// those of the wide nodes below, depth first) go to `plan` for [`push`].
+fn count<T: Binary + ?Sized>(tree: &T, lanes: Lanes, plan: &mut Vec<Lanes>) -> (usize, usize) {
+    plan.push(lanes);
     let mut n = (1, 0);
-    for l in open(tree, lanes) {
+    for &l in &lanes.0[..lanes.1] {
         let (w, b) = tree
             .children(l)
-            .map_or((0, 1), |(a, b)| count(tree, vec![a, b]));
+            .map_or((0, 1), |c| count(tree, lanes_of(tree, c), plan));
         n = (n.0 + w, n.1 + b);
     }
     n
@@ -598,10 +613,11 @@ fn leaf_block<T: Binary + ?Sized>(tree: &T, n: u32, sink: &mut Sink) -> u32 {
 #[cfg(test)]
 pub(crate) fn collapse_serial<T: Binary + ?Sized>(tree: &T, root: u32) -> (Vec<Wide>, Vec<Block4>) {
     let lanes = match tree.children(root) {
-        Some((l, r)) => vec![l, r],
-        None => vec![root],
+        Some(c) => lanes_of(tree, c),
+        None => ([root, 0, 0, 0], 1),
     };
-    let (n_wide, n_blocks) = count(tree, lanes.clone());
+    let mut plan = Vec::new();
+    let (n_wide, n_blocks) = count(tree, lanes, &mut plan);
     let mut out = (vec![Wide::EMPTY; n_wide], vec![Block4::NONE; n_blocks]);
     let mut sink = Sink {
         wide: &mut out.0,
@@ -611,20 +627,24 @@ pub(crate) fn collapse_serial<T: Binary + ?Sized>(tree: &T, root: u32) -> (Vec<W
         w_base: 0,
         b_base: 0,
     };
-    push(tree, lanes, &mut sink);
+    push(tree, &mut plan.into_iter(), &mut sink);
     out
 }
 
-/// Writes the wide node of `lanes` (opening the largest inner lanes until there are four)
-/// and, depth first, those of its inner lanes; returns its index.
-fn push<T: Binary + ?Sized>(tree: &T, lanes: Vec<u32>, sink: &mut Sink) -> u32 {
-    let lanes = open(tree, lanes);
+/// Writes the next wide node of `plan` (its lanes, as [`count`] opened them) and, depth
+/// first, those of its inner lanes; returns its index.
+fn push<T: Binary + ?Sized>(
+    tree: &T,
+    plan: &mut impl Iterator<Item = Lanes>,
+    sink: &mut Sink,
+) -> u32 {
+    let (lanes, len) = plan.next().expect("a plan for every wide node");
     let at = sink.n_wide;
     sink.n_wide += 1;
-    for (l, &n) in lanes.iter().enumerate() {
+    for (l, &n) in lanes[..len].iter().enumerate() {
         set_lane(tree, &mut sink.wide[at], l, n);
         sink.wide[at].wide[l] = match tree.children(n) {
-            Some((a, b)) => push(tree, vec![a, b], sink),
+            Some(_) => push(tree, plan, sink),
             None => leaf_block(tree, n, sink),
         };
     }
