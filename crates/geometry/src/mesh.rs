@@ -621,7 +621,7 @@ impl Surface for TriMesh {
 #[inline]
 fn triangle_sphere(v: &[V3; 3]) -> (V3, f64) {
     let c = (v[0] + v[1] + v[2]) / 3.0;
-    let r = v.iter().map(|x| (x - c).norm()).fold(0.0, f64::max);
+    let r = v.iter().map(|x| (x - c).norm_squared()).fold(0.0, f64::max).sqrt();
     (c, r * (1.0 + 1e-12))
 }
 
@@ -786,10 +786,12 @@ fn slab(tris: &[[V3; 3]], normals: &[V3]) -> (V3, f64, f64, V3, f64) {
         bmax = bmax.sup(v);
     }
     let center = (bmin + bmax) * 0.5;
+    // (the root of the largest square: the largest root, to the last bit)
     let radius = tris
         .iter()
         .flatten()
-        .fold(0.0, |r: f64, v| r.max((v - center).norm()));
+        .fold(0.0, |r: f64, v| r.max((v - center).norm_squared()))
+        .sqrt();
     // widen by the round-off of the projections
     let pad = 1e-12 * (lo.abs() + hi.abs() + (hi - lo));
     let radius = radius * (1.0 + 1e-12) + 1e-12 * center.norm();
