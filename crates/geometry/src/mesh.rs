@@ -492,13 +492,21 @@ impl TriMesh {
                 continue;
             }
             let wn = &self.wide[w as usize];
-            let gb = wn.gaps2_pair(&qs);
-            let g: [f32; 4] = if wn.has_disk() {
+            // (where every lane has a slab and ball, their bound alone: the boxes rarely add
+            // to it; measured 1.7 % faster)
+            let g: [f32; 4] = if wn.all_disks() {
+                let gd = wn
+                    .disk
+                    .segment_bounds2_pair(&af, &bf, [pad, pad], f32::INFINITY);
+                std::array::from_fn(|l| gd[l].min(gd[l + 4]))
+            } else if wn.has_disk() {
+                let gb = wn.gaps2_pair(&qs);
                 let gd = wn
                     .disk
                     .segment_bounds2_pair(&af, &bf, [pad, pad], f32::INFINITY);
                 std::array::from_fn(|l| gb[l].max(gd[l]).min(gb[l + 4].max(gd[l + 4])))
             } else {
+                let gb = wn.gaps2_pair(&qs);
                 std::array::from_fn(|l| gb[l].min(gb[l + 4]))
             };
             let order = wide::order(&g);
@@ -621,7 +629,11 @@ impl Surface for TriMesh {
 #[inline]
 fn triangle_sphere(v: &[V3; 3]) -> (V3, f64) {
     let c = (v[0] + v[1] + v[2]) / 3.0;
-    let r = v.iter().map(|x| (x - c).norm_squared()).fold(0.0, f64::max).sqrt();
+    let r = v
+        .iter()
+        .map(|x| (x - c).norm_squared())
+        .fold(0.0, f64::max)
+        .sqrt();
     (c, r * (1.0 + 1e-12))
 }
 

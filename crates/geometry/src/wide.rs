@@ -64,6 +64,12 @@ impl Wide {
     pub fn has_disk(&self) -> bool {
         self.disk.radius != [f32::INFINITY; 4]
     }
+
+    /// Whether every lane has a slab and ball.
+    #[inline(always)]
+    pub fn all_disks(&self) -> bool {
+        self.disk.radius.iter().all(|r| r.is_finite())
+    }
 }
 
 /// Flag of a leaf lane in [`Wide::wide`].
