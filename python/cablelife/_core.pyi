@@ -331,3 +331,8 @@ def weld_vertices(vertices, faces) -> Any:
     order and coordinates kept) and re-indexes the faces (F, 3): (vertices (M, 3), faces (F, 3)).
     """
     ...
+
+def mesh_topology(faces, n_vertices: int) -> tuple[bool, int, Any, int]:
+    """Closedness, boundary edges and shells of a mesh (faces (F, 3), indices below n_vertices):
+    (watertight, boundary edge count, shell per face (F,) numbered by first face, shells)."""
+    ...

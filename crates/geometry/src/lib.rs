@@ -18,6 +18,7 @@ pub mod clearance;
 pub mod closest;
 pub mod mesh;
 pub mod primitives;
+pub mod topology;
 pub mod weld;
 mod wide;
 
@@ -28,6 +29,7 @@ pub type V3 = Vector3<f64>;
 pub use clearance::{clearance, Clearance, ClearanceError, Control, Part, RigidMap};
 pub use mesh::{MeshError, TriMesh};
 pub use primitives::{Cuboid, Cylinder, HalfSpace, Sphere};
+pub use topology::{topology, Topology};
 pub use weld::weld_vertices;
 
 /// Closest point of a surface to a query point.

@@ -391,6 +391,36 @@ impl Surroundings {
 /// Merged vertices (M, 3) and re-indexed faces (F, 3).
 type Welded<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<i64>>);
 
+/// Closedness, boundary edges and shells of a mesh (`faces` (F, 3) indices below
+/// `n_vertices`): (watertight, boundary edge count, shell per face (F,), number of shells).
+#[pyfunction]
+fn mesh_topology<'py>(
+    py: Python<'py>,
+    faces: PyReadonlyArray2<'py, i64>,
+    n_vertices: usize,
+) -> PyResult<(bool, usize, Bound<'py, PyArray1<i64>>, usize)> {
+    let f = faces.as_array();
+    if f.ncols() != 3 {
+        return Err(PyValueError::new_err(format!(
+            "faces {:?}: must be (F, 3)",
+            f.shape()
+        )));
+    }
+    let mut tri = Vec::with_capacity(f.nrows());
+    for (i, r) in f.rows().into_iter().enumerate() {
+        let face = [r[0], r[1], r[2]];
+        if face.iter().any(|&k| k < 0 || k as u64 >= n_vertices as u64) {
+            return Err(PyValueError::new_err(format!(
+                "face {i} {face:?}: vertex indices must be in 0..{n_vertices}"
+            )));
+        }
+        tri.push(face.map(|k| k as u32));
+    }
+    let t = py.detach(|| ::geometry::topology(n_vertices, &tri));
+    let shell = PyArray1::from_vec(py, t.shell.into_iter().map(i64::from).collect());
+    Ok((t.watertight, t.boundary, shell, t.shells))
+}
+
 /// Merges the vertices (N, 3) of a triangle soup that agree to 8 decimals (first appearance's
 /// order and coordinates kept) and re-indexes the faces (F, 3): (vertices (M, 3), faces (F, 3)).
 #[pyfunction]
@@ -422,5 +452,6 @@ fn weld_vertices<'py>(
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Surroundings>()?;
     m.add_function(wrap_pyfunction!(weld_vertices, m)?)?;
+    m.add_function(wrap_pyfunction!(mesh_topology, m)?)?;
     Ok(())
 }
