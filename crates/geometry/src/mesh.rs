@@ -146,15 +146,14 @@ pub struct TriMesh {
     /// Vertex indices of the triangles (for the vertex pseudo-normals).
     corners: Vec<[u32; 3]>,
     face_normals: Vec<V3>,
-    /// Bounding sphere (centroid, radius) of each triangle: a cheap, tight lower bound of its
-    /// distance to a segment.
     /// Per triangle its edges' indices in `edge_sums`, the edges' pseudo-normals (the sums of
     /// their faces' normals).
     edges: Vec<[u32; 3]>,
     edge_sums: Vec<V3>,
     vertex_normals: Vec<V3>,
+    /// The binary hierarchy (its leaves' triangle ranges; its boxes give the mesh's bounds).
     nodes: Vec<Node>,
-    /// The 4-wide float32 view of `nodes` for the clearance's queries, and per leaf its
+    /// The 4-wide float32 view of `nodes` that every search walks, and per leaf its
     /// triangles' planes and disks in float32, in the leaf block's own frame.
     wide: Vec<Wide>,
     blocks: Vec<Block4>,
