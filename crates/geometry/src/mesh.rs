@@ -660,33 +660,13 @@ impl EdgeSums {
 /// increasing side order). One sum per edge, not per side: half the memory to fault in.
 fn edge_normals(n_vertices: usize, faces: &[[u32; 3]], normals: &[V3]) -> (EdgeSums, bool) {
     use std::sync::atomic::{AtomicU32, Ordering};
-    let ends = |side: usize| {
+    // whether a side runs from its lower vertex to its higher one
+    let forward = |side: usize| {
         let f = &faces[side / 3];
-        let (a, b) = (f[side % 3], f[(side + 1) % 3]);
-        if a < b {
-            (a, b, true)
-        } else {
-            (b, a, false)
-        }
+        f[side % 3] < f[(side + 1) % 3]
     };
     let n_sides = 3 * faces.len();
-    // bucket boundaries by lower vertex, then each side's other vertex into its bucket
-    let mut start = vec![0u32; n_vertices + 1];
-    for side in 0..n_sides {
-        start[ends(side).0 as usize + 1] += 1;
-    }
-    for v in 0..n_vertices {
-        start[v + 1] += start[v];
-    }
-    let mut other = vec![(0u32, 0u32); n_sides];
-    let mut next = start.clone();
-    for side in 0..n_sides {
-        let (lo, hi, _) = ends(side);
-        let at = &mut next[lo as usize];
-        other[*at as usize] = (hi, side as u32);
-        *at += 1;
-    }
-    drop(next);
+    let (start, mut other) = crate::topology::sides_by_lower_vertex(n_vertices, faces);
     // per range of vertices (in parallel): each bucket sorted by other vertex, then side (the
     // sides of one edge together, in increasing order); its edges counted
     let chunk = n_vertices
@@ -712,7 +692,7 @@ fn edge_normals(n_vertices: usize, faces: &[[u32; 3]], normals: &[V3]) -> (EdgeS
                 for group in bucket.chunk_by(|x, y| x.0 == y.0) {
                     edges += 1;
                     let side = |i: usize| group[i].1 as usize;
-                    closed &= group.len() == 2 && ends(side(0)).2 != ends(side(1)).2;
+                    closed &= group.len() == 2 && forward(side(0)) != forward(side(1));
                 }
             }
             (edges, closed)

@@ -30,15 +30,19 @@ fn find(parent: &mut [u32], mut x: u32) -> u32 {
     x
 }
 
-/// The topology of `faces` (vertex indices below `n_vertices`, checked by the caller).
-pub fn topology(n_vertices: usize, faces: &[[u32; 3]]) -> Topology {
+/// The sides of `faces` (side 3 t + k: edge k of triangle t, from corner k to corner k + 1)
+/// bucketed by their lower vertex with a counting sort, in increasing side order within a
+/// bucket: (bucket starts per vertex (n_vertices + 1), per side (other vertex, side)).
+pub(crate) fn sides_by_lower_vertex(
+    n_vertices: usize,
+    faces: &[[u32; 3]],
+) -> (Vec<u32>, Vec<(u32, u32)>) {
     let n_sides = 3 * faces.len();
     let ends = |side: usize| {
         let f = &faces[side / 3];
         let (a, b) = (f[side % 3], f[(side + 1) % 3]);
         (a.min(b), a.max(b))
     };
-    // sides bucketed by lower vertex (counting sort), each bucket's by other vertex
     let mut start = vec![0u32; n_vertices + 1];
     for side in 0..n_sides {
         start[ends(side).0 as usize + 1] += 1;
@@ -51,10 +55,16 @@ pub fn topology(n_vertices: usize, faces: &[[u32; 3]]) -> Topology {
     for side in 0..n_sides {
         let (lo, hi) = ends(side);
         let at = &mut next[lo as usize];
-        other[*at as usize] = (hi, (side / 3) as u32);
+        other[*at as usize] = (hi, side as u32);
         *at += 1;
     }
-    drop(next);
+    (start, other)
+}
+
+/// The topology of `faces` (vertex indices below `n_vertices`, checked by the caller).
+pub fn topology(n_vertices: usize, faces: &[[u32; 3]]) -> Topology {
+    // sides bucketed by lower vertex, each bucket's by other vertex: an edge's sides together
+    let (start, mut other) = sides_by_lower_vertex(n_vertices, faces);
     let mut parent: Vec<u32> = (0..faces.len() as u32).collect();
     let (mut watertight, mut boundary) = (true, 0);
     for v in 0..n_vertices {
@@ -65,7 +75,8 @@ pub fn topology(n_vertices: usize, faces: &[[u32; 3]]) -> Topology {
             boundary += (edge.len() == 1) as usize;
             // the faces of an edge in one shell
             for pair in edge.windows(2) {
-                let (a, b) = (find(&mut parent, pair[0].1), find(&mut parent, pair[1].1));
+                let face = |i: usize| pair[i].1 / 3;
+                let (a, b) = (find(&mut parent, face(0)), find(&mut parent, face(1)));
                 if a != b {
                     parent[a.max(b) as usize] = a.min(b);
                 }

@@ -390,13 +390,7 @@ fn mesh_shape(
         .into_iter()
         .map(|r| Vector3::new(r[0], r[1], r[2]))
         .collect();
-    let mut tris = Vec::with_capacity(f.nrows());
-    for r in f.rows() {
-        if r.iter().any(|&k| k < 0 || k as usize >= verts.len()) {
-            return Err(bad(format!("bad vertex index in face {r}")));
-        }
-        tris.push([r[0] as u32, r[1] as u32, r[2] as u32]);
-    }
+    let tris = crate::geometry::face_rows(faces, verts.len()).map_err(bad)?;
     let mesh = ::geometry::TriMesh::new(&verts, &tris).map_err(|e| bad(e.0))?;
     Ok(Box::new(MeshShape::new(mesh, &verts)))
 }

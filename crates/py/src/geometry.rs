@@ -31,6 +31,30 @@ fn rows3(a: &PyReadonlyArray2<'_, f64>, what: &str) -> PyResult<Vec<V3>> {
         .collect())
 }
 
+/// The faces (F, 3) as indices of `n_vertices` vertices (at most 2³²); the error names the
+/// first bad face.
+pub(crate) fn face_rows(
+    faces: &PyReadonlyArray2<'_, i64>,
+    n_vertices: usize,
+) -> Result<Vec<[u32; 3]>, String> {
+    let f = faces.as_array();
+    if f.ncols() != 3 {
+        return Err(format!("faces have shape {:?}: must be (F, 3)", f.shape()));
+    }
+    let limit = n_vertices.min(u32::MAX as usize + 1) as u64;
+    let mut tris = Vec::with_capacity(f.nrows());
+    for (i, r) in f.rows().into_iter().enumerate() {
+        let face = [r[0], r[1], r[2]];
+        if face.iter().any(|&k| k < 0 || k as u64 >= limit) {
+            return Err(format!(
+                "face {i} {face:?}: vertex indices must be in 0..{limit}"
+            ));
+        }
+        tris.push(face.map(|k| k as u32));
+    }
+    Ok(tris)
+}
+
 fn finite(values: &[f64], what: &str) -> PyResult<()> {
     if values.iter().all(|x| x.is_finite()) {
         Ok(())
@@ -81,22 +105,7 @@ impl Surroundings {
         faces: PyReadonlyArray2<'_, i64>,
     ) -> PyResult<usize> {
         let v = rows3(&vertices, "vertices")?;
-        let f = faces.as_array();
-        if f.ncols() != 3 {
-            return Err(PyValueError::new_err(format!(
-                "faces has shape {:?}: must be (F, 3)",
-                f.shape()
-            )));
-        }
-        let mut tris = Vec::with_capacity(f.nrows());
-        for r in f.rows() {
-            if r.iter().any(|&k| k < 0 || k > u32::MAX as i64) {
-                return Err(PyValueError::new_err(format!(
-                    "bad vertex index in face {r}"
-                )));
-            }
-            tris.push([r[0] as u32, r[1] as u32, r[2] as u32]);
-        }
+        let tris = face_rows(&faces, v.len()).map_err(PyValueError::new_err)?;
         let mesh = py
             .detach(|| TriMesh::new(&v, &tris))
             .map_err(|e| PyValueError::new_err(e.0))?;
@@ -399,23 +408,7 @@ fn mesh_topology<'py>(
     faces: PyReadonlyArray2<'py, i64>,
     n_vertices: usize,
 ) -> PyResult<(bool, usize, Bound<'py, PyArray1<i64>>, usize)> {
-    let f = faces.as_array();
-    if f.ncols() != 3 {
-        return Err(PyValueError::new_err(format!(
-            "faces {:?}: must be (F, 3)",
-            f.shape()
-        )));
-    }
-    let mut tri = Vec::with_capacity(f.nrows());
-    for (i, r) in f.rows().into_iter().enumerate() {
-        let face = [r[0], r[1], r[2]];
-        if face.iter().any(|&k| k < 0 || k as u64 >= n_vertices as u64) {
-            return Err(PyValueError::new_err(format!(
-                "face {i} {face:?}: vertex indices must be in 0..{n_vertices}"
-            )));
-        }
-        tri.push(face.map(|k| k as u32));
-    }
+    let tri = face_rows(&faces, n_vertices).map_err(PyValueError::new_err)?;
     let t = py.detach(|| ::geometry::topology(n_vertices, &tri));
     let shell = PyArray1::from_vec(py, t.shell.into_iter().map(i64::from).collect());
     Ok((t.watertight, t.boundary, shell, t.shells))
