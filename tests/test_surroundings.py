@@ -10,6 +10,7 @@ import warnings
 
 import numpy as np
 import pytest
+from cablelife import _core
 from cablelife.scene import SceneError, scene_from_dict
 from cablelife.surroundings.build import load_surroundings
 from cablelife.surroundings.clearance import cable_clearance
@@ -996,3 +997,19 @@ def test_vectorised_mesh_reading_equals_trimesh(tmp_path):
     tri = m.vertices[m.faces]
     volume = np.einsum("ij,ij->", tri[:, 0], np.cross(tri[:, 1], tri[:, 2])) / 6
     assert volume == pytest.approx(b.volume, rel=1e-6)
+
+
+def test_queries_of_non_finite_points_are_named():
+    """The surroundings' point and segment queries refuse a non-finite row with its index (no
+    answer exists; before, a Rust panic), for primitives and meshes alike."""
+    s = _core.Surroundings()
+    s.add_sphere(0, [0.0, 0.0, 0.0], 1.0)
+    tri = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+    s.add_mesh(0, tri, np.array([[0, 1, 2]]))
+    ok = np.array([[0.0, 0.0, 2.0]])
+    for part in (0, 1):
+        assert np.isfinite(s.project_points(part, ok)["distance"]).all()
+        with pytest.raises(ValueError, match=r"points: row 1 \[NaN"):
+            s.project_points(part, np.array([[0.0, 0.0, 2.0], [np.nan, 0.0, 0.0]]))
+        with pytest.raises(ValueError, match=r"b: row 0 \[inf"):
+            s.closest_to_segments(part, ok, np.array([[np.inf, 0.0, 0.0]]))

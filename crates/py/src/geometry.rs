@@ -55,6 +55,18 @@ pub(crate) fn face_rows(
     Ok(tris)
 }
 
+/// The first row of `rows` that is not finite, named (queries of non-finite points have no
+/// answer).
+fn finite_rows(rows: &[V3], what: &str) -> PyResult<()> {
+    match rows.iter().position(|p| !p.iter().all(|x| x.is_finite())) {
+        None => Ok(()),
+        Some(i) => Err(PyValueError::new_err(format!(
+            "{what}: row {i} {:?} is not finite; allowed: finite coordinates",
+            rows[i].as_slice()
+        ))),
+    }
+}
+
 fn finite(values: &[f64], what: &str) -> PyResult<()> {
     if values.iter().all(|x| x.is_finite()) {
         Ok(())
@@ -187,6 +199,7 @@ impl Surroundings {
     ) -> PyResult<Bound<'py, PyDict>> {
         let shape = &self.part(part)?.shape;
         let q = rows3(&points, "points")?;
+        finite_rows(&q, "points")?;
         let out: Vec<_> = py.detach(|| {
             use rayon::prelude::*;
             q.par_iter()
@@ -224,6 +237,8 @@ impl Surroundings {
         let shape = &self.part(part)?.shape;
         let a = rows3(&a, "a")?;
         let b = rows3(&b, "b")?;
+        finite_rows(&a, "a")?;
+        finite_rows(&b, "b")?;
         if a.len() != b.len() {
             return Err(PyValueError::new_err("a and b must have the same shape"));
         }
