@@ -317,7 +317,8 @@ def fatigue_turning_points(series, hysteresis=0.0) -> Any:
 
 def section_strains(positions, quaternions, arc_length) -> Any:
     """Axial strain Γ₃ and shear strain |(Γ₁, Γ₂)| per step and edge (T, N) of saved positions
-    (T, N + 1, 3), edge quaternions (T, N, 4, scalar first) and node arc lengths (N + 1)."""
+    (T, N + 1, 3), edge quaternions (T, N, 4, scalar first) and node arc lengths (N + 1), all
+    C-contiguous."""
     ...
 
 def strain_extremes(positions, quaternions, arc_length) -> Any:

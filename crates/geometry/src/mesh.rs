@@ -364,7 +364,7 @@ impl TriMesh {
         segment_excluded_by(&self.face_normals[t], &c, r, a, b, best_d2)
     }
 
-    /// Closest triangle to p within sqrt(best_d2): (triangle, closest point, squared distance).
+    /// Closest triangle to p within sqrt(best_d2): (triangle, closest point).
     fn nearest_triangle(&self, p: &V3, mut best_d2: f64, hint: usize) -> Option<(usize, V3)> {
         let mut best = None;
         if hint < self.triangles.len() {
@@ -636,8 +636,6 @@ fn triangle_sphere(v: &[V3; 3]) -> (V3, f64) {
     (c, r * (1.0 + 1e-12))
 }
 
-/// Per triangle side (3 t + k: from corner k to corner k + 1) the sum of the normals of the
-/// faces sharing its edge: `sum[slot[side]]`.
 /// The edges' pseudo-normals: per side (3 t + k: edge k of triangle t) its edge, per edge the
 /// sum of the normals of its faces.
 struct EdgeSums {
@@ -798,12 +796,12 @@ fn tree_size(k: usize) -> usize {
     }
 }
 
-/// Builds the hierarchy over `items` (centroid, triangle), reordering them, into `out`
-/// (`tree_size(items.len())` nodes, depth first); `offset` is the position of items[0] in
-/// the whole triangle order, `base` the index of out[0] among all nodes.
 /// A triangle in the build: its centroid (float32: the splits' keys only) and index.
 type Item = ([f32; 3], u32);
 
+/// Builds the hierarchy over `items` (centroid, triangle), reordering them, into `out`
+/// (`tree_size(items.len())` nodes, depth first); `offset` is the position of items[0] in
+/// the whole triangle order, `base` the index of out[0] among all nodes.
 fn build(items: &mut [Item], offset: usize, base: usize, out: &mut [Node], d: &BuildData) {
     if items.len() <= LEAF_SIZE {
         let (mut lo, mut hi) = (V3::repeat(f64::INFINITY), V3::repeat(f64::NEG_INFINITY));

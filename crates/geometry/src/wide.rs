@@ -6,8 +6,9 @@
 //! traffic of the float64 binary nodes. The float32 boxes are rounded outwards and the query
 //! rounded down and up ([`Rounded`]), so a float32 box distance (scaled by [`F32_SAFE`]) is a
 //! lower bound of the exact float64 distance: it only ever skips what the float64 test would
-//! skip. The binary nodes keep their float64 data (slab and ball bounds, triangle ranges): the
-//! wide nodes point at them, and the leaves are tested exactly.
+//! skip. The wide nodes also hold, where a lane's subtree is nearly flat, its slab and ball
+//! ([`Disk4`]); leaf lanes point at their binary node (its triangle range) and at a block of
+//! their triangles' planes and disks ([`Block4`]); the triangles are then measured exactly.
 use rayon::prelude::*;
 use wide::f32x8;
 
@@ -194,7 +195,8 @@ impl Disk4 {
         let xa = n[0] * av[0] + n[1] * av[1] + n[2] * av[2];
         let xd = n[0] * d[0] + n[1] * d[1] + n[2] * d[2];
         let xb = xa + xd;
-        let g = ((twice(&self.lo) - xa.max(xb)).max(xa.min(xb) - twice(&self.hi)) - pad).max(zero);
+        let (lo, hi) = (twice(&self.lo), twice(&self.hi));
+        let g = ((lo - xa.max(xb)).max(xa.min(xb) - hi) - pad).max(zero);
         let u: [f32x8; 3] = std::array::from_fn(|k| av[k] - twice(&self.center[k]));
         let xu = n[0] * u[0] + n[1] * u[1] + n[2] * u[2];
         let pu: [f32x8; 3] = std::array::from_fn(|k| u[k] - n[k] * xu);
@@ -216,7 +218,6 @@ impl Disk4 {
         // the segment, else where the tangents cross. Tight where the nearest point is an
         // end, as where a cable's segment passes obliquely above an inclined part of a
         // surface, which the first stage's gap and offset taken apart are not
-        let (lo, hi) = (twice(&self.lo), twice(&self.hi));
         let two = f32x8::splat(2.0);
         let tiny = f32x8::splat(f32::MIN_POSITIVE);
         // at an end x (axial) and q (across): (gap, d(gap²)/ds) and (lat, d(lat²)/ds)

@@ -12,7 +12,6 @@ use rod::assembly::Workspace;
 use rod::contact::{Contact, ContactOptions, Cuboid, Cylinder, Obstacle, Plane, Shape, Sphere};
 use rod::contact_mesh::MeshShape;
 use rod::routing::route;
-use rod::shear::saved_strain as shear_strain_of_saved;
 use rod::sliding::SlidingClips;
 use rod::{
     CableSpec, ClipKind, ClipMotion, ClipSpec, DynamicOptions, Dynamics, NewtonOptions, PointLoad,
@@ -1174,7 +1173,8 @@ fn strain_extremes(
 }
 
 /// Axial strain Γ₃ and shear strain |(Γ₁, Γ₂)| per step and edge (T, N) of saved positions
-/// (T, N + 1, 3), edge quaternions (T, N, 4, scalar first) and node arc lengths (N + 1).
+/// (T, N + 1, 3), edge quaternions (T, N, 4, scalar first) and node arc lengths (N + 1),
+/// C-contiguous.
 #[pyfunction]
 fn section_strains<'py>(
     py: Python<'py>,
@@ -1182,22 +1182,28 @@ fn section_strains<'py>(
     quaternions: PyReadonlyArray3<'py, f64>,
     arc_length: PyReadonlyArray1<'py, f64>,
 ) -> PyResult<StrainArrays<'py>> {
-    let (x, p, s) = (
-        positions.as_array(),
-        quaternions.as_array(),
-        arc_length.as_array(),
-    );
+    let (x, p) = (positions.as_array(), quaternions.as_array());
     let (t, n) = (p.shape()[0], p.shape()[1]);
-    let inv_ds = saved_shapes("section_strains", x.shape(), p.shape(), s.as_slice())?;
+    let inv_ds = saved_shapes(
+        "section_strains",
+        x.shape(),
+        p.shape(),
+        arc_length.as_slice().ok(),
+    )?;
+    let (Ok(x), Ok(p)) = (positions.as_slice(), quaternions.as_slice()) else {
+        return Err(PyValueError::new_err(
+            "section_strains: positions and quaternions must be C-contiguous",
+        ));
+    };
     let (mut axial, mut shear) = (vec![0.0; t * n], vec![0.0; t * n]);
     for k in 0..t {
-        for e in 0..n {
-            let at = |i: usize| Vector3::new(x[[k, i, 0]], x[[k, i, 1]], x[[k, i, 2]]);
-            let u = Vector3::new(p[[k, e, 1]], p[[k, e, 2]], p[[k, e, 3]]);
-            let g = shear_strain_of_saved(&at(e), &at(e + 1), p[[k, e, 0]], &u, inv_ds[e]);
-            axial[k * n + e] = g.z;
-            shear[k * n + e] = (g.x * g.x + g.y * g.y).sqrt();
-        }
+        rod::shear::saved_step_strains(
+            &x[k * 3 * (n + 1)..(k + 1) * 3 * (n + 1)],
+            &p[k * 4 * n..(k + 1) * 4 * n],
+            &inv_ds,
+            &mut axial[k * n..(k + 1) * n],
+            &mut shear[k * n..(k + 1) * n],
+        );
     }
     let shape = [t, n];
     Ok((

@@ -73,6 +73,32 @@ impl Extreme {
     }
 }
 
+/// Axial strain Γ₃ and shear strain |(Γ₁, Γ₂)| of every edge at one saved step: positions
+/// `x` (N + 1, 3) and quaternions `p` (N, 4, scalar first, any length) row-major, `inv_ds`
+/// 1/Δs per edge (N), into `axial` and `shear` (N).
+pub fn saved_step_strains(
+    x: &[f64],
+    p: &[f64],
+    inv_ds: &[f64],
+    axial: &mut [f64],
+    shear: &mut [f64],
+) {
+    let strains = inv_ds.iter().zip(axial.iter_mut().zip(shear));
+    for (e, (inv, (ax, sh))) in strains.enumerate() {
+        let at = |i: usize| Vector3::new(x[3 * i], x[3 * i + 1], x[3 * i + 2]);
+        let q = &p[4 * e..4 * e + 4];
+        let g = saved_strain(
+            &at(e),
+            &at(e + 1),
+            q[0],
+            &Vector3::new(q[1], q[2], q[3]),
+            *inv,
+        );
+        *ax = g.z;
+        *sh = (g.x * g.x + g.y * g.y).sqrt();
+    }
+}
+
 /// The validity scan of a saved run in one pass, without the strain arrays: the largest
 /// axial strain Γ₃, the largest compression (−Γ₃) and the largest shear strain |(Γ₁, Γ₂)|
 /// over the steps and edges, each with where it is (the first of equal values; a NaN
@@ -100,20 +126,7 @@ pub fn saved_strain_extremes(
     for k in 0..steps {
         let x = &positions[k * 3 * (n + 1)..(k + 1) * 3 * (n + 1)];
         let p = &quaternions[k * 4 * n..(k + 1) * 4 * n];
-        let strains = inv_ds.iter().zip(axial.iter_mut().zip(&mut shear));
-        for (e, (inv, (ax, sh))) in strains.enumerate() {
-            let at = |i: usize| Vector3::new(x[3 * i], x[3 * i + 1], x[3 * i + 2]);
-            let q = &p[4 * e..4 * e + 4];
-            let g = saved_strain(
-                &at(e),
-                &at(e + 1),
-                q[0],
-                &Vector3::new(q[1], q[2], q[3]),
-                *inv,
-            );
-            *ax = g.z;
-            *sh = (g.x * g.x + g.y * g.y).sqrt();
-        }
+        saved_step_strains(x, p, inv_ds, &mut axial, &mut shear);
         for (e, (a, s)) in axial.iter().zip(&shear).enumerate() {
             Extreme::offer(&mut best[0], *a, k, e);
             Extreme::offer(&mut best[1], -a, k, e);
