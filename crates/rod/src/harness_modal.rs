@@ -16,7 +16,7 @@ use crate::harness::{Harness, HarnessError, HarnessState};
 use crate::harness_solver::HarnessStatics;
 use crate::modal::{
     dissipated_power, energy_shares, lowest_pairs, lumped_mass, modal_mass, HeldRate, ModalError,
-    ModeKind, ShiftInvert,
+    ModeKind, ShiftInvert, REFINEMENT_STEPS,
 };
 use crate::statics::NewtonOptions;
 use nalgebra::{Matrix6, Vector3, Vector6};
@@ -215,9 +215,15 @@ impl ShiftInvert for HarnessPencil<'_> {
         (self.s.work.inertia.zero == 0).then_some(self.s.work.inertia.negative)
     }
 
-    /// y = (K − σM)⁻¹ M x by the tree solve with two steps of iterative refinement (as the
-    /// single cable's `apply`).
-    fn apply(&mut self, x: &[Vector6<f64>], y: &mut [Vector6<f64>], r: &mut [Vector6<f64>]) {
+    /// y = (K − σM)⁻¹ M x by the tree solve with, if `refine`, two steps of iterative
+    /// refinement (as the single cable's `apply`).
+    fn apply(
+        &mut self,
+        x: &[Vector6<f64>],
+        y: &mut [Vector6<f64>],
+        r: &mut [Vector6<f64>],
+        refine: bool,
+    ) {
         let b: Vec<Vector6<f64>> = x
             .iter()
             .zip(&self.s.m)
@@ -225,7 +231,7 @@ impl ShiftInvert for HarnessPencil<'_> {
             .collect();
         self.solve(&b, y);
         let mut dy = vec![Vector6::zeros(); y.len()];
-        for _ in 0..2 {
+        for _ in 0..if refine { REFINEMENT_STEPS } else { 0 } {
             self.residual(&b, y, r);
             self.solve(r, &mut dy);
             for (y, d) in y.iter_mut().zip(&dy) {
@@ -343,7 +349,7 @@ impl ModalSystem {
                 return Ok(None);
             }
             for _ in 0..(if pass == 0 { 30 } else { 40 }) {
-                p.apply(&x, &mut y, &mut r);
+                p.apply(&x, &mut y, &mut r, true);
                 let xmy = m_dot(&x, &y, &p.s.m);
                 let xmx = m_dot(&x, &x, &p.s.m);
                 rho = mu + xmx / xmy;

@@ -142,7 +142,12 @@ impl std::error::Error for ModalError {}
 /// which it stops when the changes no longer shrink (the round-off floor of the solves).
 const TOLERANCE: f64 = 1e-11;
 const FLOOR: f64 = 1e-5;
-const REFINEMENT_STEPS: usize = 2;
+/// Steps of iterative refinement per refined solve (`ShiftInvert::apply`).
+pub(crate) const REFINEMENT_STEPS: usize = 2;
+/// The change of the Ritz values at which the iteration turns from plain solves to refined
+/// ones: the vectors are converged but for the solves' error, which the refined iterations
+/// then remove (two or three of them instead of all).
+const PLAIN_TOLERANCE: f64 = 1e-8;
 const MAX_ITERATIONS: usize = 300;
 /// A negative eigenvalue within this fraction of the largest returned one is a zero mode.
 const ZERO_MODE: f64 = 1e-8;
@@ -203,8 +208,15 @@ pub(crate) trait ShiftInvert {
     /// Factors K − σM; returns its inertia (the number of eigenvalues below σ), or None if a
     /// pivot is zero (σ on or next to an eigenvalue).
     fn factor(&mut self, sigma: f64) -> Option<usize>;
-    /// y = (K − σM)⁻¹ M x with the current factorisation (`r`: work space).
-    fn apply(&mut self, x: &[Vector6<f64>], y: &mut [Vector6<f64>], r: &mut [Vector6<f64>]);
+    /// y = (K − σM)⁻¹ M x with the current factorisation (`r`: work space), with
+    /// `REFINEMENT_STEPS` steps of iterative refinement if `refine`.
+    fn apply(
+        &mut self,
+        x: &[Vector6<f64>],
+        y: &mut [Vector6<f64>],
+        r: &mut [Vector6<f64>],
+        refine: bool,
+    );
 
     fn n(&self) -> usize {
         self.mass().len()
@@ -255,18 +267,24 @@ impl ShiftInvert for Pencil {
         (inertia.zero == 0).then_some(inertia.negative)
     }
 
-    /// y = (K − σM)⁻¹ M x with the current factorisation and two steps of iterative
-    /// refinement (`r`: work space). K − σM is ill-conditioned by design (stiff shear and
-    /// axial terms against soft bending, σ near the spectrum): one solve leaves a relative
-    /// error ~1e-5 in the bending directions of a section with GA/EI = 5e8 1/m²; refinement
-    /// brings the Ritz values to ~1e-7.
-    fn apply(&mut self, x: &[Vector6<f64>], y: &mut [Vector6<f64>], r: &mut [Vector6<f64>]) {
+    /// y = (K − σM)⁻¹ M x with the current factorisation and, if `refine`, two steps of
+    /// iterative refinement (`r`: work space). K − σM is ill-conditioned by design (stiff
+    /// shear and axial terms against soft bending, σ near the spectrum): one solve leaves a
+    /// relative error ~1e-5 in the bending directions of a section with GA/EI = 5e8 1/m²;
+    /// refinement brings the Ritz values to ~1e-7.
+    fn apply(
+        &mut self,
+        x: &[Vector6<f64>],
+        y: &mut [Vector6<f64>],
+        r: &mut [Vector6<f64>],
+        refine: bool,
+    ) {
         let n = self.n();
         for ((y, x), m) in y.iter_mut().zip(x).zip(&self.m) {
             *y = x.component_mul(m);
         }
         self.work.solve_range(0..n, y);
-        for _ in 0..REFINEMENT_STEPS {
+        for _ in 0..if refine { REFINEMENT_STEPS } else { 0 } {
             self.work.mul(y, r);
             for ((r, x), m) in r.iter_mut().zip(x).zip(&self.m) {
                 *r = x.component_mul(m) - *r;
@@ -296,7 +314,10 @@ pub(crate) struct Ritz {
     pub vectors: Vec<Vec<Vector6<f64>>>,
 }
 
-/// Subspace iteration with `p` vectors from the start vectors `x` at shift σ (factored).
+/// Subspace iteration with `p` vectors from the start vectors `x` at shift σ (factored): plain
+/// solves until the Ritz values change by less than `PLAIN_TOLERANCE` (or stop shrinking),
+/// then refined ones until they change by less than `TOLERANCE`; only a refined iteration
+/// ends it.
 fn subspace_iteration<P: ShiftInvert>(
     pencil: &mut P,
     sigma: f64,
@@ -310,10 +331,11 @@ fn subspace_iteration<P: ShiftInvert>(
     let mut r = vec![Vector6::zeros(); n];
     let mut old: Vec<f64> = vec![f64::NAN; p];
     let (mut best, mut since_best) = (f64::INFINITY, 0);
+    let mut refine = false;
     for _ in 0..MAX_ITERATIONS {
         *iterations += 1;
         for (xi, yi) in x.iter().zip(y.iter_mut()) {
-            pencil.apply(xi, yi, &mut r);
+            pencil.apply(xi, yi, &mut r, refine);
         }
         // Scale the columns of Y to unit M-norm (diagonal scaling of the Gram matrices).
         let mut scale = vec![1.0; p];
@@ -374,6 +396,12 @@ fn subspace_iteration<P: ShiftInvert>(
         }
         let converged = change <= TOLERANCE || (since_best >= 6 && best <= FLOOR);
         old = values;
+        if !refine {
+            if change <= PLAIN_TOLERANCE || since_best >= 3 {
+                (refine, best, since_best) = (true, f64::INFINITY, 0);
+            }
+            continue;
+        }
         if converged {
             return Some(Ritz {
                 values: old,
