@@ -126,3 +126,30 @@ def test_shared_psd_seed_warns():
         body_motion(
             [channel("z", signal=psd), channel("x", frame="body", signal=psd)], time_grid(2.0, 1e-3)
         )
+
+
+def test_translation_only_motion_skips_the_rotation_terms():
+    """Without a moving rotation channel the body motion is a translation (``rotates`` False):
+    R = I, ω = α = 0, global plus body-axis translations (R0 u_b), exact derivatives."""
+    c, s = np.cos(0.4), np.sin(0.4)
+    r0 = np.array([[1, 0, 0], [0, c, -s], [0, s, c]])
+    motions = [
+        channel("x", signal=sine(0.01, 1.3, 0.1)),
+        channel("z", frame="body", signal=sine(0.015, 1.1, 0.9)),
+        channel("ry", 0.0),  # a rotation channel at rest
+    ]
+    dt = 1e-4
+    t = time_grid(1.0, dt)
+    m = body_motion(motions, t, orientation=r0)
+    assert not m.rotates
+    assert np.array_equal(m.rotation, np.broadcast_to(np.eye(3), m.rotation.shape))
+    assert not m.angular_velocity.any() and not m.angular_acceleration.any()
+    u_g = 0.01 * np.sin(2 * np.pi * 1.3 * t + 0.1)
+    u_b = 0.015 * np.sin(2 * np.pi * 1.1 * t + 0.9)
+    expected = np.outer(u_g, [1.0, 0.0, 0.0]) + np.outer(u_b, r0[:, 2])
+    assert np.allclose(m.translation, expected, rtol=0, atol=1e-15)
+    inner = slice(2, -2)
+    for x, v in ((m.translation, m.velocity), (m.velocity, m.acceleration)):
+        fd = np.gradient(x, dt, axis=0)
+        assert np.max(np.abs(fd[inner] - v[inner])) < 1e-5 * np.max(np.abs(v))
+    assert body_motion([channel("rx", signal=sine(0.1, 1.0))], t).rotates

@@ -58,7 +58,9 @@ def frame_matrix(direction, normal=None) -> np.ndarray:
     n = np.asarray(normal, float)
     d1 = n - d3 * n.dot(d3)
     d1 /= np.linalg.norm(d1)
-    return np.column_stack([d1, np.cross(d3, d1), d3])
+    (a0, a1, a2), (b0, b1, b2) = d3.tolist(), d1.tolist()  # d2 = d3 × d1
+    d2 = (a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0)
+    return np.array([[b0, d2[0], a0], [b1, d2[1], a1], [b2, d2[2], a2]])
 
 
 def _grid_steps(duration: float, time_step: float) -> float:
@@ -173,6 +175,12 @@ def clip_kinematics(
             out["positions"][:, j] = pos
             frames.append(local)
             continue
+        if not motion.rotates:  # R = I, ω = α = 0: the same values as below, T times cheaper
+            out["positions"][:, j] = origin + motion.translation[:n_t] + (pos - origin)
+            out["velocities"][:, j] = motion.velocity[:n_t]
+            out["accelerations"][:, j] = motion.acceleration[:n_t]
+            frames.append(local)
+            continue
         rot = motion.rotation[:n_t]
         arm = rot @ (pos - origin)  # r = R(X − o)
         w, alpha = motion.angular_velocity[:n_t], motion.angular_acceleration[:n_t]
@@ -185,10 +193,16 @@ def clip_kinematics(
         out["angular_accelerations"][:, j] = alpha
         frames.append(rot @ local)
     _check_clip_motion(cable, times, out)
-    # a clip at rest converts its one matrix (the same quaternion as each of T copies)
+    # one conversion for all clips; a clip at rest converts its one matrix (the same
+    # quaternion as each of T copies)
     out["quaternions"] = np.empty((n_t, n_c, 4))
-    for j, frame in enumerate(frames):
-        out["quaternions"][:, j] = matrix_quaternions(frame)
+    if frames:
+        stacked = [f.reshape(-1, 3, 3) for f in frames]
+        quats = matrix_quaternions(np.concatenate(stacked))
+        start = 0
+        for j, f in enumerate(stacked):
+            out["quaternions"][:, j] = quats[start : start + len(f)]
+            start += len(f)
     return out
 
 

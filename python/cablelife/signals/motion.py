@@ -42,6 +42,7 @@ class BodyMotion:
     angular_velocity: np.ndarray  # (T, 3) rad/s
     acceleration: np.ndarray  # (T, 3) m/s² of the origin
     angular_acceleration: np.ndarray  # (T, 3) rad/s²
+    rotates: bool = True  # False: R(t) = I, ω = α = 0 at every t (no rotation channel moves)
 
     def positions(self, points: np.ndarray, origin: np.ndarray) -> np.ndarray:
         """(T, P, 3) positions of body points at rest positions ``points`` (P, 3)."""
@@ -82,23 +83,25 @@ def axis_rotation(axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
 
 def compose_rotations(
     factors: list[tuple[np.ndarray, Kinematics]], n: int
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, bool]:
     """R = R1 R2 ... of rotations about fixed axes n_i (in the frame to their left).
 
     Returns R (T,3,3), the spatial angular velocity ω = Σ θ̇_i a_i with a_i = R1..R_{i-1} n_i,
-    and α = Σ θ̈_i a_i + θ̇_i (ω_{<i} × a_i).
+    α = Σ θ̈_i a_i + θ̇_i (ω_{<i} × a_i), and whether any factor moves (else R = I).
     """
     rotation = np.broadcast_to(np.eye(3), (n, 3, 3)).copy()
     omega = np.zeros((n, 3))
     alpha = np.zeros((n, 3))
+    moves = False
     for axis, kin in factors:
         if not (kin.value.any() or kin.velocity.any() or kin.acceleration.any()):
             continue  # a channel at rest: R_i = I, no term (the same values to the last bit)
+        moves = True
         a = rotation @ np.asarray(axis, float)
         alpha = alpha + kin.acceleration[:, None] * a + kin.velocity[:, None] * np.cross(omega, a)
         omega = omega + kin.velocity[:, None] * a
         rotation = rotation @ axis_rotation(axis, kin.value)
-    return rotation, omega, alpha
+    return rotation, omega, alpha, moves
 
 
 def body_motion(
@@ -132,17 +135,21 @@ def body_motion(
     e = np.eye(3)
     factors = [(e[_AXES[c]], get("global", c)) for c in ("rz", "ry", "rx")]
     factors += [(r0[:, _AXES[c]], get("body", c)) for c in ROTATIONS]
-    rotation, omega, alpha = compose_rotations(factors, n)
+    rotation, omega, alpha, rotates = compose_rotations(factors, n)
 
     def stack(frame: str, attr: str) -> np.ndarray:
         return np.stack([getattr(get(frame, c), attr) for c in TRANSLATIONS], axis=1)
 
     # global part, then the body part w = R R0 u_b along the current body axes
-    axes = rotation @ r0
+    axes = rotation @ r0 if rotates else np.broadcast_to(r0, (n, 3, 3))
     w = np.einsum("tij,tj->ti", axes, stack("body", "value"))
     w_rate = np.einsum("tij,tj->ti", axes, stack("body", "velocity"))  # R R0 u̇_b
     w_acc = np.einsum("tij,tj->ti", axes, stack("body", "acceleration"))  # R R0 ü_b
     translation = stack("global", "value") + w
+    if not rotates:  # ω = α = 0: the cross products below vanish
+        velocity = stack("global", "velocity") + w_rate
+        acceleration = stack("global", "acceleration") + w_acc
+        return BodyMotion(t, translation, rotation, velocity, omega, acceleration, alpha, False)
     velocity = stack("global", "velocity") + np.cross(omega, w) + w_rate
     acceleration = (
         stack("global", "acceleration")
@@ -151,7 +158,7 @@ def body_motion(
         + 2 * np.cross(omega, w_rate)
         + w_acc
     )
-    return BodyMotion(t, translation, rotation, velocity, omega, acceleration, alpha)
+    return BodyMotion(t, translation, rotation, velocity, omega, acceleration, alpha, rotates)
 
 
 def _checked_orientation(orientation: np.ndarray) -> np.ndarray:
