@@ -13,6 +13,9 @@ use crate::state::State;
 use crate::statics::SolveError;
 use nalgebra::{Matrix3, Vector3, Vector6};
 
+mod lanes;
+use lanes::Elements;
+
 /// Scratch and outputs of one assembly; allocated once per cable.
 #[derive(Clone, Debug)]
 pub struct Workspace {
@@ -385,32 +388,11 @@ impl Workspace {
         want_jac: bool,
         part: Part,
     ) -> Result<(), KinkAt> {
-        match part {
-            Part::All => {
-                let outputs = self.section_outputs;
-                for e in 0..rod.n_edges() {
-                    self.shear_term(rod, st, rates, want_jac, e, outputs);
-                }
-                for i in 0..rod.bend_terms.len() {
-                    self.bend_term(rod, st, rates, want_jac, i, outputs)?;
-                }
-                for n in 0..if outputs { self.node_moment.len() } else { 0 } {
-                    if self.node_moment_count[n] > 1 {
-                        let w = 1.0 / self.node_moment_count[n] as f64;
-                        self.node_moment[n] *= w;
-                        self.node_moment_viscous[n] *= w;
-                    }
-                }
-            }
-            Part::Segment(seg) => {
-                for &e in &seg.edges {
-                    self.shear_term(rod, st, rates, want_jac, e, false);
-                }
-                for &i in &seg.bend_terms {
-                    self.bend_term(rod, st, rates, want_jac, i, false)?;
-                }
-            }
-        }
+        // The energy sums (elastic energy, dissipated power) in locals through the loops.
+        let mut sums = (self.elastic_energy, self.dissipation);
+        let terms = self.elastic_terms(rod, st, rates, want_jac, part, &mut sums);
+        (self.elastic_energy, self.dissipation) = sums;
+        terms?;
         if want_jac {
             let edges = match part {
                 Part::All => 0..rod.n_edges(),
@@ -430,8 +412,62 @@ impl Workspace {
         Ok(())
     }
 
+    /// The shear and bending terms of `part` (`add_elastic_part`); without the Jacobian four
+    /// elements at a time (`lanes`, the same values to the last bit).
+    fn elastic_terms(
+        &mut self,
+        rod: &Rod,
+        st: &State,
+        rates: Option<&Rates>,
+        want_jac: bool,
+        part: Part,
+        sums: &mut (f64, f64),
+    ) -> Result<(), KinkAt> {
+        match part {
+            Part::All => {
+                let outputs = self.section_outputs;
+                if want_jac {
+                    for e in 0..rod.n_edges() {
+                        self.shear_term(rod, st, rates, true, e, outputs, sums);
+                    }
+                    for i in 0..rod.bend_terms.len() {
+                        self.bend_term(rod, st, rates, true, i, outputs, sums)?;
+                    }
+                } else {
+                    let edges = Elements::Range(0, rod.n_edges());
+                    self.shear_terms_lanes(rod, st, rates, edges, outputs, sums);
+                    let terms = Elements::Range(0, rod.bend_terms.len());
+                    self.bend_terms_lanes(rod, st, rates, terms, outputs, sums)?;
+                }
+                for n in 0..if outputs { self.node_moment.len() } else { 0 } {
+                    if self.node_moment_count[n] > 1 {
+                        let w = 1.0 / self.node_moment_count[n] as f64;
+                        self.node_moment[n] *= w;
+                        self.node_moment_viscous[n] *= w;
+                    }
+                }
+            }
+            Part::Segment(seg) if want_jac => {
+                for &e in &seg.edges {
+                    self.shear_term(rod, st, rates, true, e, false, sums);
+                }
+                for &i in &seg.bend_terms {
+                    self.bend_term(rod, st, rates, true, i, false, sums)?;
+                }
+            }
+            Part::Segment(seg) => {
+                let edges = Elements::List(&seg.edges);
+                self.shear_terms_lanes(rod, st, rates, edges, false, sums);
+                let terms = Elements::List(&seg.bend_terms);
+                self.bend_terms_lanes(rod, st, rates, terms, false, sums)?;
+            }
+        }
+        Ok(())
+    }
+
     /// Shear/extension element of edge e (with `outputs`, its energy and section force are
-    /// stored).
+    /// stored; `sums`: the elastic energy and the dissipated power summed so far).
+    #[allow(clippy::too_many_arguments)]
     #[inline]
     fn shear_term(
         &mut self,
@@ -441,6 +477,7 @@ impl Workspace {
         want_jac: bool,
         e: usize,
         outputs: bool,
+        sums: &mut (f64, f64),
     ) {
         let sec = &rod.spec.section;
         let strain0 = Vector3::zeros();
@@ -448,7 +485,7 @@ impl Workspace {
         let kin = ShearKinematics::new(&st.x[e], &st.x[e + 1], &st.p[e], ds, &strain0);
         let f_el = sec.shear_stiffness.component_mul(&kin.strain);
         if outputs {
-            self.elastic_energy += 0.5 * ds * kin.strain.dot(&f_el);
+            sums.0 += 0.5 * ds * kin.strain.dot(&f_el);
         }
         let mut f = f_el;
         let mut viscous = None;
@@ -458,7 +495,7 @@ impl Workspace {
             let omega: Vector3<f64> = r.v[e].fixed_rows::<3>(3).into();
             let gd = kin.rate(&va, &vb, &omega);
             let fd = r.shear_damping.component_mul(&gd);
-            self.dissipation += ds * gd.dot(&fd);
+            sums.1 += ds * gd.dot(&fd);
             f += fd;
             if want_jac {
                 viscous = Some(ShearViscous {
@@ -513,6 +550,7 @@ impl Workspace {
     }
 
     /// Bending/torsion term i (with `outputs`, its section moment is added to the node's).
+    #[allow(clippy::too_many_arguments)]
     #[inline]
     fn bend_term(
         &mut self,
@@ -522,6 +560,7 @@ impl Workspace {
         want_jac: bool,
         i: usize,
         outputs: bool,
+        sums: &mut (f64, f64),
     ) -> Result<(), KinkAt> {
         let sec = &rod.spec.section;
         let k0 = rod.spec.natural_curvature;
@@ -531,7 +570,7 @@ impl Workspace {
         let dk = kin.curvature - k0;
         let m_el = sec.bend_stiffness.component_mul(&dk);
         if outputs {
-            self.elastic_energy += 0.5 * t.weight * dk.dot(&m_el);
+            sums.0 += 0.5 * t.weight * dk.dot(&m_el);
         }
         let mut m = m_el;
         let mut viscous = None;
@@ -539,7 +578,7 @@ impl Workspace {
             let (omega_a, omega_b) = (r.omega(t.a), r.omega(t.b));
             let kd = kin.rate(&omega_a, &omega_b);
             let md = r.bend_damping.component_mul(&kd);
-            self.dissipation += t.weight * kd.dot(&md);
+            sums.1 += t.weight * kd.dot(&md);
             m += md;
             if want_jac {
                 viscous = Some(BendViscous {
