@@ -296,8 +296,8 @@ impl Workspace {
             let kinked = (s * s).simd_lt(splat(limit) * (s * s + nv));
             if kinked.any() {
                 // the one-element code, which reports the first kinked cell
-                for l in 0..4 {
-                    self.bend_term(rod, st, rates, false, i[l], outputs, sums)?;
+                for &i in &i {
+                    self.bend_term(rod, st, rates, false, i, outputs, sums)?;
                 }
                 k += 4;
                 continue;
@@ -443,11 +443,10 @@ mod tests {
     fn state(rod: &Rod, rng: &mut Rng) -> State {
         let mut st = route(rod, None).unwrap();
         st.x.iter_mut().for_each(|x| *x += rng.vec(2e-3));
-        st.p.iter_mut()
-            .for_each(|p| *p = *p * exp_half(&rng.vec(0.2)));
+        st.p.iter_mut().for_each(|p| *p *= exp_half(&rng.vec(0.2)));
         st.ghost
             .iter_mut()
-            .for_each(|p| *p = *p * exp_half(&rng.vec(0.2)));
+            .for_each(|p| *p *= exp_half(&rng.vec(0.2)));
         st
     }
 
