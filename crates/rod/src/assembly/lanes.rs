@@ -127,16 +127,10 @@ impl V3 {
         }
     }
 
-    fn lane(&self, l: usize) -> Vector3<f64> {
-        Vector3::new(
-            self.x.to_array()[l],
-            self.y.to_array()[l],
-            self.z.to_array()[l],
-        )
-    }
-
+    #[inline(always)]
     fn lanes(&self) -> [Vector3<f64>; 4] {
-        std::array::from_fn(|l| self.lane(l))
+        let (x, y, z) = (self.x.to_array(), self.y.to_array(), self.z.to_array());
+        std::array::from_fn(|l| Vector3::new(x[l], y[l], z[l]))
     }
 }
 
@@ -193,6 +187,24 @@ impl Workspace {
         outputs: bool,
         sums: &mut (f64, f64),
     ) {
+        // one loop per case, without its branches
+        match (rates.is_some(), outputs) {
+            (true, true) => self.shear_lanes::<true, true>(rod, st, rates, edges, sums),
+            (true, false) => self.shear_lanes::<true, false>(rod, st, rates, edges, sums),
+            (false, true) => self.shear_lanes::<false, true>(rod, st, rates, edges, sums),
+            (false, false) => self.shear_lanes::<false, false>(rod, st, rates, edges, sums),
+        }
+    }
+
+    fn shear_lanes<const RATES: bool, const OUTPUTS: bool>(
+        &mut self,
+        rod: &Rod,
+        st: &State,
+        rates: Option<&Rates>,
+        edges: Elements,
+        sums: &mut (f64, f64),
+    ) {
+        let outputs = OUTPUTS;
         let n = edges.len();
         let full = n - n % 4;
         let sec = &rod.spec.section;
@@ -220,7 +232,7 @@ impl Workspace {
             let energy = outputs.then(|| (splat(0.5) * ds * strain.dot(f_el)).to_array());
             let mut f = f_el;
             let mut dissipated = None;
-            if let Some(rt) = rates {
+            if let Some(rt) = rates.filter(|_| RATES) {
                 let va = V3::gather(|l| rt.v[e[l]].fixed_rows::<3>(0).into());
                 let vb = V3::gather(|l| rt.v[e[l] + 1].fixed_rows::<3>(0).into());
                 let omega = V3::gather(|l| rt.v[e[l]].fixed_rows::<3>(3).into());
@@ -267,6 +279,23 @@ impl Workspace {
         outputs: bool,
         sums: &mut (f64, f64),
     ) -> Result<(), KinkAt> {
+        match (rates.is_some(), outputs) {
+            (true, true) => self.bend_lanes::<true, true>(rod, st, rates, terms, sums),
+            (true, false) => self.bend_lanes::<true, false>(rod, st, rates, terms, sums),
+            (false, true) => self.bend_lanes::<false, true>(rod, st, rates, terms, sums),
+            (false, false) => self.bend_lanes::<false, false>(rod, st, rates, terms, sums),
+        }
+    }
+
+    fn bend_lanes<const RATES: bool, const OUTPUTS: bool>(
+        &mut self,
+        rod: &Rod,
+        st: &State,
+        rates: Option<&Rates>,
+        terms: Elements,
+        sums: &mut (f64, f64),
+    ) -> Result<(), KinkAt> {
+        let outputs = OUTPUTS;
         let n = terms.len();
         let sec = &rod.spec.section;
         let k0 = rod.spec.natural_curvature;
@@ -315,7 +344,7 @@ impl Workspace {
             let energy = outputs.then(|| (splat(0.5) * w * dk.dot(m_el)).to_array());
             let mut m = m_el;
             let mut dissipated = None;
-            if let Some(rt) = rates {
+            if let Some(rt) = rates.filter(|_| RATES) {
                 let oa = V3::gather(|l| rt.omega(t[l].a));
                 let ob = V3::gather(|l| rt.omega(t[l].b));
                 // BendKinematics::rate
