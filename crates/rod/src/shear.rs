@@ -5,6 +5,7 @@
 //! the Hessian is the exact second derivative in these coordinates (symmetric).
 use crate::rotation::{rotation_matrix, skew, Quat};
 use nalgebra::{Matrix3, Vector3};
+use wide::f64x4;
 
 /// Value, gradient and Hessian of one shear element.
 #[derive(Clone, Debug, Default)]
@@ -76,6 +77,9 @@ impl Extreme {
 /// Axial strain Γ₃ and shear strain |(Γ₁, Γ₂)| of every edge at one saved step: positions
 /// `x` (N + 1, 3) and quaternions `p` (N, 4, scalar first, any length) row-major, `inv_ds`
 /// 1/Δs per edge (N), into `axial` and `shear` (N).
+///
+/// Four edges at a time in f64x4 lanes (`wide`), each lane with the operations of
+/// `saved_strain` in its order: the same values to the last bit.
 pub fn saved_step_strains(
     x: &[f64],
     p: &[f64],
@@ -83,8 +87,34 @@ pub fn saved_step_strains(
     axial: &mut [f64],
     shear: &mut [f64],
 ) {
-    let strains = inv_ds.iter().zip(axial.iter_mut().zip(shear));
-    for (e, (inv, (ax, sh))) in strains.enumerate() {
+    let n = inv_ds.len();
+    let full = n - n % 4;
+    for e0 in (0..full).step_by(4) {
+        let lanes = |f: &dyn Fn(usize) -> f64| f64x4::new([f(0), f(1), f(2), f(3)]);
+        let w = lanes(&|l| p[4 * (e0 + l)]);
+        let (ux, uy, uz) = (
+            lanes(&|l| p[4 * (e0 + l) + 1]),
+            lanes(&|l| p[4 * (e0 + l) + 2]),
+            lanes(&|l| p[4 * (e0 + l) + 3]),
+        );
+        let inv = lanes(&|l| inv_ds[e0 + l]);
+        let k = f64x4::splat(2.0) / (w * w + (ux * ux + uy * uy + uz * uz));
+        let d = |i: usize| {
+            (lanes(&|l| x[3 * (e0 + l + 1) + i]) - lanes(&|l| x[3 * (e0 + l) + i])) * inv
+        };
+        let (vx, vy, vz) = (d(0), d(1), d(2));
+        // c = u × v, then u × c
+        let (cx, cy, cz) = (uy * vz - uz * vy, uz * vx - ux * vz, ux * vy - uy * vx);
+        let (ex, ey, ez) = (uy * cz - uz * cy, uz * cx - ux * cz, ux * cy - uy * cx);
+        // v + k (u × c − w c) − e₃ (x − 0 is x to the last bit)
+        let gx = vx + k * (ex - w * cx);
+        let gy = vy + k * (ey - w * cy);
+        let gz = vz + k * (ez - w * cz) - f64x4::splat(1.0);
+        axial[e0..e0 + 4].copy_from_slice(&gz.to_array());
+        shear[e0..e0 + 4].copy_from_slice(&(gx * gx + gy * gy).sqrt().to_array());
+    }
+    let tail = inv_ds.iter().zip(axial.iter_mut().zip(shear)).enumerate();
+    for (e, (inv, (ax, sh))) in tail.skip(full) {
         let at = |i: usize| Vector3::new(x[3 * i], x[3 * i + 1], x[3 * i + 2]);
         let q = &p[4 * e..4 * e + 4];
         let g = saved_strain(
@@ -127,10 +157,31 @@ pub fn saved_strain_extremes(
         let x = &positions[k * 3 * (n + 1)..(k + 1) * 3 * (n + 1)];
         let p = &quaternions[k * 4 * n..(k + 1) * 4 * n];
         saved_step_strains(x, p, inv_ds, &mut axial, &mut shear);
-        for (e, (a, s)) in axial.iter().zip(&shear).enumerate() {
-            Extreme::offer(&mut best[0], *a, k, e);
-            Extreme::offer(&mut best[1], -a, k, e);
-            Extreme::offer(&mut best[2], *s, k, e);
+        // each scan only where one of the step's values could be taken (`Extreme::offer`:
+        // none yet, or above the largest so far, or a NaN — unless that is a NaN already)
+        let open = |b: &Option<Extreme>, values: &mut dyn Iterator<Item = f64>| match b {
+            None => true,
+            Some(b) => {
+                !b.value.is_nan() && values.fold(false, |any, v| any | (v > b.value || v.is_nan()))
+            }
+        };
+        if open(&best[0], &mut axial.iter().copied()) {
+            axial
+                .iter()
+                .enumerate()
+                .for_each(|(e, a)| Extreme::offer(&mut best[0], *a, k, e));
+        }
+        if open(&best[1], &mut axial.iter().map(|a| -a)) {
+            axial
+                .iter()
+                .enumerate()
+                .for_each(|(e, a)| Extreme::offer(&mut best[1], -a, k, e));
+        }
+        if open(&best[2], &mut shear.iter().copied()) {
+            shear
+                .iter()
+                .enumerate()
+                .for_each(|(e, s)| Extreme::offer(&mut best[2], *s, k, e));
         }
     }
     match best {
@@ -377,6 +428,91 @@ mod tests {
         }
         assert_eq!(saved_strain_extremes(&[], &[], &inv), None);
         assert_eq!(saved_strain_extremes(&[0.0; 3], &[], &[]), None);
+    }
+
+    /// Random saved steps: positions (T, N + 1, 3) along z with noise, quaternions of any
+    /// length; the stretch grows with the step (the extremes move).
+    fn random_steps(steps: usize, n: usize, seed: u64) -> (Vec<f64>, Vec<f64>) {
+        let mut s = seed;
+        let mut rnd = || {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((s >> 11) as f64 / (1u64 << 53) as f64) - 0.5
+        };
+        let (mut x, mut q) = (vec![], vec![]);
+        for k in 0..steps {
+            let mut p = Vector3::zeros();
+            x.extend_from_slice(p.as_slice());
+            for _ in 0..n {
+                let stretch = 1.0 + 0.01 * k as f64 * rnd();
+                p += Vector3::new(0.01 * rnd(), 0.01 * rnd(), 0.1 * stretch);
+                x.extend_from_slice(p.as_slice());
+                q.extend_from_slice(&[1.0 + 0.01 * rnd(), 0.01 * rnd(), 0.01 * rnd(), rnd()]);
+            }
+        }
+        (x, q)
+    }
+
+    /// The lanes of four edges give `saved_strain`'s values to the last bit (41 edges: ten
+    /// blocks and a tail).
+    #[test]
+    fn step_strains_in_lanes_are_saved_strain_bit_for_bit() {
+        let n = 41;
+        let (x, q) = random_steps(1, n, 5);
+        let inv: Vec<f64> = (0..n).map(|e| 10.0 + 0.1 * e as f64).collect();
+        let (mut axial, mut shear) = (vec![0.0; n], vec![0.0; n]);
+        saved_step_strains(&x, &q, &inv, &mut axial, &mut shear);
+        for e in 0..n {
+            let at = |i: usize| Vector3::new(x[3 * i], x[3 * i + 1], x[3 * i + 2]);
+            let u = Vector3::new(q[4 * e + 1], q[4 * e + 2], q[4 * e + 3]);
+            let g = saved_strain(&at(e), &at(e + 1), q[4 * e], &u, inv[e]);
+            assert_eq!(axial[e].to_bits(), g.z.to_bits(), "edge {e}");
+            let s = (g.x * g.x + g.y * g.y).sqrt();
+            assert_eq!(shear[e].to_bits(), s.to_bits(), "edge {e}");
+        }
+    }
+
+    /// The scan skips a step's offers only where none could be taken: the extremes of every
+    /// value offered, with and without a NaN late in the run.
+    #[test]
+    fn strain_extremes_equal_offering_every_value() {
+        let (steps, n) = (30, 13);
+        let (mut x, q) = random_steps(steps, n, 9);
+        let inv = vec![10.0; n];
+        for nan in [false, true] {
+            if nan {
+                x[(25 * (n + 1) + 7) * 3 + 2] = f64::NAN;
+            }
+            let mut all = [None; 3];
+            let (mut axial, mut shear) = (vec![0.0; n], vec![0.0; n]);
+            for k in 0..steps {
+                let xs = &x[k * 3 * (n + 1)..(k + 1) * 3 * (n + 1)];
+                saved_step_strains(
+                    xs,
+                    &q[k * 4 * n..(k + 1) * 4 * n],
+                    &inv,
+                    &mut axial,
+                    &mut shear,
+                );
+                for e in 0..n {
+                    Extreme::offer(&mut all[0], axial[e], k, e);
+                    Extreme::offer(&mut all[1], -axial[e], k, e);
+                    Extreme::offer(&mut all[2], shear[e], k, e);
+                }
+            }
+            let got = saved_strain_extremes(&x, &q, &inv).unwrap();
+            for (g, a) in got.iter().zip(all) {
+                let a = a.unwrap();
+                assert_eq!((g.step, g.edge), (a.step, a.edge));
+                assert_eq!(g.value.to_bits(), a.value.to_bits());
+            }
+            assert!(
+                got[0].step > 0 && got[2].step > 0,
+                "the extremes moved: {got:?}"
+            );
+            assert_eq!(got[0].value.is_nan(), nan);
+        }
     }
 
     #[test]
