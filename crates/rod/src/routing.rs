@@ -229,70 +229,33 @@ impl SpanCurve {
             sag: n * beta,
         };
         let lmax = chord.max(1e-3 * span);
-        let length0 = make(lmax, 0.0).length();
-        if length0 >= span {
-            let lambda = increasing_root(
-                |l| make(l, 0.0).length() - span,
-                (0.0, chord - span),
-                (lmax, length0 - span),
-                span,
-            );
-            return make(lambda, 0.0);
+        if make(lmax, 0.0).length() >= span {
+            let (mut lo, mut hi) = (0.0, lmax);
+            for _ in 0..60 {
+                let mid = 0.5 * (lo + hi);
+                if make(mid, 0.0).length() < span {
+                    lo = mid
+                } else {
+                    hi = mid
+                }
+            }
+            return make(0.5 * (lo + hi), 0.0);
         }
         let mut hi = span;
-        let mut g_hi = make(lmax, hi).length() - span;
-        while g_hi < 0.0 {
+        while make(lmax, hi).length() < span {
             hi *= 2.0;
-            g_hi = make(lmax, hi).length() - span;
         }
-        let beta = increasing_root(
-            |b| make(lmax, b).length() - span,
-            (0.0, length0 - span),
-            (hi, g_hi),
-            span,
-        );
-        make(lmax, beta)
-    }
-}
-
-/// The root of the increasing function `g` between `lo` and `hi` (with g(lo) < 0 ≤ g(hi),
-/// given), by regula falsi with the Illinois halving: to |g| ≤ 1e-13 `scale` or an interval of
-/// round-off width, in ~10 evaluations where bisection to the same width takes ~55.
-fn increasing_root(
-    g: impl Fn(f64) -> f64,
-    (mut lo, mut g_lo): (f64, f64),
-    (mut hi, mut g_hi): (f64, f64),
-    scale: f64,
-) -> f64 {
-    let mut side = 0i8;
-    for _ in 0..100 {
-        let x = if g_hi > g_lo {
-            (lo - g_lo * (hi - lo) / (g_hi - g_lo)).clamp(lo, hi)
-        } else {
-            0.5 * (lo + hi)
-        };
-        if hi - lo <= 4.0 * f64::EPSILON * hi.abs() {
-            return x;
-        }
-        let gx = g(x);
-        if gx.abs() <= 1e-13 * scale {
-            return x;
-        }
-        if gx < 0.0 {
-            (lo, g_lo) = (x, gx);
-            if side == -1 {
-                g_hi *= 0.5;
+        let mut lo = 0.0;
+        for _ in 0..60 {
+            let mid = 0.5 * (lo + hi);
+            if make(lmax, mid).length() < span {
+                lo = mid
+            } else {
+                hi = mid
             }
-            side = -1;
-        } else {
-            (hi, g_hi) = (x, gx);
-            if side == 1 {
-                g_lo *= 0.5;
-            }
-            side = 1;
         }
+        make(lmax, 0.5 * (lo + hi))
     }
-    0.5 * (lo + hi)
 }
 
 /// The direction a slack span sags: along gravity, orthogonal to the chord; without gravity
