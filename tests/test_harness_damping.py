@@ -113,3 +113,43 @@ def test_harness_free_decay_shows_the_modal_damping_ratio():
     # The run says that this mode is hardly bending and what damping it gets.
     hints = [h for h in run_hints(scene, result) if "bending" in h]
     assert len(hints) == 3 and "only 9 % bending" in hints[0], hints
+
+
+class Recording:
+    """A solver object that records the tolerance its ``modes`` is asked for."""
+
+    def __init__(self, solver):
+        self.solver, self.asked = solver, []
+
+    def modes(self, *args, **kwargs):
+        self.asked.append(kwargs.get("tolerance"))
+        return self.solver.modes(*args, **kwargs)
+
+
+def test_calibration_tolerance_loosens_only_the_last_digits():
+    """The damping's calibration stops the modal iteration at a change of 1e-9 instead of
+    1e-11: ω₁ and ζ₁ as the full accuracy's to 1e-7, on a harness and on a single cable; a
+    tolerance outside (0, 1) is an error naming it."""
+    from cablelife.modal import CALIBRATION_TOLERANCE, _equilibrium
+    from cablelife.scene import load_scene
+
+    scene = load_scene(Path(__file__).parents[1] / "examples" / "harness" / "scene.toml")
+    core, cables, _, _ = harness_equilibrium(scene)
+    single, _ = _equilibrium(scene, scene.cables[0])
+    for solver, n in ((core, len(cables)), (single, None)):
+        taus = dict(shear_tau=[0.0] * 3, bend_tau=[1.0, 1.0, 0.0])
+        if n is not None:
+            taus = {k: [v] * n for k, v in taus.items()}
+        full = solver.modes(1, **taus)
+        quick = solver.modes(1, **taus, tolerance=CALIBRATION_TOLERANCE)
+        for key in ("omega", "damping_ratio"):
+            np.testing.assert_allclose(quick[key], full[key], rtol=1e-7, atol=0)
+        recording = Recording(solver)  # the calibration asks the solver for its tolerance
+        assert mode1_bending_damping(recording, n) == (
+            float(quick["omega"][0]),
+            float(quick["damping_ratio"][0]),
+        )
+        assert recording.asked == [CALIBRATION_TOLERANCE]
+        for bad in (0.0, 1.0, float("nan"), -1e-9):
+            with pytest.raises(ValueError, match=r"tolerance = .*allowed 0 < tolerance < 1"):
+                solver.modes(1, tolerance=bad)

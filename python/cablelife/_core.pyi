@@ -43,7 +43,7 @@ class Cable:
         Massless unknowns (swivel twists) have mass 0.
         """
         ...
-    def modes(self, count, shear_tau=None, bend_tau=None) -> Any:
+    def modes(self, count, shear_tau=None, bend_tau=None, tolerance=None) -> Any:
         """The `count` lowest natural modes about the state of the last run (a static
         equilibrium), by the banded shift-invert solver (`rod::modal`). Returns `omega` (k,)
         rad/s, `displacements` (k, N+1, 3) and `rotations` (k, N, 3) mass-normalised (global
@@ -51,7 +51,8 @@ class Cable:
         and `kind` (k,) names. With the Kelvin–Voigt retardation times `shear_tau` (GA₁, GA₂,
         EA) and `bend_tau` (EI₁, EI₂, GJ), s, also `damping_ratio` (k,): each mode's Rayleigh
         quotient φᵀCφ / (2ω φᵀMφ) with the damping matrix C of the section law
-        (`rod::modal::damping_ratio`). An unstable equilibrium is a ValueError.
+        (`rod::modal::damping_ratio`). An unstable equilibrium is a ValueError. `tolerance`:
+        the relative change of the eigenvalues at which the iteration stops (default 1e-11).
         """
         ...
     @property
@@ -173,7 +174,7 @@ class Harness:
         drags); the harness keeps its own copies otherwise.
         """
         ...
-    def modes(self, count, shear_tau=None, bend_tau=None) -> Any:
+    def modes(self, count, shear_tau=None, bend_tau=None, tolerance=None) -> Any:
         """The `count` lowest natural modes of the whole harness about the last step of
         `run_sequence` (a static equilibrium): shift-invert on the tree elimination
         (`rod::harness_modal`). Returns `omega` (k,) rad/s, `cables` (one dict per cable:
@@ -183,6 +184,7 @@ class Harness:
         ValueError. With per-cable Kelvin–Voigt retardation times `shear_tau` and `bend_tau`
         (one triple per cable, as `Cable.modes`), also `damping_ratio` (k,): each mode's
         Rayleigh quotient over the whole harness (`rod::harness_modal::harness_damping_ratio`).
+        `tolerance` as `Cable.modes`.
         """
         ...
     def run_dynamic(

@@ -69,6 +69,20 @@ impl Impacts {
     }
 }
 
+/// The modal solver's stopping tolerance of a `modes` call: `rod::modal::TOLERANCE` unless
+/// given; a ValueError outside 0 < tolerance < 1.
+pub(crate) fn modal_tolerance(tolerance: Option<f64>) -> PyResult<f64> {
+    match tolerance {
+        None => Ok(rod::modal::TOLERANCE),
+        Some(t) if t > 0.0 && t < 1.0 => Ok(t),
+        Some(t) => Err(PyValueError::new_err(format!(
+            "tolerance = {t}: allowed 0 < tolerance < 1 (the relative change of the eigenvalues \
+             at which the iteration stops; default {:e})",
+            rod::modal::TOLERANCE
+        ))),
+    }
+}
+
 /// Per-step outputs collected during a run (flat, row-major).
 #[derive(Default)]
 pub(crate) struct Record {
@@ -981,15 +995,18 @@ impl Cable {
     /// and `kind` (k,) names. With the Kelvin–Voigt retardation times `shear_tau` (GA₁, GA₂,
     /// EA) and `bend_tau` (EI₁, EI₂, GJ), s, also `damping_ratio` (k,): each mode's Rayleigh
     /// quotient φᵀCφ / (2ω φᵀMφ) with the damping matrix C of the section law
-    /// (`rod::modal::damping_ratio`). An unstable equilibrium is a ValueError.
-    #[pyo3(signature = (count, shear_tau=None, bend_tau=None))]
+    /// (`rod::modal::damping_ratio`). An unstable equilibrium is a ValueError. `tolerance`:
+    /// the relative change of the eigenvalues at which the iteration stops (default 1e-11).
+    #[pyo3(signature = (count, shear_tau=None, bend_tau=None, tolerance=None))]
     fn modes<'py>(
         &mut self,
         py: Python<'py>,
         count: usize,
         shear_tau: Option<[f64; 3]>,
         bend_tau: Option<[f64; 3]>,
+        tolerance: Option<f64>,
     ) -> PyResult<Bound<'py, PyDict>> {
+        let tolerance = modal_tolerance(tolerance)?;
         let st = self
             .state
             .as_ref()
@@ -998,7 +1015,7 @@ impl Cable {
         // About an equilibrium with contact: the contact stiffness in K.
         let contact = self.solver.contact.as_mut();
         let modes = py
-            .detach(|| rod::modal::lowest_modes_with_contact(rod, st, count, contact))
+            .detach(|| rod::modal::lowest_modes_with_contact(rod, st, count, contact, tolerance))
             .map_err(|e| PyValueError::new_err(e.to_string()))?;
         let k = modes.len();
         let (nodes, edges) = (rod.arc.len(), rod.n_edges());

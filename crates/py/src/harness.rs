@@ -332,14 +332,17 @@ impl Harness {
     /// ValueError. With per-cable Kelvin–Voigt retardation times `shear_tau` and `bend_tau`
     /// (one triple per cable, as `Cable.modes`), also `damping_ratio` (k,): each mode's
     /// Rayleigh quotient over the whole harness (`rod::harness_modal::harness_damping_ratio`).
-    #[pyo3(signature = (count, shear_tau=None, bend_tau=None))]
+    /// `tolerance` as `Cable.modes`.
+    #[pyo3(signature = (count, shear_tau=None, bend_tau=None, tolerance=None))]
     fn modes<'py>(
         &mut self,
         py: Python<'py>,
         count: usize,
         shear_tau: Option<Vec<[f64; 3]>>,
         bend_tau: Option<Vec<[f64; 3]>>,
+        tolerance: Option<f64>,
     ) -> PyResult<Bound<'py, PyDict>> {
+        let tolerance = crate::cable::modal_tolerance(tolerance)?;
         let nc = self.tree.cables.len();
         let taus = match (shear_tau, bend_tau) {
             (Some(ts), Some(tb)) if ts.len() != nc || tb.len() != nc => {
@@ -371,7 +374,7 @@ impl Harness {
             .detach(|| {
                 // A harness resting on the geometry: its contact stiffness is part of K.
                 let contact = solver.has_contact().then_some(&mut solver.contact);
-                harness_lowest_modes_with_contact(tree, st, count, contact)
+                harness_lowest_modes_with_contact(tree, st, count, contact, tolerance)
             })
             .map_err(|e| PyValueError::new_err(e.0))?;
         let k = modes.len();

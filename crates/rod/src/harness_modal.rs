@@ -378,7 +378,7 @@ pub fn harness_lowest_modes(
     st: &HarnessState,
     count: usize,
 ) -> Result<Vec<HarnessMode>, HarnessError> {
-    harness_lowest_modes_with_contact(h, st, count, None)
+    harness_lowest_modes_with_contact(h, st, count, None, crate::modal::TOLERANCE)
 }
 
 /// `harness_lowest_modes` with each cable's contact stiffness in K (`contact`: the solver's
@@ -390,6 +390,7 @@ pub fn harness_lowest_modes_with_contact(
     st: &HarnessState,
     count: usize,
     contact: Option<&mut Vec<Option<Contact>>>,
+    tolerance: f64,
 ) -> Result<Vec<HarnessMode>, HarnessError> {
     let describe = |e: ModalError| HarnessError(format!("modal analysis of the harness: {e}"));
     let mut sys = ModalSystem::new(h);
@@ -408,8 +409,14 @@ pub fn harness_lowest_modes_with_contact(
     }
     let count = count.clamp(1, massive);
     let scale = eigen_scale(p);
-    let ritz = lowest_pairs(&mut HarnessPencil { h, s: &mut sys }, count, massive, scale)
-        .map_err(describe)?;
+    let ritz = lowest_pairs(
+        &mut HarnessPencil { h, s: &mut sys },
+        count,
+        massive,
+        scale,
+        tolerance,
+    )
+    .map_err(describe)?;
     let p = &sys;
     let nc = p.offsets[h.cables.len()];
     Ok(ritz

@@ -138,9 +138,10 @@ impl fmt::Display for ModalError {
 }
 impl std::error::Error for ModalError {}
 
-/// Relative change of the Ritz values at which the iteration stops, and the change below
-/// which it stops when the changes no longer shrink (the round-off floor of the solves).
-const TOLERANCE: f64 = 1e-11;
+/// Relative change of the Ritz values at which the iteration stops (the default accuracy of
+/// the modal analysis), and the change below which it stops when the changes no longer shrink
+/// (the round-off floor of the solves).
+pub const TOLERANCE: f64 = 1e-11;
 const FLOOR: f64 = 1e-5;
 /// Steps of iterative refinement per refined solve (`ShiftInvert::apply`).
 pub(crate) const REFINEMENT_STEPS: usize = 2;
@@ -316,7 +317,7 @@ pub(crate) struct Ritz {
 
 /// Subspace iteration with `p` vectors from the start vectors `x` at shift σ (factored): plain
 /// solves until the Ritz values change by less than `PLAIN_TOLERANCE` (or stop shrinking),
-/// then refined ones until they change by less than `TOLERANCE`; only a refined iteration
+/// then refined ones until they change by less than `tolerance`; only a refined iteration
 /// ends it.
 fn subspace_iteration<P: ShiftInvert>(
     pencil: &mut P,
@@ -324,6 +325,7 @@ fn subspace_iteration<P: ShiftInvert>(
     mut x: Vec<Vec<Vector6<f64>>>,
     count: usize,
     iterations: &mut usize,
+    tolerance: f64,
 ) -> Option<Ritz> {
     let n = pencil.n();
     let p = x.len();
@@ -394,10 +396,10 @@ fn subspace_iteration<P: ShiftInvert>(
         } else {
             since_best += 1;
         }
-        let converged = change <= TOLERANCE || (since_best >= 6 && best <= FLOOR);
+        let converged = change <= tolerance || (since_best >= 6 && best <= FLOOR);
         old = values;
         if !refine {
-            if change <= PLAIN_TOLERANCE || since_best >= 3 {
+            if change <= PLAIN_TOLERANCE.max(tolerance) || since_best >= 3 {
                 (refine, best, since_best) = (true, f64::INFINITY, 0);
             }
             continue;
@@ -414,17 +416,20 @@ fn subspace_iteration<P: ShiftInvert>(
 
 /// The `count` lowest modes of the cable at the equilibrium `st`.
 pub fn lowest_modes(rod: &Rod, st: &State, count: usize) -> Result<Vec<Mode>, ModalError> {
-    lowest_modes_with_contact(rod, st, count, None)
+    lowest_modes_with_contact(rod, st, count, None, TOLERANCE)
 }
 
 /// `lowest_modes` about an equilibrium in contact with the surroundings: K takes the contact
 /// term's stiffness (`tangent_stiffness_with_contact`), so a cable resting on a surface is an
-/// equilibrium of K (without it the carried part is unsupported).
+/// equilibrium of K (without it the carried part is unsupported). `tolerance`: the relative
+/// change of the eigenvalues at which the iteration stops (`TOLERANCE` for the modal analysis;
+/// a looser one where fewer digits serve, as the default damping's calibration).
 pub fn lowest_modes_with_contact(
     rod: &Rod,
     st: &State,
     count: usize,
     contact: Option<&mut Contact>,
+    tolerance: f64,
 ) -> Result<Vec<Mode>, ModalError> {
     let mass = lumped_mass(rod);
     let m = mass.clone();
@@ -480,7 +485,7 @@ pub fn lowest_modes_with_contact(
         k,
         m,
     };
-    let ritz = lowest_pairs(&mut pencil, count, massive, scale)?;
+    let ritz = lowest_pairs(&mut pencil, count, massive, scale, tolerance)?;
     Ok((0..count)
         .map(|i| {
             let shape = ritz.vectors[i]
@@ -501,6 +506,7 @@ pub(crate) fn lowest_pairs<P: ShiftInvert>(
     count: usize,
     massive: usize,
     scale: f64,
+    tolerance: f64,
 ) -> Result<Ritz, ModalError> {
     // Stability: the inertia of K (shifted below a zero mode if K is singular).
     let (sigma, negative) = pencil.factor_near(0.0, 1e-12 * scale);
@@ -518,7 +524,7 @@ pub(crate) fn lowest_pairs<P: ShiftInvert>(
                 .collect();
             start.push(v);
         }
-        let ritz = subspace_iteration(pencil, sigma, start, count, &mut iterations)
+        let ritz = subspace_iteration(pencil, sigma, start, count, &mut iterations, tolerance)
             .ok_or(ModalError::NotConverged { iterations })?;
         let top = ritz.values[..count]
             .iter()

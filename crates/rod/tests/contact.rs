@@ -1229,7 +1229,14 @@ fn modes_on_a_table_are_the_horizontal_beam_modes() {
         let tip = pose([l, 0.0, z0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]);
         spec.clips.push(clip("tip", l, 0.0, ClipKind::Fixed, tip));
         let (rod, st, mut s) = solved_on_a_table(spec, r, z0);
-        let with = rod::modal::lowest_modes_with_contact(&rod, &st, 2, s.contact.as_mut()).unwrap();
+        let with = rod::modal::lowest_modes_with_contact(
+            &rod,
+            &st,
+            2,
+            s.contact.as_mut(),
+            rod::modal::TOLERANCE,
+        )
+        .unwrap();
         let without = rod::modal::lowest_modes(&rod, &st, 2).unwrap();
         let horizontal = |m: &rod::modal::Mode| {
             let u = m.displacements(&rod);
