@@ -22,7 +22,9 @@ use crate::contraction::{Contraction, Tolerance};
 use crate::impact::take_gain;
 use crate::model::{EdgeKind, NodeKind, Pose, Rod, Segment};
 use crate::predictor::Extrapolation;
-use crate::rotation::{log_vec, right_jacobian, rotate_body, rotation_matrix, skew, slerp, Quat};
+use crate::rotation::{
+    log_vec, right_jacobian, rotate_body, rotate_edges, rotation_matrix, skew, slerp, Quat,
+};
 use crate::sliding::SlidingClips;
 use crate::state::State;
 use crate::statics::SolveError;
@@ -326,6 +328,9 @@ pub struct Dynamics {
     pub(crate) inertial: Vec<[bool; 6]>,
     /// Per block: whether the node and the edge have inertia.
     inertial_half: Vec<[bool; 2]>,
+    /// Per edge: its rotation's turn h Δθ in the step (scratch of `apply_correction` and
+    /// `predicted_kinematics`, which then turn the edges four at a time: `rotate_edges`).
+    turn: Vec<Vector3<f64>>,
     /// Δq = dq0 + k_dq v̇, v = v0 + k_v v̇, a = a0 + k_a v̇ during a step.
     dq0: Vec<Vector6<f64>>,
     v0: Vec<Vector6<f64>>,
@@ -410,6 +415,7 @@ impl Dynamics {
             a_n: vec![Vector6::zeros(); n + 1],
             delta: vec![Vector6::zeros(); n + 1],
             inertial_half: inertial.iter().map(|m| [m[0], m[3]]).collect(),
+            turn: vec![Vector3::zeros(); n],
             inertial,
             dq0: vec![Vector6::zeros(); n + 1],
             v0: vec![Vector6::zeros(); n + 1],
@@ -1144,7 +1150,7 @@ impl Dynamics {
             .zip(&mut self.rates.v[r.clone()])
             .zip(&mut st.x[r.clone()])
             .zip(&self.x_n[r.clone()]);
-        let mut edges = st.p[re.clone()].iter_mut().zip(&self.p_n[re]);
+        let mut edges = self.turn[re.clone()].iter_mut();
         for (((((((half, vdot), vd_n), dq0), v0), v), x), x_n) in blocks {
             let dq = dq0 + k_dq * vdot;
             let vel = v0 + k_v * vdot;
@@ -1156,17 +1162,24 @@ impl Dynamics {
                 dx_max = dx_max.max(dx.amax());
                 ex = ex.max(d.fixed_rows::<3>(0).amax());
             }
-            let Some((p, p_n)) = edges.next() else {
+            let Some(turn) = edges.next() else {
                 break;
             };
             if half[1] {
                 v.fixed_rows_mut::<3>(3).copy_from(&vel.fixed_rows::<3>(3));
                 let dth: Vector3<f64> = h * dq.fixed_rows::<3>(3);
-                *p = rotate_body(p_n, &dth);
+                *turn = dth;
                 dth_max = dth_max.max(dth.amax());
                 eth = eth.max(d.fixed_rows::<3>(3).amax());
             }
         }
+        let half = &self.inertial_half[re.clone()];
+        rotate_edges(
+            &self.p_n[re.clone()],
+            &self.turn[re.clone()],
+            |e| half[e][1],
+            &mut st.p[re],
+        );
         let error = self.error_estimate(ex, eth);
         ((dx_max / self.length).max(dth_max), error)
     }
@@ -1209,26 +1222,31 @@ impl Dynamics {
             }
         }
         let re = r.start..r.end.min(st.p.len());
-        for ((((((((half, d), vdot), dq0), v0), v), p), p_n), vd_n) in self.inertial_half
-            [re.clone()]
-        .iter()
-        .zip(&self.delta[re.clone()])
-        .zip(&mut self.vdot[re.clone()])
-        .zip(&self.dq0[re.clone()])
-        .zip(&self.v0[re.clone()])
-        .zip(&mut self.rates.v[re.clone()])
-        .zip(&mut st.p[re.clone()])
-        .zip(&self.p_n[re.clone()])
-        .zip(&self.vdot_n[re.clone()])
+        for (((((((half, d), vdot), dq0), v0), v), turn), vd_n) in self.inertial_half[re.clone()]
+            .iter()
+            .zip(&self.delta[re.clone()])
+            .zip(&mut self.vdot[re.clone()])
+            .zip(&self.dq0[re.clone()])
+            .zip(&self.v0[re.clone()])
+            .zip(&mut self.rates.v[re.clone()])
+            .zip(&mut self.turn[re.clone()])
+            .zip(&self.vdot_n[re.clone()])
         {
             if half[1] {
                 let (dq, e) = correct_slots(3, (c_mass, k_dq, k_v), d, vdot, dq0, v0, v, vd_n);
                 eth = eth.max(e);
                 let dth = h * dq;
-                *p = rotate_body(p_n, &dth);
+                *turn = dth;
                 dth_max = dth_max.max(dth.amax());
             }
         }
+        let half = &self.inertial_half[re.clone()];
+        rotate_edges(
+            &self.p_n[re.clone()],
+            &self.turn[re.clone()],
+            |e| half[e][1],
+            &mut st.p[re],
+        );
         self.apply_massless(rod, st, seg);
         let error = self.error_estimate(ex, eth);
         ((dx_max / self.length).max(dth_max), error)
