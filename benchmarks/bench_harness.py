@@ -187,7 +187,7 @@ def main() -> None:
     print(f"{'  × real time (simulate() CPU)':<34} {cpu[0]:>12.2f} {cpu[1]:>14.2f}")
     print(f"{'  Newton iterations per step':<34} {med(hd, 2):>12.2f} {med(sd, 2):>14.2f}")
     if LONG > 0:
-        # the steady rate a user sees: the whole call's set-up (≈ 27 ms: static start, modal
+        # the steady rate a user sees: the whole call's set-up (≈ 14 ms: static start, modal
         # analysis for the default damping, kinematics, checks) spread over a longer run
         hl_scene = scene_from_dict(scene("dynamic", LONG))
         sl_scene = scene_from_dict(single("dynamic", LONG))
