@@ -540,8 +540,6 @@ pub(crate) fn lowest_pairs<P: ShiftInvert>(
             ritz.values[p - 1] + 1e-6 * top
         };
         let (_, below) = pencil.factor_near(cut, 1e-10 * cut.abs().max(1e-3 * top));
-        // restore the factorisation at σ for a further attempt
-        let _ = pencil.factor(sigma);
         if below == found {
             if negative > 0 && ritz.values[0] < -ZERO_MODE * top {
                 return Err(ModalError::Unstable {
@@ -556,7 +554,8 @@ pub(crate) fn lowest_pairs<P: ShiftInvert>(
             values.iter_mut().for_each(|v| *v = v.max(0.0));
             return Ok(Ritz { values, vectors });
         }
-        // a mode was missed: enlarge the subspace, keep the Ritz vectors
+        // a mode was missed: enlarge the subspace, keep the Ritz vectors, and factor at σ again
+        let _ = pencil.factor(sigma);
         start = ritz.vectors;
         p = (p + count + 8).min(massive);
     }
