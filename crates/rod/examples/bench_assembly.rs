@@ -1,7 +1,10 @@
 //! Cost of the pieces of one Newton iteration at N segments (run with
-//! `cargo run --release -p cablelife-rod --example bench_assembly -- 100`).
-use nalgebra::{Quaternion, Vector3, Vector6};
-use rod::assembly::Workspace;
+//! `cargo run --release -p cablelife-rod --example bench_assembly -- 100`); with the rates of a
+//! dynamic step also the residual alone and with the section outputs (the outputs pass),
+//! the shear and bending terms' four-lane kernels (docs/dynamics.md, session 20).
+use nalgebra::{Matrix3, Quaternion, Vector3, Vector6};
+use rod::assembly::{Part, Rates, Workspace};
+use rod::rotation::exp_half;
 use rod::routing::route;
 use rod::{CableSpec, ClipKind, ClipSpec, Pose, Rod, Section};
 use std::time::Instant;
@@ -56,6 +59,33 @@ fn main() {
     time("assembly with Jacobian", &mut || {
         ws.assemble_static(&rod, &st, 1.0, true).unwrap()
     });
+    // A dynamic step's elastic residual: a bent state with velocities and viscous damping.
+    let mut bent = st.clone();
+    for (k, p) in bent.p.iter_mut().enumerate() {
+        *p *= exp_half(&Vector3::new(0.01 * (k as f64).sin(), 0.02, 0.0));
+    }
+    let rates = Rates {
+        v: (0..n + 1)
+            .map(|k| Vector6::from_fn(|i, _| ((k * 6 + i) as f64).sin()))
+            .collect(),
+        ghost_omega: vec![Vector3::zeros(); rod.ghosts.len()],
+        shear_damping: Vector3::new(3.0, 4.0, 5.0),
+        bend_damping: Vector3::new(2e-3, 3e-3, 1e-3),
+        damping_factor: 0.0,
+        tangent: Vec::<Matrix3<f64>>::new(),
+    };
+    for (label, outputs) in [
+        ("elastic residual, rates", false),
+        ("the same with outputs", true),
+    ] {
+        ws.section_outputs = outputs;
+        time(label, &mut || {
+            ws.clear(false);
+            ws.add_elastic_part(&rod, &bent, Some(&rates), false, Part::All)
+                .unwrap()
+        });
+    }
+    ws.section_outputs = true;
     let mut jac = ws.jac.clone();
     time("block LU factorisation", &mut || jac.factor().unwrap());
     let mut rhs = vec![Vector6::repeat(1.0); n + 1];

@@ -298,9 +298,11 @@ impl ShiftInvert for Pencil {
     }
 }
 
-struct Rng(u64);
+/// A linear congruential generator of values in [−0.5, 0.5): the modal solver's start vectors
+/// (deterministic runs) and the random inputs of the crate's tests.
+pub(crate) struct Rng(pub(crate) u64);
 impl Rng {
-    fn next(&mut self) -> f64 {
+    pub(crate) fn next(&mut self) -> f64 {
         self.0 = self
             .0
             .wrapping_mul(6364136223846793005)

@@ -266,13 +266,8 @@ mod tests {
     /// and not (1/√|q|²).
     #[test]
     fn rotate_edges_is_rotate_body_bit_for_bit() {
-        let mut seed = 23u64;
-        let mut rnd = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
-        };
+        let mut rng = crate::modal::Rng(23);
+        let mut rnd = || rng.next();
         let n = 43;
         let p_n: Vec<Quat> = (0..n)
             .map(|e| {

@@ -508,13 +508,8 @@ mod length_tests {
     /// with and without sag, short and long, and through the fit's brackets.
     #[test]
     fn length_in_lanes_is_the_pointwise_length_bit_for_bit() {
-        let mut seed = 17u64;
-        let mut rnd = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
-        };
+        let mut rng = crate::modal::Rng(17);
+        let mut rnd = || rng.next();
         for k in 0..50 {
             let scale = [1e-3, 0.3, 2.0, 40.0][k % 4];
             let mut v = || Vector3::new(rnd(), rnd(), rnd()) * scale;

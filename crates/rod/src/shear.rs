@@ -433,13 +433,8 @@ mod tests {
     /// Random saved steps: positions (T, N + 1, 3) along z with noise, quaternions of any
     /// length; the stretch grows with the step (the extremes move).
     fn random_steps(steps: usize, n: usize, seed: u64) -> (Vec<f64>, Vec<f64>) {
-        let mut s = seed;
-        let mut rnd = || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((s >> 11) as f64 / (1u64 << 53) as f64) - 0.5
-        };
+        let mut rng = crate::modal::Rng(seed);
+        let mut rnd = || rng.next();
         let (mut x, mut q) = (vec![], vec![]);
         for k in 0..steps {
             let mut p = Vector3::zeros();

@@ -403,23 +403,15 @@ impl Workspace {
 mod tests {
     use super::*;
     use crate::assembly::Part;
+    use crate::modal::Rng;
     use crate::model::{CableSpec, ClipKind, ClipSpec, Pose, Section};
     use crate::rotation::{exp_half, Quat};
     use crate::routing::route;
     use nalgebra::{Matrix3, Vector6};
 
-    struct Rng(u64);
-    impl Rng {
-        fn next(&mut self) -> f64 {
-            self.0 = self
-                .0
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((self.0 >> 11) as f64 / (1u64 << 53) as f64) - 0.5
-        }
-        fn vec(&mut self, scale: f64) -> Vector3<f64> {
-            Vector3::new(self.next(), self.next(), self.next()) * scale
-        }
+    /// A random vector of entries in [−scale/2, scale/2).
+    fn vec(rng: &mut Rng, scale: f64) -> Vector3<f64> {
+        Vector3::new(rng.next(), rng.next(), rng.next()) * scale
     }
 
     fn clip(name: &str, s: f64, length: f64, kind: ClipKind, x: f64) -> ClipSpec {
@@ -471,11 +463,11 @@ mod tests {
     /// The routed state moved off it at random (positions by ~1 mm, rotations by ~0.1 rad).
     fn state(rod: &Rod, rng: &mut Rng) -> State {
         let mut st = route(rod, None).unwrap();
-        st.x.iter_mut().for_each(|x| *x += rng.vec(2e-3));
-        st.p.iter_mut().for_each(|p| *p *= exp_half(&rng.vec(0.2)));
+        st.x.iter_mut().for_each(|x| *x += vec(rng, 2e-3));
+        st.p.iter_mut().for_each(|p| *p *= exp_half(&vec(rng, 0.2)));
         st.ghost
             .iter_mut()
-            .for_each(|p| *p *= exp_half(&rng.vec(0.2)));
+            .for_each(|p| *p *= exp_half(&vec(rng, 0.2)));
         st
     }
 
@@ -484,7 +476,7 @@ mod tests {
             v: (0..rod.n_edges() + 1)
                 .map(|_| Vector6::from_fn(|_, _| rng.next()))
                 .collect(),
-            ghost_omega: (0..rod.ghosts.len()).map(|_| rng.vec(1.0)).collect(),
+            ghost_omega: (0..rod.ghosts.len()).map(|_| vec(rng, 1.0)).collect(),
             shear_damping: Vector3::new(3.0, 4.0, 5.0),
             bend_damping: Vector3::new(2e-3, 3e-3, 1e-3),
             damping_factor: 0.0,
@@ -503,7 +495,7 @@ mod tests {
             .chain(&mut ws.node_moment)
             .chain(&mut ws.node_moment_viscous)
         {
-            *v = rng.vec(1.0);
+            *v = vec(rng, 1.0);
         }
         ws.outputs_only = outputs_only;
         ws
