@@ -235,8 +235,8 @@ def uses_mode1(cable: Cable) -> bool:
 
 
 #: The modal solver's stopping tolerance for the damping's calibration on mode 1: ω₁ and ζ₁
-#: to about 1e-9 instead of the modal analysis's 1e-11 (fewer refined iterations: the
-#: harness benchmark's calibration 3.4 → 2.4 ms; τ changes by ~1e-9 of itself).
+#: to about 1e-8 instead of the modal analysis's 1e-11 (fewer refined iterations and a smaller
+#: subspace: the harness benchmark's calibration 3.4 → 1.3 ms; τ changes by ~1e-8 of itself).
 CALIBRATION_TOLERANCE = 1e-9
 
 
