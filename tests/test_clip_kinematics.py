@@ -37,3 +37,39 @@ def test_a_translating_body_gives_the_general_formulas_values(scene_dict):
     for key in fast:
         assert np.array_equal(fast[key], slow[key]), key
     assert fast["positions"][:, 1:].std(axis=0).min() > 1e-5  # both clips move with the body
+
+
+def test_few_frames_convert_as_the_array_code_bit_for_bit():
+    """Up to ``SMALL`` matrices are converted one by one in Python floats: the same
+    quaternions to the last bit as the array code, on every branch of Shepperd's method
+    (random rotations, ones near the degenerate branches, exact ties)."""
+    from cablelife import rotations
+
+    rng = np.random.default_rng(1)
+    for trial in range(2000):
+        q = rng.normal(size=(int(rng.integers(1, rotations.SMALL + 1)), 4))
+        if trial % 7 == 0:
+            q[:, trial % 4] *= 1e-9
+        q /= np.linalg.norm(q, axis=1, keepdims=True)
+        w, x, y, z = q.T
+        m = np.stack(
+            [
+                np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
+                np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
+                np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1),
+            ],
+            -2,
+        )
+        small = rotations.matrix_quaternions(m)
+        assert small.tobytes() == rotations._matrix_quaternions_arrays(m).tobytes(), trial
+        np.testing.assert_allclose(np.abs(np.sum(small * q, axis=1)), 1.0, atol=1e-12)
+    # 170° about (1, 1, 0.1): the equal first two diagonal entries are the largest (a tie:
+    # the first is taken, as numpy's argmax takes it)
+    n = np.array([1.0, 1.0, 0.1]) / np.linalg.norm([1.0, 1.0, 0.1])
+    c, s = np.cos(np.radians(170.0)), np.sin(np.radians(170.0))
+    k = np.array([[0.0, -n[2], n[1]], [n[2], 0.0, -n[0]], [-n[1], n[0], 0.0]])
+    tie = c * np.eye(3) + s * k + (1 - c) * np.outer(n, n)
+    assert tie[0, 0] == tie[1, 1] == max(np.diag(tie).max(), np.trace(tie))
+    for m in (np.eye(3), np.diag([1.0, -1, -1]), np.diag([-1.0, -1, 1]), tie):
+        want = rotations._matrix_quaternions_arrays(m[None])
+        assert rotations.matrix_quaternions(m).tobytes() == want.tobytes()

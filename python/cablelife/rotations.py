@@ -4,6 +4,8 @@ both against scipy)."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 
@@ -21,6 +23,41 @@ def matrix_quaternions(matrices: np.ndarray) -> np.ndarray:
     """Unit quaternions (n, 4), scalar first, of rotation matrices (n, 3, 3); Shepperd's method
     (the largest of trace and diagonal picks the stable formula; the same choice as scipy)."""
     r = np.asarray(matrices, dtype=float).reshape(-1, 3, 3)
+    if r.shape[0] <= SMALL and np.isfinite(r).all():
+        # a few matrices (a cable's clips at rest): Python floats, the same operations
+        return np.array([_shepperd(m) for m in r.tolist()]).reshape(-1, 4)
+    return _matrix_quaternions_arrays(r)
+
+
+#: Up to this many matrices are converted one by one (numpy's per-call cost, ~50 µs, is
+#: then most of the time: a harness run converts its clips' frames at rest 17 times).
+SMALL = 4
+
+
+def _shepperd(r: list) -> list[float]:
+    """`matrix_quaternions` of one matrix (nested lists), as the array code computes it: the
+    same choice (the first largest of the diagonal and the trace), the same sums in the same
+    order, the norm summed from x to w."""
+    d = (r[0][0], r[1][1], r[2][2])
+    trace = d[0] + d[1] + d[2]
+    options = (*d, trace)
+    choice = max(range(4), key=lambda c: (options[c], -c))
+    q = [0.0] * 4  # x, y, z, w
+    if choice == 3:
+        q = [r[2][1] - r[1][2], r[0][2] - r[2][0], r[1][0] - r[0][1], 1.0 + trace]
+    else:
+        i = choice
+        j, k = (i + 1) % 3, (i + 2) % 3
+        q[i] = 1.0 - trace + 2.0 * r[i][i]
+        q[j] = r[j][i] + r[i][j]
+        q[k] = r[k][i] + r[i][k]
+        q[3] = r[k][j] - r[j][k]
+    norm = math.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
+    return [q[3] / norm, q[0] / norm, q[1] / norm, q[2] / norm]
+
+
+def _matrix_quaternions_arrays(r: np.ndarray) -> np.ndarray:
+    """`matrix_quaternions` of (n, 3, 3) in array operations."""
     n = r.shape[0]
     diag = np.stack([r[:, 0, 0], r[:, 1, 1], r[:, 2, 2]], axis=1)
     trace = diag.sum(axis=1)
