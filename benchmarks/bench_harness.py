@@ -127,16 +127,22 @@ def single(mode: str, duration: float) -> dict:
     return sc
 
 
+#: Every run's result, kept to the end of the benchmark (`timed`).
+KEPT: list = []
+
+
 def timed(sc, repeat: int) -> tuple[float, float, float, float]:
     """Medians of the solver wall time, the whole simulate() call, the mean Newton
     iterations per step after the first and the CPU time of the simulate() call (one
     thread: the time on one core, whatever the machine's load). Every run's result is kept
-    until all are timed: each run writes its records into fresh memory, as a user's single
-    run in a new process does, and no run is charged with freeing the one before (at 5 s
-    that was 14 ms of the harness's whole call; freed before the next run, its memory would
-    be reused without page faults: 0.078 s instead of 0.092 s of solver for the 1 s run)."""
+    to the end of the benchmark (`KEPT`): each run writes its records into fresh memory, as a
+    user's single run in a new process does, and no run is charged with freeing the one
+    before (at 5 s that was 14 ms of the harness's whole call; freed before the next run, its
+    memory would be reused without page faults: 0.078 s instead of 0.092 s of solver for the
+    1 s run). Session 20: kept per call of `timed` only, the quasistatic runs' memory, freed
+    before the dynamic ones, was reused by them (solver 0.070 s instead of 0.082 s)."""
     solver, whole, iters, cpu = [], [], [], []
-    kept = []
+    kept = KEPT
     for _ in range(repeat):
         t0, c0 = time.perf_counter(), time.process_time()
         res = simulate(sc)
