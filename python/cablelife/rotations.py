@@ -19,6 +19,11 @@ def euler_matrix(angles) -> np.ndarray:
     return rz @ ry @ rx
 
 
+#: Up to this many matrices are converted one by one (numpy's per-call cost, ~50 µs, is
+#: then most of the time: a harness run converts its clips' frames at rest 17 times).
+SMALL = 4
+
+
 def matrix_quaternions(matrices: np.ndarray) -> np.ndarray:
     """Unit quaternions (n, 4), scalar first, of rotation matrices (n, 3, 3); Shepperd's method
     (the largest of trace and diagonal picks the stable formula; the same choice as scipy)."""
@@ -29,11 +34,6 @@ def matrix_quaternions(matrices: np.ndarray) -> np.ndarray:
     return _matrix_quaternions_arrays(r)
 
 
-#: Up to this many matrices are converted one by one (numpy's per-call cost, ~50 µs, is
-#: then most of the time: a harness run converts its clips' frames at rest 17 times).
-SMALL = 4
-
-
 def _shepperd(r: list) -> list[float]:
     """`matrix_quaternions` of one matrix (nested lists), as the array code computes it: the
     same choice (the first largest of the diagonal and the trace), the same sums in the same
@@ -42,12 +42,12 @@ def _shepperd(r: list) -> list[float]:
     trace = d[0] + d[1] + d[2]
     options = (*d, trace)
     choice = max(range(4), key=lambda c: (options[c], -c))
-    q = [0.0] * 4  # x, y, z, w
-    if choice == 3:
+    if choice == 3:  # x, y, z, w
         q = [r[2][1] - r[1][2], r[0][2] - r[2][0], r[1][0] - r[0][1], 1.0 + trace]
     else:
         i = choice
         j, k = (i + 1) % 3, (i + 2) % 3
+        q = [0.0] * 4
         q[i] = 1.0 - trace + 2.0 * r[i][i]
         q[j] = r[j][i] + r[i][j]
         q[k] = r[k][i] + r[i][k]

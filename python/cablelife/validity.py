@@ -69,7 +69,13 @@ def strains(c: CableResult, steps: slice = slice(None)) -> tuple[np.ndarray, np.
     # Rust kernel (rod::shear::saved_strain): the rotation matrices of every step and edge are
     # never formed; a dynamic run saves 1000s of steps (numpy took 9 ms per simulated second of
     # bench_harness.py's harness, 5 % of its simulate()).
-    return _core.section_strains(
+    return _core.section_strains(*_saved_configuration(c, steps))
+
+
+def _saved_configuration(c: CableResult, steps: slice = slice(None)):
+    """Positions, quaternions (of the saved ``steps``) and arc lengths as the Rust strain
+    kernels take them: C-contiguous float64."""
+    return (
         np.ascontiguousarray(c.positions[steps], dtype=float),
         np.ascontiguousarray(c.quaternions[steps], dtype=float),
         np.ascontiguousarray(c.arc_length, dtype=float),
@@ -82,11 +88,7 @@ def strain_extremes(c: CableResult) -> dict:
     # one pass in Rust (rod::shear::saved_strain_extremes), no strain arrays: 2.4 ms per
     # simulated second of bench_harness.py's harness instead of 12 ms over 5 s through the
     # arrays and numpy's argmax
-    found = _core.strain_extremes(
-        np.ascontiguousarray(c.positions, dtype=float),
-        np.ascontiguousarray(c.quaternions, dtype=float),
-        np.ascontiguousarray(c.arc_length, dtype=float),
-    )
+    found = _core.strain_extremes(*_saved_configuration(c))
     out = {}
     for key, extreme in zip(("axial", "compression", "shear"), found or (None,) * 3, strict=True):
         if extreme is None:

@@ -423,43 +423,35 @@ impl Workspace {
         part: Part,
         sums: &mut (f64, f64),
     ) -> Result<(), KinkAt> {
-        match part {
-            Part::All => {
-                let outputs = self.section_outputs;
-                if want_jac {
-                    for e in 0..rod.n_edges() {
-                        self.shear_term(rod, st, rates, true, e, outputs, sums);
-                    }
-                    for i in 0..rod.bend_terms.len() {
-                        self.bend_term(rod, st, rates, true, i, outputs, sums)?;
-                    }
-                } else {
-                    let edges = Elements::Range(0, rod.n_edges());
-                    self.shear_terms_lanes(rod, st, rates, edges, outputs, sums);
-                    let terms = Elements::Range(0, rod.bend_terms.len());
-                    self.bend_terms_lanes(rod, st, rates, terms, outputs, sums)?;
-                }
-                for n in 0..if outputs { self.node_moment.len() } else { 0 } {
-                    if self.node_moment_count[n] > 1 {
-                        let w = 1.0 / self.node_moment_count[n] as f64;
-                        self.node_moment[n] *= w;
-                        self.node_moment_viscous[n] *= w;
-                    }
-                }
+        // section outputs (averaged at the nodes) only for the whole cable
+        let (edges, terms, outputs) = match part {
+            Part::All => (
+                Elements::Range(0, rod.n_edges()),
+                Elements::Range(0, rod.bend_terms.len()),
+                self.section_outputs,
+            ),
+            Part::Segment(seg) => (
+                Elements::List(&seg.edges),
+                Elements::List(&seg.bend_terms),
+                false,
+            ),
+        };
+        if want_jac {
+            for k in 0..edges.len() {
+                self.shear_term(rod, st, rates, true, edges.at(k), outputs, sums);
             }
-            Part::Segment(seg) if want_jac => {
-                for &e in &seg.edges {
-                    self.shear_term(rod, st, rates, true, e, false, sums);
-                }
-                for &i in &seg.bend_terms {
-                    self.bend_term(rod, st, rates, true, i, false, sums)?;
-                }
+            for k in 0..terms.len() {
+                self.bend_term(rod, st, rates, true, terms.at(k), outputs, sums)?;
             }
-            Part::Segment(seg) => {
-                let edges = Elements::List(&seg.edges);
-                self.shear_terms_lanes(rod, st, rates, edges, false, sums);
-                let terms = Elements::List(&seg.bend_terms);
-                self.bend_terms_lanes(rod, st, rates, terms, false, sums)?;
+        } else {
+            self.shear_terms_lanes(rod, st, rates, edges, outputs, sums);
+            self.bend_terms_lanes(rod, st, rates, terms, outputs, sums)?;
+        }
+        for n in 0..if outputs { self.node_moment.len() } else { 0 } {
+            if self.node_moment_count[n] > 1 {
+                let w = 1.0 / self.node_moment_count[n] as f64;
+                self.node_moment[n] *= w;
+                self.node_moment_viscous[n] *= w;
             }
         }
         Ok(())

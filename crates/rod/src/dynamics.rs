@@ -1173,15 +1173,16 @@ impl Dynamics {
                 eth = eth.max(d.fixed_rows::<3>(3).amax());
             }
         }
-        let half = &self.inertial_half[re.clone()];
-        rotate_edges(
-            &self.p_n[re.clone()],
-            &self.turn[re.clone()],
-            |e| half[e][1],
-            &mut st.p[re],
-        );
+        self.turn_edges(st, re);
         let error = self.error_estimate(ex, eth);
         ((dx_max / self.length).max(dth_max), error)
+    }
+
+    /// p = p_n ⊗ exp(turn/2) for the inertial edges of `re` (their turns just stored).
+    fn turn_edges(&self, st: &mut State, re: std::ops::Range<usize>) {
+        let half = &self.inertial_half[re.clone()];
+        let (p_n, turn) = (&self.p_n[re.clone()], &self.turn[re.clone()]);
+        rotate_edges(p_n, turn, |e| half[e][1], &mut st.p[re]);
     }
 
     /// Applies the Newton correction `delta` of a segment (v̇ += c_m δq on inertial slots, the
@@ -1240,13 +1241,7 @@ impl Dynamics {
                 dth_max = dth_max.max(dth.amax());
             }
         }
-        let half = &self.inertial_half[re.clone()];
-        rotate_edges(
-            &self.p_n[re.clone()],
-            &self.turn[re.clone()],
-            |e| half[e][1],
-            &mut st.p[re],
-        );
+        self.turn_edges(st, re);
         self.apply_massless(rod, st, seg);
         let error = self.error_estimate(ex, eth);
         ((dx_max / self.length).max(dth_max), error)

@@ -51,6 +51,9 @@ pub struct ModalSystem {
     sigma: f64,
     xc: Vec<Vec<Vector6<f64>>>,
     xj: Vec<Vector6<f64>>,
+    /// M x and a refinement's correction in `HarnessPencil::apply` (flattened unknowns).
+    mx: Vec<Vector6<f64>>,
+    dy: Vec<Vector6<f64>>,
 }
 
 /// The lumped mass of junction `j` on its unknowns: its own mass plus the node masses of the
@@ -91,6 +94,7 @@ impl ModalSystem {
             .map(|r| vec![Vector6::zeros(); r.arc.len()])
             .collect();
         let xj = vec![Vector6::zeros(); h.junctions.len()];
+        let n = m.len();
         ModalSystem {
             k,
             work,
@@ -99,6 +103,8 @@ impl ModalSystem {
             sigma: 0.0,
             xc,
             xj,
+            mx: vec![Vector6::zeros(); n],
+            dy: vec![Vector6::zeros(); n],
         }
     }
 
@@ -224,13 +230,15 @@ impl ShiftInvert for HarnessPencil<'_> {
         r: &mut [Vector6<f64>],
         refine: bool,
     ) {
-        let b: Vec<Vector6<f64>> = x
-            .iter()
-            .zip(&self.s.m)
-            .map(|(x, m)| x.component_mul(m))
-            .collect();
+        // the system's buffers, taken out for the calls that borrow it
+        let (mut b, mut dy) = (
+            std::mem::take(&mut self.s.mx),
+            std::mem::take(&mut self.s.dy),
+        );
+        for ((b, x), m) in b.iter_mut().zip(x).zip(&self.s.m) {
+            *b = x.component_mul(m);
+        }
         self.solve(&b, y);
-        let mut dy = vec![Vector6::zeros(); y.len()];
         for _ in 0..if refine { REFINEMENT_STEPS } else { 0 } {
             self.residual(&b, y, r);
             self.solve(r, &mut dy);
@@ -238,6 +246,7 @@ impl ShiftInvert for HarnessPencil<'_> {
                 *y += d;
             }
         }
+        (self.s.mx, self.s.dy) = (b, dy);
     }
 }
 

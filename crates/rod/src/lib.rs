@@ -28,6 +28,7 @@ mod projection;
 pub mod rotation;
 pub mod routing;
 pub mod shear;
+mod simd;
 pub mod sliding;
 pub mod stability;
 pub mod state;

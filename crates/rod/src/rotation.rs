@@ -2,8 +2,8 @@
 //!
 //! nalgebra's `Quaternion::new(w, i, j, k)` is used throughout; `R(p)` maps the material frame
 //! (d1, d2, d3) to the global frame. Increments act in the body frame: p ← p ⊗ exp(θ/2).
+use crate::simd::{lanes, splat};
 use nalgebra::{Matrix3, Quaternion, Vector3};
-use wide::f64x4;
 
 pub type Quat = Quaternion<f64>;
 
@@ -53,15 +53,14 @@ pub fn rotate_edges(
     let mut e = 0;
     while e < n {
         if e + 4 <= n && (e..e + 4).all(&moves) {
-            let lanes = |f: &dyn Fn(usize) -> f64| f64x4::new([f(0), f(1), f(2), f(3)]);
             let (tx, ty, tz) = (
-                lanes(&|l| turn[e + l].x),
-                lanes(&|l| turn[e + l].y),
-                lanes(&|l| turn[e + l].z),
+                lanes(|l| turn[e + l].x),
+                lanes(|l| turn[e + l].y),
+                lanes(|l| turn[e + l].z),
             );
             let a2 = tx * tx + ty * ty + tz * tz;
-            if a2.simd_lt(f64x4::splat(1e-2)).all() {
-                let s = f64x4::splat;
+            if a2.simd_lt(splat(1e-2)).all() {
+                let s = splat;
                 // exp_half's series
                 let t2 = s(0.25) * a2;
                 let t4 = t2 * t2;
@@ -72,10 +71,10 @@ pub fn rotate_edges(
                 let (ei, ej, ek) = (k * tx, k * ty, k * tz);
                 // p ⊗ exp (nalgebra's product)
                 let (pi, pj, pk, pw) = (
-                    lanes(&|l| p_n[e + l].i),
-                    lanes(&|l| p_n[e + l].j),
-                    lanes(&|l| p_n[e + l].k),
-                    lanes(&|l| p_n[e + l].w),
+                    lanes(|l| p_n[e + l].i),
+                    lanes(|l| p_n[e + l].j),
+                    lanes(|l| p_n[e + l].k),
+                    lanes(|l| p_n[e + l].w),
                 );
                 let qw = pw * ew - pi * ei - pj * ej - pk * ek;
                 let qi = pw * ei + pi * ew + pj * ek - pk * ej;

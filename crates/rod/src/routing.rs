@@ -4,9 +4,9 @@
 //! and the twist mismatch at the next clip is spread linearly over the span.
 use crate::model::{Pose, Rod, SpecError};
 use crate::rotation::{any_normal, exp_half, min_rotation, rotation_matrix, Quat};
+use crate::simd::{f64x4, splat};
 use crate::state::{twist, State};
 use nalgebra::Vector3;
-use wide::f64x4;
 
 const SAMPLES: usize = 400;
 
@@ -211,7 +211,7 @@ impl SpanCurve {
         const PADDED: usize = SAMPLES + 4;
         let (mut px, mut py, mut pz) = ([0.0; PADDED], [0.0; PADDED], [0.0; PADDED]);
         (px[0], py[0], pz[0]) = (self.a.x, self.a.y, self.a.z);
-        let s = |x: f64| f64x4::splat(x);
+        let s = splat;
         let n = s(SAMPLES as f64);
         let mut i = 1;
         while i <= SAMPLES {

@@ -4,8 +4,8 @@
 //! Derivatives are taken in the coordinates (x_a, x_b, θ) with p ← p ⊗ exp(θ/2) at θ = 0;
 //! the Hessian is the exact second derivative in these coordinates (symmetric).
 use crate::rotation::{rotation_matrix, skew, Quat};
+use crate::simd::{lanes, splat};
 use nalgebra::{Matrix3, Vector3};
-use wide::f64x4;
 
 /// Value, gradient and Hessian of one shear element.
 #[derive(Clone, Debug, Default)]
@@ -72,6 +72,25 @@ impl Extreme {
             *slot = Some(Extreme { value, step, edge });
         }
     }
+
+    /// `offer` of a saved step's values by edge, scanned only where one of them could be
+    /// taken: none yet, or one above the largest so far, or a NaN (unless that is a NaN
+    /// already). The test pass has no early exit, so that it vectorises.
+    fn offer_step(
+        slot: &mut Option<Extreme>,
+        values: impl Iterator<Item = f64> + Clone,
+        step: usize,
+    ) {
+        if let Some(b) = slot {
+            let above = |any: bool, v: f64| any | (v > b.value || v.is_nan());
+            if b.value.is_nan() || !values.clone().fold(false, above) {
+                return;
+            }
+        }
+        for (edge, value) in values.enumerate() {
+            Extreme::offer(slot, value, step, edge);
+        }
+    }
 }
 
 /// Axial strain Γ₃ and shear strain |(Γ₁, Γ₂)| of every edge at one saved step: positions
@@ -90,18 +109,16 @@ pub fn saved_step_strains(
     let n = inv_ds.len();
     let full = n - n % 4;
     for e0 in (0..full).step_by(4) {
-        let lanes = |f: &dyn Fn(usize) -> f64| f64x4::new([f(0), f(1), f(2), f(3)]);
-        let w = lanes(&|l| p[4 * (e0 + l)]);
+        let w = lanes(|l| p[4 * (e0 + l)]);
         let (ux, uy, uz) = (
-            lanes(&|l| p[4 * (e0 + l) + 1]),
-            lanes(&|l| p[4 * (e0 + l) + 2]),
-            lanes(&|l| p[4 * (e0 + l) + 3]),
+            lanes(|l| p[4 * (e0 + l) + 1]),
+            lanes(|l| p[4 * (e0 + l) + 2]),
+            lanes(|l| p[4 * (e0 + l) + 3]),
         );
-        let inv = lanes(&|l| inv_ds[e0 + l]);
-        let k = f64x4::splat(2.0) / (w * w + (ux * ux + uy * uy + uz * uz));
-        let d = |i: usize| {
-            (lanes(&|l| x[3 * (e0 + l + 1) + i]) - lanes(&|l| x[3 * (e0 + l) + i])) * inv
-        };
+        let inv = lanes(|l| inv_ds[e0 + l]);
+        let k = splat(2.0) / (w * w + (ux * ux + uy * uy + uz * uz));
+        let d =
+            |i: usize| (lanes(|l| x[3 * (e0 + l + 1) + i]) - lanes(|l| x[3 * (e0 + l) + i])) * inv;
         let (vx, vy, vz) = (d(0), d(1), d(2));
         // c = u × v, then u × c
         let (cx, cy, cz) = (uy * vz - uz * vy, uz * vx - ux * vz, ux * vy - uy * vx);
@@ -109,7 +126,7 @@ pub fn saved_step_strains(
         // v + k (u × c − w c) − e₃ (x − 0 is x to the last bit)
         let gx = vx + k * (ex - w * cx);
         let gy = vy + k * (ey - w * cy);
-        let gz = vz + k * (ez - w * cz) - f64x4::splat(1.0);
+        let gz = vz + k * (ez - w * cz) - splat(1.0);
         axial[e0..e0 + 4].copy_from_slice(&gz.to_array());
         shear[e0..e0 + 4].copy_from_slice(&(gx * gx + gy * gy).sqrt().to_array());
     }
@@ -157,32 +174,9 @@ pub fn saved_strain_extremes(
         let x = &positions[k * 3 * (n + 1)..(k + 1) * 3 * (n + 1)];
         let p = &quaternions[k * 4 * n..(k + 1) * 4 * n];
         saved_step_strains(x, p, inv_ds, &mut axial, &mut shear);
-        // each scan only where one of the step's values could be taken (`Extreme::offer`:
-        // none yet, or above the largest so far, or a NaN — unless that is a NaN already)
-        let open = |b: &Option<Extreme>, values: &mut dyn Iterator<Item = f64>| match b {
-            None => true,
-            Some(b) => {
-                !b.value.is_nan() && values.fold(false, |any, v| any | (v > b.value || v.is_nan()))
-            }
-        };
-        if open(&best[0], &mut axial.iter().copied()) {
-            axial
-                .iter()
-                .enumerate()
-                .for_each(|(e, a)| Extreme::offer(&mut best[0], *a, k, e));
-        }
-        if open(&best[1], &mut axial.iter().map(|a| -a)) {
-            axial
-                .iter()
-                .enumerate()
-                .for_each(|(e, a)| Extreme::offer(&mut best[1], -a, k, e));
-        }
-        if open(&best[2], &mut shear.iter().copied()) {
-            shear
-                .iter()
-                .enumerate()
-                .for_each(|(e, s)| Extreme::offer(&mut best[2], *s, k, e));
-        }
+        Extreme::offer_step(&mut best[0], axial.iter().copied(), k);
+        Extreme::offer_step(&mut best[1], axial.iter().map(|a| -a), k);
+        Extreme::offer_step(&mut best[2], shear.iter().copied(), k);
     }
     match best {
         [Some(a), Some(c), Some(s)] => Some([a, c, s]),

@@ -15,9 +15,9 @@ use super::{rot, KinkAt, Workspace};
 use crate::assembly::Rates;
 use crate::bending::MIN_COS_HALF;
 use crate::model::{Rod, RotRef};
+use crate::simd::{f64x4, lanes, splat};
 use crate::state::State;
 use nalgebra::Vector3;
-use wide::f64x4;
 
 /// The elements of a part: a range (the whole cable) or a list (a segment's).
 #[derive(Clone, Copy)]
@@ -27,7 +27,7 @@ pub(crate) enum Elements<'a> {
 }
 
 impl Elements<'_> {
-    fn len(&self) -> usize {
+    pub(super) fn len(&self) -> usize {
         match self {
             Elements::Range(a, b) => b - a,
             Elements::List(l) => l.len(),
@@ -35,7 +35,7 @@ impl Elements<'_> {
     }
 
     #[inline(always)]
-    fn at(&self, k: usize) -> usize {
+    pub(super) fn at(&self, k: usize) -> usize {
         match self {
             Elements::Range(a, _) => a + k,
             Elements::List(l) => l[k],
@@ -44,17 +44,6 @@ impl Elements<'_> {
 }
 
 type V = f64x4;
-
-/// Four lanes from a value per lane.
-#[inline(always)]
-fn lanes(f: impl Fn(usize) -> f64) -> V {
-    f64x4::new([f(0), f(1), f(2), f(3)])
-}
-
-#[inline(always)]
-fn splat(x: f64) -> V {
-    f64x4::splat(x)
-}
 
 /// A vector of three lanes.
 #[derive(Clone, Copy)]
